@@ -1,0 +1,38 @@
+//! Distributions sampled by the inversion method, and discrete choices.
+//!
+//! - [`Exponential`]: x = -ln(1 - U)/λ, the textbook example of inverting a CDF.
+//! - [`PiecewiseConstant1D`]: any tabulated non-negative function on an interval, normalised
+//!   into a pdf; its CDF is built once and inverted by binary search. Continuous and discrete
+//!   sampling.
+//! - [`PiecewiseConstant2D`]: a tabulated function on a rectangle, sampled by a marginal
+//!   distribution over rows and a conditional one within the chosen row (what environment-map
+//!   importance sampling uses).
+//! - [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias method, built by
+//!   Vose's algorithm), e.g. choosing a light in proportion to its power.
+//!
+//! Every `sample` returns the value *and* its pdf (or pmf), and every distribution has a
+//! matching `pdf` so that the two can be checked against each other.
+
+mod alias;
+mod exponential;
+mod piecewise;
+
+pub use alias::{AliasSample, AliasTable};
+pub use exponential::Exponential;
+pub use piecewise::{DiscreteSample, PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseSample};
+
+use crate::error::{Error, Result};
+
+/// Checks that every value is finite and non-negative.
+pub(crate) fn check_weights<T: Copy + Into<f64>>(what: &'static str, values: &[T]) -> Result<()> {
+    if values.is_empty() {
+        return Err(Error::Empty { what });
+    }
+    for (index, &v) in values.iter().enumerate() {
+        let value: f64 = v.into();
+        if !value.is_finite() || value < 0.0 {
+            return Err(Error::InvalidValue { what, index, value });
+        }
+    }
+    Ok(())
+}

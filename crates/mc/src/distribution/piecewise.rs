@@ -1,0 +1,292 @@
+use super::check_weights;
+use crate::error::{Error, Result};
+use glam::Vec2;
+
+/// A continuous sample of a [`PiecewiseConstant1D`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PiecewiseSample {
+    /// The sampled point in `[min, max)`.
+    pub x: f32,
+    /// Its density with respect to x.
+    pub pdf: f32,
+    /// The index of the piece it fell in.
+    pub offset: usize,
+}
+
+/// A discrete sample of a [`PiecewiseConstant1D`]: a piece chosen with probability
+/// proportional to its value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiscreteSample {
+    /// The chosen piece.
+    pub index: usize,
+    /// Its probability.
+    pub pmf: f32,
+    /// The random number, stretched back to [0, 1) inside the chosen piece, so that it can be
+    /// reused for another decision.
+    pub u_remapped: f32,
+}
+
+/// A piecewise-constant density on `[min, max]`: `n` equal pieces with values `f[i]`,
+/// normalised so that it integrates to one.
+///
+/// Construction builds the CDF (running sums in `f64`, stored in `f32`); sampling inverts it by
+/// binary search for the piece and linear interpolation inside the piece. A function that is
+/// zero everywhere is treated as uniform, so that sampling is always defined.
+///
+/// ```
+/// use pathlab_mc::distribution::PiecewiseConstant1D;
+/// let d = PiecewiseConstant1D::new(&[1.0, 3.0], 0.0, 1.0).unwrap();
+/// let s = d.sample(0.5);          // the CDF is 0.25 at x = 0.5
+/// assert_eq!(s.offset, 1);
+/// assert!((s.pdf - 1.5).abs() < 1e-6 && (d.pdf(0.25) - 0.5).abs() < 1e-6);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct PiecewiseConstant1D {
+    func: Vec<f32>,
+    cdf: Vec<f32>,
+    min: f32,
+    max: f32,
+    func_int: f32,
+}
+
+impl PiecewiseConstant1D {
+    /// The distribution of the values `func` (finite, ≥ 0, at least one) over `[min, max]`.
+    pub fn new(func: &[f32], min: f32, max: f32) -> Result<Self> {
+        const WHAT: &str = "piecewise-constant distribution";
+        check_weights(WHAT, func)?;
+        if !(min.is_finite() && max.is_finite() && min < max) {
+            return Err(Error::InvalidParameter {
+                what: WHAT,
+                message: format!("domain [{min}, {max}] must be a finite, non-empty interval"),
+            });
+        }
+        let n = func.len();
+        let width = (max - min) as f64;
+        let mut sums = Vec::with_capacity(n + 1);
+        let mut acc = 0.0f64;
+        sums.push(0.0);
+        for &f in func {
+            acc += f as f64 * width / n as f64;
+            sums.push(acc);
+        }
+        let func_int = acc;
+        let cdf = if func_int > 0.0 {
+            sums.iter().map(|&c| (c / func_int) as f32).collect()
+        } else {
+            (0..=n).map(|i| (i as f64 / n as f64) as f32).collect()
+        };
+        let mut cdf: Vec<f32> = cdf;
+        cdf[n] = 1.0;
+        Ok(PiecewiseConstant1D {
+            func: func.to_vec(),
+            cdf,
+            min,
+            max,
+            func_int: func_int as f32,
+        })
+    }
+
+    /// The number of pieces.
+    pub fn len(&self) -> usize {
+        self.func.len()
+    }
+
+    /// Always false: a distribution has at least one piece.
+    pub fn is_empty(&self) -> bool {
+        self.func.is_empty()
+    }
+
+    /// ∫ f(x) dx over the domain (before normalisation).
+    pub fn integral(&self) -> f32 {
+        self.func_int
+    }
+
+    /// The domain `[min, max]`.
+    pub fn domain(&self) -> (f32, f32) {
+        (self.min, self.max)
+    }
+
+    /// The piece values as given.
+    pub fn func(&self) -> &[f32] {
+        &self.func
+    }
+
+    /// The CDF at the piece boundaries (`len() + 1` values from 0 to 1).
+    pub fn cdf(&self) -> &[f32] {
+        &self.cdf
+    }
+
+    /// The piece `o` with `cdf[o] <= u < cdf[o + 1]` (pieces of zero probability are skipped).
+    #[inline]
+    fn find_piece(&self, u: f32) -> usize {
+        // Number of CDF entries <= u, minus one, kept within 0..n.
+        let upper = self.cdf.partition_point(|&c| c <= u);
+        upper.saturating_sub(1).min(self.func.len() - 1)
+    }
+
+    /// Density of piece `o` with respect to x.
+    #[inline]
+    fn piece_pdf(&self, o: usize) -> f32 {
+        if self.func_int > 0.0 {
+            self.func[o] / self.func_int
+        } else {
+            1.0 / (self.max - self.min)
+        }
+    }
+
+    /// A point with density `pdf(x)`, by inverting the CDF at `u` in [0, 1).
+    pub fn sample(&self, u: f32) -> PiecewiseSample {
+        let o = self.find_piece(u);
+        let (c0, c1) = (self.cdf[o], self.cdf[o + 1]);
+        let mut du = u - c0;
+        if c1 - c0 > 0.0 {
+            du /= c1 - c0;
+        }
+        let t = ((o as f32 + du.clamp(0.0, 1.0)) / self.func.len() as f32).min(1.0);
+        let x = (self.min + t * (self.max - self.min)).min(self.max.next_down());
+        PiecewiseSample {
+            x,
+            pdf: self.piece_pdf(o),
+            offset: o,
+        }
+    }
+
+    /// The density at `x` (0 outside the domain).
+    pub fn pdf(&self, x: f32) -> f32 {
+        if !(self.min..=self.max).contains(&x) {
+            return 0.0;
+        }
+        self.piece_pdf(self.offset_of(x))
+    }
+
+    /// The index of the piece containing `x` (clamped to the domain).
+    #[inline]
+    pub fn offset_of(&self, x: f32) -> usize {
+        let n = self.func.len();
+        let t = (x - self.min) / (self.max - self.min);
+        ((t * n as f32) as isize).clamp(0, n as isize - 1) as usize
+    }
+
+    /// The `u` that [`PiecewiseConstant1D::sample`] maps to `x`: the CDF at `x`.
+    pub fn invert_sample(&self, x: f32) -> f32 {
+        let n = self.func.len();
+        let t = ((x - self.min) / (self.max - self.min)).clamp(0.0, 1.0) * n as f32;
+        let o = (t as usize).min(n - 1);
+        let frac = t - o as f32;
+        self.cdf[o] + frac * (self.cdf[o + 1] - self.cdf[o])
+    }
+
+    /// A piece chosen with probability proportional to its value (uniform if all are zero).
+    pub fn sample_discrete(&self, u: f32) -> DiscreteSample {
+        let o = self.find_piece(u);
+        let (c0, c1) = (self.cdf[o], self.cdf[o + 1]);
+        let pmf = c1 - c0;
+        let u_remapped = if pmf > 0.0 {
+            ((u - c0) / pmf).clamp(0.0, 1.0f32.next_down())
+        } else {
+            0.0
+        };
+        DiscreteSample {
+            index: o,
+            pmf,
+            u_remapped,
+        }
+    }
+
+    /// The probability [`PiecewiseConstant1D::sample_discrete`] gives piece `index`.
+    pub fn discrete_pmf(&self, index: usize) -> f32 {
+        match (self.cdf.get(index), self.cdf.get(index + 1)) {
+            (Some(c0), Some(c1)) => c1 - c0,
+            _ => 0.0,
+        }
+    }
+}
+
+
+/// A piecewise-constant density on a rectangle: `nu × nv` cells with values `f[v][u]`.
+///
+/// Sampled by the marginal-conditional method: first a row `v` from the marginal density
+/// p(v) = ∫ f(u, v) du / ∫∫ f, then `u` from the conditional p(u | v) = f(u, v) / ∫ f(u, v) du
+/// within that row; the joint density is their product, f(u, v) / ∫∫ f. For environment maps
+/// the values are luminance × sin θ so that the density is uniform in solid angle where the map
+/// is constant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PiecewiseConstant2D {
+    conditional: Vec<PiecewiseConstant1D>,
+    marginal: PiecewiseConstant1D,
+    min: Vec2,
+    max: Vec2,
+}
+
+impl PiecewiseConstant2D {
+    /// The distribution of `func` (row-major, `nu` values per row, `nv` rows) over the
+    /// rectangle `[min, max]`.
+    pub fn new(func: &[f32], nu: usize, nv: usize, min: Vec2, max: Vec2) -> Result<Self> {
+        const WHAT: &str = "2D piecewise-constant distribution";
+        if nu == 0 || nv == 0 || func.len() != nu * nv {
+            return Err(Error::InvalidParameter {
+                what: WHAT,
+                message: format!(
+                    "expected {nu} x {nv} = {} values, got {}",
+                    nu.saturating_mul(nv),
+                    func.len()
+                ),
+            });
+        }
+        check_weights(WHAT, func)?;
+        let conditional = func
+            .chunks_exact(nu)
+            .map(|row| PiecewiseConstant1D::new(row, min.x, max.x))
+            .collect::<Result<Vec<_>>>()?;
+        let row_integrals: Vec<f32> = conditional.iter().map(|c| c.integral()).collect();
+        let marginal = PiecewiseConstant1D::new(&row_integrals, min.y, max.y)?;
+        Ok(PiecewiseConstant2D {
+            conditional,
+            marginal,
+            min,
+            max,
+        })
+    }
+
+    /// ∫∫ f over the rectangle.
+    pub fn integral(&self) -> f32 {
+        self.marginal.integral()
+    }
+
+    /// The rectangle `(min, max)`.
+    pub fn domain(&self) -> (Vec2, Vec2) {
+        (self.min, self.max)
+    }
+
+    /// A point of the rectangle and its density (per unit area of the rectangle).
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let row = self.marginal.sample(u.y);
+        let col = self.conditional[row.offset].sample(u.x);
+        (Vec2::new(col.x, row.x), col.pdf * row.pdf)
+    }
+
+    /// The density at `p` (0 outside the rectangle).
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        if !(self.min.x..=self.max.x).contains(&p.x) || !(self.min.y..=self.max.y).contains(&p.y)
+        {
+            return 0.0;
+        }
+        let v = self.marginal.offset_of(p.y);
+        let row = &self.conditional[v];
+        if self.marginal.integral() > 0.0 {
+            row.func()[row.offset_of(p.x)] / self.marginal.integral()
+        } else {
+            let size = self.max - self.min;
+            1.0 / (size.x * size.y)
+        }
+    }
+
+    /// The `u` that [`PiecewiseConstant2D::sample`] maps to `p`.
+    pub fn invert_sample(&self, p: Vec2) -> Vec2 {
+        let v = self.marginal.offset_of(p.y);
+        Vec2::new(
+            self.conditional[v].invert_sample(p.x),
+            self.marginal.invert_sample(p.y),
+        )
+    }
+}

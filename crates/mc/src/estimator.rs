@@ -1,0 +1,292 @@
+//! Estimators: running statistics and the Monte Carlo integral F_N = 1/N Σ f(X_i)/p(X_i).
+//!
+//! [`RunningStats`] keeps the count, mean and sum of squared deviations of a stream of values
+//! (Welford's algorithm, numerically stable in one pass) and merges with another in O(1)
+//! (Chan, Golub and LeVeque's pairwise update), so parallel workers can each keep their own
+//! and combine them at the end. [`Estimate`] is what is reported: mean, standard error and a
+//! 95% confidence interval.
+//!
+//! [`integrate`] is the estimator itself: draw X_i with density p, average f(X_i)/p(X_i). It is
+//! unbiased whenever p > 0 wherever f ≠ 0; its variance is Var[f(X)/p(X)]/N, which importance
+//! sampling makes small by choosing p close to proportional to |f|.
+//!
+//! ```
+//! use pathlab_mc::estimator::integrate;
+//! use pathlab_mc::sampler::{IndependentSampler, Sampler};
+//! use pathlab_mc::warp::{sample_uniform_hemisphere, uniform_hemisphere_pdf};
+//! // ∫ cos θ dω over the hemisphere = π
+//! let mut s = IndependentSampler::new(1, 1);
+//! let est = integrate(
+//!     |w: &glam::Vec3| w.z as f64,
+//!     &mut s,
+//!     |s| (sample_uniform_hemisphere(s.next_2d()), uniform_hemisphere_pdf() as f64),
+//!     100_000,
+//! );
+//! assert!((est.mean - std::f64::consts::PI).abs() < 4.0 * est.std_error);
+//! ```
+
+use crate::sampler::Sampler;
+use rayon::prelude::*;
+use statrs::distribution::{ContinuousCDF, StudentsT};
+
+/// Count, mean and sum of squared deviations of a stream of values.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RunningStats {
+    n: u64,
+    mean: f64,
+    m2: f64,
+}
+
+impl RunningStats {
+    /// No values yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds one value (Welford's update).
+    #[inline]
+    pub fn push(&mut self, x: f64) {
+        self.n += 1;
+        let delta = x - self.mean;
+        self.mean += delta / self.n as f64;
+        self.m2 += delta * (x - self.mean);
+    }
+
+    /// Combines with the statistics of another, disjoint set of values: the result is what
+    /// pushing all of them into one would give (up to rounding).
+    pub fn merge(&mut self, other: &RunningStats) {
+        if other.n == 0 {
+            return;
+        }
+        if self.n == 0 {
+            *self = *other;
+            return;
+        }
+        let n = self.n + other.n;
+        let delta = other.mean - self.mean;
+        let (na, nb) = (self.n as f64, other.n as f64);
+        self.mean += delta * nb / n as f64;
+        self.m2 += other.m2 + delta * delta * na * nb / n as f64;
+        self.n = n;
+    }
+
+    /// Number of values.
+    pub fn count(&self) -> u64 {
+        self.n
+    }
+
+    /// Their mean (0 when empty).
+    pub fn mean(&self) -> f64 {
+        self.mean
+    }
+
+    /// The unbiased sample variance Σ (x - mean)² / (n - 1) (0 with fewer than two values).
+    pub fn variance(&self) -> f64 {
+        if self.n < 2 {
+            0.0
+        } else {
+            self.m2 / (self.n - 1) as f64
+        }
+    }
+
+    /// Standard deviation, √variance.
+    pub fn std_dev(&self) -> f64 {
+        self.variance().sqrt()
+    }
+
+    /// Standard error of the mean, √(variance / n).
+    pub fn std_error(&self) -> f64 {
+        if self.n == 0 {
+            0.0
+        } else {
+            (self.variance() / self.n as f64).sqrt()
+        }
+    }
+
+    /// The summary of these values as an estimate of their expectation.
+    pub fn estimate(&self) -> Estimate {
+        Estimate::from_stats(self)
+    }
+}
+
+/// A Monte Carlo estimate with its uncertainty.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// Number of samples.
+    pub n: u64,
+    /// The estimate F_N.
+    pub mean: f64,
+    /// Sample variance of the individual terms f(X_i)/p(X_i).
+    pub variance: f64,
+    /// Standard error of F_N, √(variance / N).
+    pub std_error: f64,
+    /// Two-sided 95% confidence interval for the expectation (Student's t with N - 1 degrees of
+    /// freedom, which is the normal 1.96 for large N).
+    pub ci95: (f64, f64),
+}
+
+impl Estimate {
+    /// Summarises running statistics.
+    pub fn from_stats(stats: &RunningStats) -> Self {
+        let se = stats.std_error();
+        let half = t_quantile_975(stats.count()) * se;
+        Estimate {
+            n: stats.count(),
+            mean: stats.mean(),
+            variance: stats.variance(),
+            std_error: se,
+            ci95: (stats.mean() - half, stats.mean() + half),
+        }
+    }
+
+    /// Relative standard error, σ_F / |F| (infinite for a zero estimate with nonzero error).
+    pub fn relative_error(&self) -> f64 {
+        if self.std_error == 0.0 {
+            0.0
+        } else {
+            self.std_error / self.mean.abs()
+        }
+    }
+
+    /// Half the width of the 95% confidence interval.
+    pub fn ci95_half_width(&self) -> f64 {
+        0.5 * (self.ci95.1 - self.ci95.0)
+    }
+
+    /// Whether `value` lies inside the 95% confidence interval.
+    pub fn ci95_contains(&self, value: f64) -> bool {
+        (self.ci95.0..=self.ci95.1).contains(&value)
+    }
+}
+
+/// The 0.975 quantile of Student's t with n - 1 degrees of freedom.
+fn t_quantile_975(n: u64) -> f64 {
+    if n < 2 {
+        return f64::INFINITY;
+    }
+    if n > 100_000 {
+        return 1.959_963_984_540_054; // the normal quantile, to 1e-5 relative
+    }
+    StudentsT::new(0.0, 1.0, (n - 1) as f64)
+        .map(|t| t.inverse_cdf(0.975))
+        .unwrap_or(1.959_963_984_540_054)
+}
+
+/// The Monte Carlo estimator F_N = 1/N Σ f(X_i)/p(X_i).
+///
+/// For `i` in `0..n`, positions `sampler` at sample `i` (pixel (0, 0), dimension 0), calls
+/// `sample` to draw X_i and its density p(X_i) from the sampler, and averages f(X_i)/p(X_i).
+/// A draw with p = 0 contributes 0: such points are outside the sampled domain, and the
+/// estimate is of the integral of f over the set where p > 0.
+pub fn integrate<S: Sampler, X>(
+    mut f: impl FnMut(&X) -> f64,
+    sampler: &mut S,
+    mut sample: impl FnMut(&mut S) -> (X, f64),
+    n: u32,
+) -> Estimate {
+    let mut stats = RunningStats::new();
+    for i in 0..n {
+        sampler.start_pixel_sample([0, 0], i, 0);
+        stats.push(weighted_value(&mut f, sampler, &mut sample));
+    }
+    stats.estimate()
+}
+
+#[inline]
+fn weighted_value<S, X>(
+    f: &mut impl FnMut(&X) -> f64,
+    sampler: &mut S,
+    sample: &mut impl FnMut(&mut S) -> (X, f64),
+) -> f64 {
+    let (x, pdf) = sample(sampler);
+    if pdf > 0.0 {
+        f(&x) / pdf
+    } else {
+        0.0
+    }
+}
+
+/// Samples per work unit in [`integrate_parallel`].
+pub const PARALLEL_CHUNK: u32 = 4096;
+
+/// [`integrate`] on all threads, with the same result for any thread count.
+///
+/// Sample indices are cut into chunks of [`PARALLEL_CHUNK`]; each chunk runs on a clone of
+/// `sampler` and keeps its own [`RunningStats`]; the chunks are merged in index order. Because
+/// each sample depends only on its index, the estimate is bit-for-bit the same for any number
+/// of threads (it can differ from [`integrate`] in the last bits, from the merge order).
+pub fn integrate_parallel<S, X>(
+    f: impl Fn(&X) -> f64 + Sync,
+    sampler: &S,
+    sample: impl Fn(&mut S) -> (X, f64) + Sync,
+    n: u32,
+) -> Estimate
+where
+    S: Sampler + Clone + Send + Sync,
+{
+    let chunks = n.div_ceil(PARALLEL_CHUNK);
+    let partial: Vec<RunningStats> = (0..chunks)
+        .into_par_iter()
+        .map(|c| {
+            let mut s = sampler.clone();
+            let mut stats = RunningStats::new();
+            let start = c * PARALLEL_CHUNK;
+            let end = start.saturating_add(PARALLEL_CHUNK).min(n);
+            for i in start..end {
+                s.start_pixel_sample([0, 0], i, 0);
+                stats.push(weighted_value(&mut &f, &mut s, &mut &sample));
+            }
+            stats
+        })
+        .collect();
+    let mut total = RunningStats::new();
+    for p in &partial {
+        total.merge(p);
+    }
+    total.estimate()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn welford_matches_two_pass() {
+        let xs: Vec<f64> = (0..1000).map(|i| ((i * 7919) % 1000) as f64 * 0.01 + 1e6).collect();
+        let mut s = RunningStats::new();
+        xs.iter().for_each(|&x| s.push(x));
+        let mean = xs.iter().sum::<f64>() / xs.len() as f64;
+        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (xs.len() - 1) as f64;
+        assert!((s.mean() - mean).abs() < 1e-9 * mean);
+        assert!((s.variance() - var).abs() < 1e-9 * var);
+    }
+
+    #[test]
+    fn merge_equals_sequential() {
+        let xs: Vec<f64> = (0..777).map(|i| (i as f64 * 0.37).sin() * 10.0).collect();
+        let mut all = RunningStats::new();
+        xs.iter().for_each(|&x| all.push(x));
+        for split in [0, 1, 100, 776, 777] {
+            let (mut a, mut b) = (RunningStats::new(), RunningStats::new());
+            xs[..split].iter().for_each(|&x| a.push(x));
+            xs[split..].iter().for_each(|&x| b.push(x));
+            a.merge(&b);
+            assert_eq!(a.count(), all.count());
+            assert!((a.mean() - all.mean()).abs() < 1e-12);
+            assert!((a.variance() - all.variance()).abs() < 1e-10);
+        }
+    }
+
+    #[test]
+    fn confidence_interval_uses_student_t() {
+        let mut s = RunningStats::new();
+        for x in [1.0, 2.0, 3.0] {
+            s.push(x);
+        }
+        let e = s.estimate();
+        // t_{0.975, 2} = 4.302653; se = 1/√3.
+        let half = 4.302_652_729_911_275 / 3f64.sqrt();
+        assert!((e.ci95_half_width() - half).abs() < 1e-9);
+        assert!(e.ci95_contains(2.0));
+    }
+}

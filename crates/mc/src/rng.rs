@@ -1,0 +1,182 @@
+//! Random numbers: the PCG32 generator and the hashing that derives reproducible streams.
+//!
+//! PCG32 (O'Neill, "PCG: A Family of Simple Fast Space-Efficient Statistically Good Algorithms
+//! for Random Number Generation", 2014) has 64 bits of state, 2^63 selectable streams and can
+//! jump ahead by any distance in O(log distance) steps. Those two properties give every pixel
+//! sample its own stream that depends only on `(seed, pixel, sample index, dimension)`:
+//! the stream is chosen by a hash of `(pixel, seed)` and the position in it by
+//! `sample index * 2^16 + dimension`, so the numbers a pixel sample sees never depend on which
+//! thread computed it or in what order.
+
+const PCG32_DEFAULT_STATE: u64 = 0x853c_49e6_748f_ea9b;
+const PCG32_DEFAULT_STREAM: u64 = 0xda3e_39cb_94b9_5bdb;
+const PCG32_MULT: u64 = 0x5851_f42d_4c95_7f2d;
+
+/// Dimensions reserved for one pixel sample in a PCG32 stream: sample `i` of a pixel starts at
+/// position `i * DIMENSIONS_PER_SAMPLE`.
+pub const DIMENSIONS_PER_SAMPLE: u64 = 1 << 16;
+
+/// The PCG32 generator (XSH-RR output on a 64-bit LCG).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Pcg32 {
+    state: u64,
+    inc: u64,
+}
+
+impl Default for Pcg32 {
+    fn default() -> Self {
+        Pcg32 {
+            state: PCG32_DEFAULT_STATE,
+            inc: PCG32_DEFAULT_STREAM,
+        }
+    }
+}
+
+impl Pcg32 {
+    /// A generator on stream `sequence`, started from `seed`.
+    pub fn new(sequence: u64, seed: u64) -> Self {
+        let mut rng = Pcg32::default();
+        rng.set_sequence(sequence, seed);
+        rng
+    }
+
+    /// Restarts the generator on stream `sequence` (any value; the top bit is ignored) with `seed`.
+    pub fn set_sequence(&mut self, sequence: u64, seed: u64) {
+        self.state = 0;
+        self.inc = (sequence << 1) | 1;
+        self.next_u32();
+        self.state = self.state.wrapping_add(seed);
+        self.next_u32();
+    }
+
+    /// The next 32 uniformly distributed bits.
+    #[inline]
+    pub fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = old.wrapping_mul(PCG32_MULT).wrapping_add(self.inc);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        let rot = (old >> 59) as u32;
+        xorshifted.rotate_right(rot)
+    }
+
+    /// A uniform `f32` in [0, 1), with 24 random bits (every value is exactly representable).
+    #[inline]
+    pub fn uniform_f32(&mut self) -> f32 {
+        (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    }
+
+    /// A uniform `f64` in [0, 1), with 53 random bits.
+    #[inline]
+    pub fn uniform_f64(&mut self) -> f64 {
+        let hi = (self.next_u32() as u64) << 21;
+        let lo = (self.next_u32() >> 11) as u64;
+        (hi | lo) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// Jumps `delta` steps ahead in O(log delta) time (Brown, "Random number generation with
+    /// arbitrary strides", 1994): the result equals calling [`Pcg32::next_u32`] `delta` times.
+    pub fn advance(&mut self, delta: u64) {
+        let mut cur_mult = PCG32_MULT;
+        let mut cur_plus = self.inc;
+        let mut acc_mult: u64 = 1;
+        let mut acc_plus: u64 = 0;
+        let mut delta = delta;
+        while delta > 0 {
+            if delta & 1 == 1 {
+                acc_mult = acc_mult.wrapping_mul(cur_mult);
+                acc_plus = acc_plus.wrapping_mul(cur_mult).wrapping_add(cur_plus);
+            }
+            cur_plus = cur_mult.wrapping_add(1).wrapping_mul(cur_plus);
+            cur_mult = cur_mult.wrapping_mul(cur_mult);
+            delta >>= 1;
+        }
+        self.state = acc_mult.wrapping_mul(self.state).wrapping_add(acc_plus);
+    }
+
+    /// The generator for one pixel sample: stream chosen by `(seed, pixel)`, positioned at
+    /// `sample_index * 2^16 + dimension`. A pure function of its arguments.
+    pub fn for_pixel_sample(seed: u64, pixel: [u32; 2], sample_index: u32, dimension: u32) -> Self {
+        let mut rng = Pcg32::new(hash_pixel(pixel, seed), mix_bits(seed));
+        rng.advance(sample_index as u64 * DIMENSIONS_PER_SAMPLE + dimension as u64);
+        rng
+    }
+}
+
+/// A 64-bit finaliser with good avalanche (every input bit flips each output bit with
+/// probability close to 1/2); the constants are those of Stafford's "Mix13" variant.
+#[inline]
+pub fn mix_bits(mut v: u64) -> u64 {
+    v ^= v >> 31;
+    v = v.wrapping_mul(0x7fb5_d329_728e_a185);
+    v ^= v >> 27;
+    v = v.wrapping_mul(0x81da_def4_bc2d_d44d);
+    v ^= v >> 33;
+    v
+}
+
+/// Hashes a list of words into 64 bits (order matters).
+#[inline]
+pub fn hash_words(words: &[u64]) -> u64 {
+    let mut h = 0x9e37_79b9_7f4a_7c15u64;
+    for &w in words {
+        h = mix_bits(h ^ mix_bits(w.wrapping_add(0x632b_e59b_d9b4_e019)));
+    }
+    h
+}
+
+/// Hash of a pixel and a seed, used to pick a pixel's stream or scramble.
+#[inline]
+pub fn hash_pixel(pixel: [u32; 2], seed: u64) -> u64 {
+    hash_words(&[((pixel[0] as u64) << 32) | pixel[1] as u64, seed])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn advance_matches_stepping() {
+        let mut a = Pcg32::new(7, 11);
+        let mut b = a.clone();
+        for _ in 0..1000 {
+            a.next_u32();
+        }
+        b.advance(1000);
+        assert_eq!(a, b);
+        assert_eq!(a.next_u32(), b.next_u32());
+    }
+
+    #[test]
+    fn streams_differ_and_repeat() {
+        let mut a = Pcg32::new(1, 42);
+        let mut b = Pcg32::new(2, 42);
+        let mut c = Pcg32::new(1, 42);
+        let va: Vec<u32> = (0..8).map(|_| a.next_u32()).collect();
+        let vb: Vec<u32> = (0..8).map(|_| b.next_u32()).collect();
+        let vc: Vec<u32> = (0..8).map(|_| c.next_u32()).collect();
+        assert_ne!(va, vb);
+        assert_eq!(va, vc);
+    }
+
+    #[test]
+    fn pixel_sample_streams_are_positioned() {
+        // Dimension d of sample i is the (i * 2^16 + d)-th number of the pixel's stream.
+        let mut base = Pcg32::for_pixel_sample(3, [10, 20], 0, 0);
+        base.advance(5 * DIMENSIONS_PER_SAMPLE + 2);
+        let mut direct = Pcg32::for_pixel_sample(3, [10, 20], 5, 2);
+        assert_eq!(base.next_u32(), direct.next_u32());
+        let other_pixel = Pcg32::for_pixel_sample(3, [20, 10], 5, 2);
+        assert_ne!(other_pixel, Pcg32::for_pixel_sample(3, [10, 20], 5, 2));
+    }
+
+    #[test]
+    fn uniform_ranges() {
+        let mut rng = Pcg32::new(0, 0);
+        for _ in 0..100_000 {
+            let f = rng.uniform_f32();
+            assert!((0.0..1.0).contains(&f));
+            let d = rng.uniform_f64();
+            assert!((0.0..1.0).contains(&d));
+        }
+    }
+}

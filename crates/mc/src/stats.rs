@@ -1,0 +1,335 @@
+//! Statistical tests for Monte Carlo code: is a sampler's output distributed as its `pdf` says,
+//! and does an estimate agree with the truth within its error?
+//!
+//! - [`chi2_test_2d`] / [`chi2_test_1d`]: Pearson's chi-square goodness-of-fit test of samples
+//!   against a density, over a grid of bins. The expected count of each bin is the density
+//!   integrated over the bin (Gauss–Legendre quadrature) times the number of samples; the mass
+//!   outside the grid forms one more cell, so a density that does not integrate to one is
+//!   caught too. Cells expecting fewer than [`MIN_EXPECTED`] samples are pooled, as the
+//!   chi-square approximation needs; a sample in a cell of zero expectation fails outright.
+//!   This is how pbrt-v4 and Mitsuba 3 test their warps and BSDFs.
+//! - [`chi2_test_discrete`]: the same for counts of discrete outcomes.
+//! - [`z_test`] and [`z_test_two_sample`]: is an estimate within its standard error of a known
+//!   value, or of another independent estimate?
+//! - [`f_test_variance_ratio`]: is one estimator's variance smaller than another's?
+//! - [`bonferroni`]: the per-test significance level that keeps the chance of any false alarm
+//!   in a suite of `m` tests at most `alpha`.
+//!
+//! ```
+//! use pathlab_mc::rng::Pcg32;
+//! use pathlab_mc::stats::chi2_test_2d;
+//! let mut rng = Pcg32::new(1, 2);
+//! let pts: Vec<[f64; 2]> = (0..20_000).map(|_| [rng.uniform_f64(), rng.uniform_f64()]).collect();
+//! let t = chi2_test_2d(pts, |_, _| 1.0, [[0.0, 1.0], [0.0, 1.0]], [10, 10]);
+//! assert!(t.p_value > 1e-4, "{t:?}");
+//! ```
+
+use statrs::distribution::{ChiSquared, ContinuousCDF, FisherSnedecor, Normal};
+
+/// Cells expecting fewer samples than this are pooled before computing the statistic.
+pub const MIN_EXPECTED: f64 = 5.0;
+
+/// Pieces per axis and bin of the quadrature that integrates the density over a bin.
+const QUADRATURE_SUBDIVISIONS: usize = 4;
+
+/// The outcome of a chi-square goodness-of-fit test.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChiSquareTest {
+    /// Pearson's statistic Σ (observed - expected)² / expected over the pooled cells.
+    pub statistic: f64,
+    /// Degrees of freedom: cells after pooling, minus one.
+    pub dof: usize,
+    /// Probability of a statistic at least this large if the samples follow the density.
+    /// Zero when a sample fell where the density is zero.
+    pub p_value: f64,
+    /// Number of samples tested.
+    pub samples: u64,
+    /// Number of cells before pooling (bins, plus the outside cell when it is used).
+    pub cells: usize,
+    /// Samples that fell in a cell whose expected count is (numerically) zero.
+    pub impossible_samples: u64,
+}
+
+impl ChiSquareTest {
+    /// Whether the test does *not* reject the density at significance level `alpha`.
+    pub fn passes(&self, alpha: f64) -> bool {
+        self.p_value >= alpha
+    }
+}
+
+/// The per-test significance level for `m` tests so that the chance of any false rejection in
+/// the whole suite is at most `alpha` (Bonferroni correction: `alpha / m`).
+pub fn bonferroni(alpha: f64, m: usize) -> f64 {
+    alpha / m.max(1) as f64
+}
+
+/// Chi-square test of 2D samples against the density `pdf(x, y)` (with respect to dx dy) over
+/// the rectangle `domain = [[x0, x1], [y0, y1]]` cut into `res = [nx, ny]` bins.
+///
+/// To test directions, map them to a parameterisation whose measure is the density's: for a
+/// solid-angle pdf use `(cos θ, φ)`, since dω = d(cos θ) dφ.
+pub fn chi2_test_2d(
+    samples: impl IntoIterator<Item = [f64; 2]>,
+    pdf: impl Fn(f64, f64) -> f64,
+    domain: [[f64; 2]; 2],
+    res: [usize; 2],
+) -> ChiSquareTest {
+    let [nx, ny] = [res[0].max(1), res[1].max(1)];
+    let [[x0, x1], [y0, y1]] = domain;
+    let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
+    let mut observed = vec![0.0f64; nx * ny + 1];
+    let mut n = 0u64;
+    for [x, y] in samples {
+        n += 1;
+        let inside = x >= x0 && x < x1 && y >= y0 && y < y1;
+        let cell = if inside {
+            let ix = (((x - x0) / dx) as usize).min(nx - 1);
+            let iy = (((y - y0) / dy) as usize).min(ny - 1);
+            iy * nx + ix
+        } else {
+            nx * ny
+        };
+        observed[cell] += 1.0;
+    }
+    let mut expected = vec![0.0f64; nx * ny + 1];
+    let mut total = 0.0;
+    for iy in 0..ny {
+        for ix in 0..nx {
+            let (bx, by) = (x0 + ix as f64 * dx, y0 + iy as f64 * dy);
+            let mass = quadrature_2d(&pdf, [bx, bx + dx], [by, by + dy]);
+            expected[iy * nx + ix] = mass * n as f64;
+            total += mass;
+        }
+    }
+    expected[nx * ny] = (1.0 - total).max(0.0) * n as f64;
+    chi2_from_cells(&observed, &expected, n)
+}
+
+/// Chi-square test of 1D samples against the density `pdf(x)` over `[x0, x1]` in `bins` bins.
+pub fn chi2_test_1d(
+    samples: impl IntoIterator<Item = f64>,
+    pdf: impl Fn(f64) -> f64,
+    domain: [f64; 2],
+    bins: usize,
+) -> ChiSquareTest {
+    chi2_test_2d(
+        samples.into_iter().map(|x| [x, 0.5]),
+        |x, _| pdf(x),
+        [domain, [0.0, 1.0]],
+        [bins, 1],
+    )
+}
+
+/// Chi-square test of counts of discrete outcomes against their probabilities. `observed[i]`
+/// is how often outcome `i` came up; `probabilities` should sum to one (any shortfall becomes
+/// an extra cell that expects the missing mass and observed nothing).
+pub fn chi2_test_discrete(observed: &[u64], probabilities: &[f64]) -> ChiSquareTest {
+    let n: u64 = observed.iter().sum();
+    let k = observed.len().max(probabilities.len());
+    let mut obs: Vec<f64> = (0..k)
+        .map(|i| observed.get(i).copied().unwrap_or(0) as f64)
+        .collect();
+    let mut exp: Vec<f64> = (0..k)
+        .map(|i| probabilities.get(i).copied().unwrap_or(0.0) * n as f64)
+        .collect();
+    let total: f64 = probabilities.iter().sum();
+    obs.push(0.0);
+    exp.push((1.0 - total).max(0.0) * n as f64);
+    chi2_from_cells(&obs, &exp, n)
+}
+
+/// Pools small cells, then computes Pearson's statistic and its p-value.
+fn chi2_from_cells(observed: &[f64], expected: &[f64], n: u64) -> ChiSquareTest {
+    // A cell whose expectation is a rounding error away from zero counts as impossible.
+    let zero = 1e-9 * n as f64;
+    let mut impossible = 0u64;
+    let mut cells: Vec<(f64, f64)> = Vec::with_capacity(observed.len());
+    for (&o, &e) in observed.iter().zip(expected) {
+        if e <= zero {
+            impossible += o as u64;
+        } else {
+            cells.push((e, o));
+        }
+    }
+    let cell_count = cells.len();
+    if impossible > 0 {
+        return ChiSquareTest {
+            statistic: f64::INFINITY,
+            dof: cell_count.saturating_sub(1),
+            p_value: 0.0,
+            samples: n,
+            cells: cell_count,
+            impossible_samples: impossible,
+        };
+    }
+    // Pool the cells of smallest expectation until the pool reaches MIN_EXPECTED.
+    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut statistic = 0.0;
+    let mut dof_cells = 0usize;
+    let (mut pool_e, mut pool_o) = (0.0, 0.0);
+    for &(e, o) in &cells {
+        if e < MIN_EXPECTED || (pool_e > 0.0 && pool_e < MIN_EXPECTED) {
+            pool_e += e;
+            pool_o += o;
+        } else {
+            statistic += (o - e) * (o - e) / e;
+            dof_cells += 1;
+        }
+    }
+    if pool_e > 0.0 {
+        statistic += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+        dof_cells += 1;
+    }
+    let dof = dof_cells.saturating_sub(1);
+    let p_value = if dof == 0 {
+        1.0
+    } else {
+        ChiSquared::new(dof as f64)
+            .map(|d| d.sf(statistic))
+            .unwrap_or(0.0)
+    };
+    ChiSquareTest {
+        statistic,
+        dof,
+        p_value,
+        samples: n,
+        cells: cell_count,
+        impossible_samples: 0,
+    }
+}
+
+/// Gauss–Legendre nodes and weights of order 4 on [-1, 1].
+const GAUSS_NODES: [f64; 4] = [
+    -0.861_136_311_594_052_6,
+    -0.339_981_043_584_856_3,
+    0.339_981_043_584_856_3,
+    0.861_136_311_594_052_6,
+];
+const GAUSS_WEIGHTS: [f64; 4] = [
+    0.347_854_845_137_453_8,
+    0.652_145_154_862_546_1,
+    0.652_145_154_862_546_1,
+    0.347_854_845_137_453_8,
+];
+
+/// ∫∫ f over a rectangle: each axis cut into [`QUADRATURE_SUBDIVISIONS`] pieces with a
+/// 4-point Gauss–Legendre rule on each. Exact for polynomials of degree 7 per axis, and no node
+/// lies on an edge, so a density that jumps at bin edges (piecewise-constant ones) is
+/// integrated exactly when its pieces align with the bins.
+fn quadrature_2d(f: &impl Fn(f64, f64) -> f64, xr: [f64; 2], yr: [f64; 2]) -> f64 {
+    let m = QUADRATURE_SUBDIVISIONS;
+    let (hx, hy) = ((xr[1] - xr[0]) / m as f64, (yr[1] - yr[0]) / m as f64);
+    let mut sum = 0.0;
+    for j in 0..m {
+        let cy = yr[0] + (j as f64 + 0.5) * hy;
+        for (ny, wy) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
+            let y = cy + 0.5 * hy * ny;
+            for i in 0..m {
+                let cx = xr[0] + (i as f64 + 0.5) * hx;
+                for (nx, wx) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
+                    sum += wx * wy * f(cx + 0.5 * hx * nx, y);
+                }
+            }
+        }
+    }
+    sum * 0.25 * hx * hy
+}
+
+/// The outcome of a z-test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ZTest {
+    /// The standardised difference.
+    pub z: f64,
+    /// Two-sided p-value, P(|Z| ≥ |z|) for a standard normal Z.
+    pub p_value: f64,
+}
+
+impl ZTest {
+    /// Whether |z| ≤ `max_abs_z`.
+    pub fn within(&self, max_abs_z: f64) -> bool {
+        self.z.abs() <= max_abs_z
+    }
+}
+
+fn z_from(diff: f64, se: f64) -> ZTest {
+    let z = if se > 0.0 {
+        diff / se
+    } else if diff == 0.0 {
+        0.0
+    } else {
+        f64::INFINITY.copysign(diff)
+    };
+    let p_value = if z.is_finite() {
+        2.0 * Normal::standard().sf(z.abs())
+    } else {
+        0.0
+    };
+    ZTest { z, p_value }
+}
+
+/// z = (estimate - truth) / std_error: is an estimate consistent with a known value?
+pub fn z_test(estimate: f64, std_error: f64, truth: f64) -> ZTest {
+    z_from(estimate - truth, std_error)
+}
+
+/// z = (a - b) / √(se_a² + se_b²): are two independent estimates of one quantity consistent?
+pub fn z_test_two_sample(a: f64, se_a: f64, b: f64, se_b: f64) -> ZTest {
+    z_from(a - b, (se_a * se_a + se_b * se_b).sqrt())
+}
+
+/// One-sided F-test that the variance behind `var_larger` (from `n_larger` values) exceeds the
+/// one behind `var_smaller` (from `n_smaller` values). Returns the p-value of the ratio
+/// `var_larger / var_smaller` under the hypothesis that both variances are equal (values are
+/// assumed roughly normal).
+pub fn f_test_variance_ratio(
+    var_larger: f64,
+    n_larger: u64,
+    var_smaller: f64,
+    n_smaller: u64,
+) -> f64 {
+    if n_larger < 2 || n_smaller < 2 {
+        return 1.0;
+    }
+    if var_smaller <= 0.0 {
+        return if var_larger > 0.0 { 0.0 } else { 1.0 };
+    }
+    let ratio = var_larger / var_smaller;
+    FisherSnedecor::new((n_larger - 1) as f64, (n_smaller - 1) as f64)
+        .map(|f| f.sf(ratio))
+        .unwrap_or(1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadrature_is_exact_for_polynomials() {
+        let v = quadrature_2d(&|x, y| x.powi(7) + y * y + 1.0, [0.0, 2.0], [1.0, 3.0]);
+        // ∫0^2∫1^3 (x⁷ + y² + 1) dy dx = 2·2⁸/8 + 2·26/3 + 4
+        let exact = 64.0 + 52.0 / 3.0 + 4.0;
+        assert!((v - exact).abs() < 1e-10);
+    }
+
+    #[test]
+    fn impossible_samples_fail() {
+        let t = chi2_test_1d([0.1, 0.2, 0.9], |x| if x < 0.5 { 2.0 } else { 0.0 }, [0.0, 1.0], 10);
+        assert_eq!(t.impossible_samples, 1);
+        assert_eq!(t.p_value, 0.0);
+    }
+
+    #[test]
+    fn z_test_values() {
+        let t = z_test(1.0 + 1.96, 1.0, 1.0);
+        assert!((t.p_value - 0.05).abs() < 1e-3);
+        assert!(z_test_two_sample(1.0, 0.3, 1.0, 0.4).z.abs() < 1e-15);
+        assert_eq!(z_test(1.0, 0.0, 1.0).z, 0.0);
+        assert!(!z_test(1.1, 0.0, 1.0).within(4.0));
+    }
+
+    #[test]
+    fn f_test_detects_a_large_ratio() {
+        assert!(f_test_variance_ratio(10.0, 30, 1.0, 30) < 1e-6);
+        assert!(f_test_variance_ratio(1.0, 30, 1.0, 30) > 0.4);
+    }
+}
