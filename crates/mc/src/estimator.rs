@@ -252,7 +252,9 @@ mod tests {
 
     #[test]
     fn welford_matches_two_pass() {
-        let xs: Vec<f64> = (0..1000).map(|i| ((i * 7919) % 1000) as f64 * 0.01 + 1e6).collect();
+        let xs: Vec<f64> = (0..1000)
+            .map(|i| ((i * 7919) % 1000) as f64 * 0.01 + 1e6)
+            .collect();
         let mut s = RunningStats::new();
         xs.iter().for_each(|&x| s.push(x));
         let mean = xs.iter().sum::<f64>() / xs.len() as f64;

@@ -277,25 +277,20 @@ pub fn z_test_two_sample(a: f64, se_a: f64, b: f64, se_b: f64) -> ZTest {
     z_from(a - b, (se_a * se_a + se_b * se_b).sqrt())
 }
 
-/// One-sided F-test that the variance behind `var_larger` (from `n_larger` values) exceeds the
-/// one behind `var_smaller` (from `n_smaller` values). Returns the p-value of the ratio
-/// `var_larger / var_smaller` under the hypothesis that both variances are equal (values are
-/// assumed roughly normal).
-pub fn f_test_variance_ratio(
-    var_larger: f64,
-    n_larger: u64,
-    var_smaller: f64,
-    n_smaller: u64,
-) -> f64 {
-    if n_larger < 2 || n_smaller < 2 {
+/// One-sided F-test that the variance behind the estimate `var_a` (with `dof_a` degrees of
+/// freedom) exceeds the one behind `var_b` (with `dof_b`). Returns the p-value of the ratio
+/// `var_a / var_b` under the hypothesis that both variances are equal (for variances estimated
+/// from roughly normal values: `n - 1` degrees of freedom for a sample variance around the
+/// sample mean, `n` for a mean square around a known value).
+pub fn f_test_variance_ratio(var_a: f64, dof_a: u64, var_b: f64, dof_b: u64) -> f64 {
+    if dof_a == 0 || dof_b == 0 {
         return 1.0;
     }
-    if var_smaller <= 0.0 {
-        return if var_larger > 0.0 { 0.0 } else { 1.0 };
+    if var_b <= 0.0 {
+        return if var_a > 0.0 { 0.0 } else { 1.0 };
     }
-    let ratio = var_larger / var_smaller;
-    FisherSnedecor::new((n_larger - 1) as f64, (n_smaller - 1) as f64)
-        .map(|f| f.sf(ratio))
+    FisherSnedecor::new(dof_a as f64, dof_b as f64)
+        .map(|f| f.sf(var_a / var_b))
         .unwrap_or(1.0)
 }
 
@@ -313,7 +308,12 @@ mod tests {
 
     #[test]
     fn impossible_samples_fail() {
-        let t = chi2_test_1d([0.1, 0.2, 0.9], |x| if x < 0.5 { 2.0 } else { 0.0 }, [0.0, 1.0], 10);
+        let t = chi2_test_1d(
+            [0.1, 0.2, 0.9],
+            |x| if x < 0.5 { 2.0 } else { 0.0 },
+            [0.0, 1.0],
+            10,
+        );
         assert_eq!(t.impossible_samples, 1);
         assert_eq!(t.p_value, 0.0);
     }
@@ -329,7 +329,7 @@ mod tests {
 
     #[test]
     fn f_test_detects_a_large_ratio() {
-        assert!(f_test_variance_ratio(10.0, 30, 1.0, 30) < 1e-6);
-        assert!(f_test_variance_ratio(1.0, 30, 1.0, 30) > 0.4);
+        assert!(f_test_variance_ratio(10.0, 29, 1.0, 29) < 1e-6);
+        assert!(f_test_variance_ratio(1.0, 29, 1.0, 29) > 0.4);
     }
 }

@@ -56,7 +56,8 @@ impl AliasTable {
         // Scaled probabilities: a bin is "small" below 1 and "large" above.
         let mut scaled: Vec<f64> = pmf.iter().map(|p| p * n as f64).collect();
         let mut bins: Vec<Bin> = (0..n).map(|i| Bin { q: 1.0, alias: i }).collect();
-        let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
+            (0..n).partition(|&i| scaled[i] < 1.0);
         while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
             small.pop();
             bins[s] = Bin {

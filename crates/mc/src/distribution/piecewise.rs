@@ -143,7 +143,16 @@ impl PiecewiseConstant1D {
             du /= c1 - c0;
         }
         let t = ((o as f32 + du.clamp(0.0, 1.0)) / self.func.len() as f32).min(1.0);
-        let x = (self.min + t * (self.max - self.min)).min(self.max.next_down());
+        let mut x = (self.min + t * (self.max - self.min)).min(self.max.next_down());
+        // Rounding can put a point at a piece's edge into the neighbouring piece, whose density
+        // differs (or is zero); step to the nearest float inside piece `o`.
+        for _ in 0..8 {
+            match self.offset_of(x).cmp(&o) {
+                std::cmp::Ordering::Less => x = x.next_up(),
+                std::cmp::Ordering::Greater => x = x.next_down(),
+                std::cmp::Ordering::Equal => break,
+            }
+        }
         PiecewiseSample {
             x,
             pdf: self.piece_pdf(o),
@@ -201,7 +210,6 @@ impl PiecewiseConstant1D {
         }
     }
 }
-
 
 /// A piecewise-constant density on a rectangle: `nu × nv` cells with values `f[v][u]`.
 ///
@@ -267,8 +275,7 @@ impl PiecewiseConstant2D {
 
     /// The density at `p` (0 outside the rectangle).
     pub fn pdf(&self, p: Vec2) -> f32 {
-        if !(self.min.x..=self.max.x).contains(&p.x) || !(self.min.y..=self.max.y).contains(&p.y)
-        {
+        if !(self.min.x..=self.max.x).contains(&p.x) || !(self.min.y..=self.max.y).contains(&p.y) {
             return 0.0;
         }
         let v = self.marginal.offset_of(p.y);

@@ -101,7 +101,9 @@ impl std::str::FromStr for SamplerKind {
         SamplerKind::ALL
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown sampler '{s}' (expected independent, stratified or sobol)"))
+            .ok_or_else(|| {
+                format!("unknown sampler '{s}' (expected independent, stratified or sobol)")
+            })
     }
 }
 
