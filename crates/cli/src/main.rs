@@ -1,1 +1,42 @@
-fn main() {}
+//! `pathlab`: the command-line front end of the pathlab renderer and Monte Carlo toolkit.
+
+mod expr;
+mod integrate;
+mod plot;
+mod sample;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// pathlab: a physically based Monte Carlo renderer and Monte Carlo toolkit.
+#[derive(Parser, Debug)]
+#[command(name = "pathlab", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Draw samples from a distribution or warp and compare them with its exact pdf.
+    Sample(sample::SampleArgs),
+    /// Estimate an integral over a box by Monte Carlo, with its error.
+    Integrate(integrate::IntegrateArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Sample(args) => sample::run(args),
+        Command::Integrate(args) => integrate::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line: the error and its causes, outermost first.
+            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
+            eprintln!("error: {}", chain.join(": "));
+            ExitCode::FAILURE
+        }
+    }
+}

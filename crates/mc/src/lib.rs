@@ -46,3 +46,8 @@ pub mod stats;
 pub mod warp;
 
 pub use error::{Error, Result};
+
+/// The crate README's example, compiled and run as a doctest.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -46,14 +46,23 @@ impl StratifiedSampler {
         }
     }
 
-    /// A sampler for `count` samples per pixel: a grid of `⌊√count⌋` columns and enough rows to
-    /// hold `count` samples. When the grid has more cells than `count`, the cells the first
-    /// `count` samples take are a random subset, which keeps every sample uniform.
+    /// A sampler for `count` samples per pixel. The grid is `a × b = count` with `a` the
+    /// largest divisor of `count` not above √count, when that grid is no more than 4:1
+    /// (e.g. 8 × 16 for 128); otherwise `⌊√count⌋` columns and enough rows to hold `count`
+    /// samples, of which the first `count` take a random subset of the cells (which keeps every
+    /// sample uniform).
     pub fn with_count(count: u32, jitter: bool, seed: u64) -> Self {
         let count = count.max(1);
-        let x = (count as f64).sqrt().floor().max(1.0) as u32;
-        let y = count.div_ceil(x);
-        StratifiedSampler::new(x, y, jitter, seed)
+        let root = (count as f64).sqrt().floor().max(1.0) as u32;
+        let divisor = (1..=root)
+            .rev()
+            .find(|d| count.is_multiple_of(*d))
+            .unwrap_or(1);
+        if count / divisor <= 4 * divisor {
+            StratifiedSampler::new(divisor, count / divisor, jitter, seed)
+        } else {
+            StratifiedSampler::new(root, count.div_ceil(root), jitter, seed)
+        }
     }
 
     /// The grid of strata, `[x_samples, y_samples]`.

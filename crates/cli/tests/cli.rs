@@ -1,0 +1,415 @@
+//! End-to-end tests: run the `pathlab` binary as a user would.
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn pathlab(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pathlab"))
+        .args(args)
+        .output()
+        .expect("the pathlab binary runs")
+}
+
+fn pathlab_with_threads(args: &[&str], threads: usize) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pathlab"))
+        .args(args)
+        .env("RAYON_NUM_THREADS", threads.to_string())
+        .output()
+        .expect("the pathlab binary runs")
+}
+
+fn json_of(out: &Output) -> Value {
+    assert!(
+        out.status.success(),
+        "pathlab failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("--json prints valid JSON")
+}
+
+/// Asserts a failed run with exactly one line on stderr, an error and no panic.
+fn assert_one_line_error(out: &Output, expected: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected a failure, got success");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "stderr: {stderr}");
+    assert!(stderr.starts_with("error: "), "stderr: {stderr}");
+    assert!(
+        stderr.contains(expected),
+        "stderr lacks '{expected}': {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "stderr: {stderr}");
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    let _ = std::fs::remove_file(&path);
+    path
+}
+
+#[test]
+fn exponential_mean_is_one_over_lambda() {
+    let v = json_of(&pathlab(&[
+        "sample",
+        "exponential",
+        "--lambda",
+        "1",
+        "-n",
+        "1000000",
+        "--json",
+    ]));
+    let c = &v["components"][0];
+    let (mean, se) = (
+        c["mean"].as_f64().unwrap(),
+        c["std_error"].as_f64().unwrap(),
+    );
+    assert!(
+        se > 0.0 && (mean - 1.0).abs() <= 4.0 * se,
+        "mean {mean} ± {se}"
+    );
+    assert_eq!(v["samples"], 1_000_000);
+}
+
+#[test]
+fn every_distribution_fits_its_pdf() {
+    // One goodness-of-fit test per distribution, Bonferroni-corrected over them.
+    let names = [
+        "exponential",
+        "uniform-hemisphere",
+        "cosine-hemisphere",
+        "uniform-sphere",
+        "uniform-cone",
+        "concentric-disk",
+        "uniform-triangle",
+        "piecewise",
+        "piecewise2d",
+        "alias",
+    ];
+    let alpha = 0.01 / names.len() as f64;
+    for name in names {
+        let v = json_of(&pathlab(&[
+            "sample", name, "-n", "200000", "--seed", "3", "--json",
+        ]));
+        let p = v["chi_square"]["p_value"].as_f64().unwrap();
+        assert!(p >= alpha, "{name}: p = {p}");
+        for c in v["components"].as_array().unwrap() {
+            let z = c["z"].as_f64().unwrap();
+            assert!(z.abs() <= 4.5, "{name} {}: z = {z}", c["name"]);
+        }
+    }
+}
+
+#[test]
+fn bad_sample_input_is_one_line_error() {
+    assert_one_line_error(
+        &pathlab(&["sample", "exponential", "--lambda", "-1"]),
+        "lambda",
+    );
+    assert_one_line_error(
+        &pathlab(&["sample", "exponential", "--lambda", "nan"]),
+        "lambda",
+    );
+    assert_one_line_error(&pathlab(&["sample", "exponential", "-n", "0"]), "-n");
+    assert_one_line_error(
+        &pathlab(&["sample", "alias", "--weights", "1,x"]),
+        "'x' is not a number",
+    );
+    assert_one_line_error(
+        &pathlab(&["sample", "alias", "--weights", "0,0"]),
+        "positive sum",
+    );
+    assert_one_line_error(
+        &pathlab(&["sample", "piecewise", "--weights", "1,-2"]),
+        "not a finite non-negative",
+    );
+    assert_one_line_error(
+        &pathlab(&["sample", "piecewise", "--range", "1,0"]),
+        "--range",
+    );
+    assert_one_line_error(
+        &pathlab(&["sample", "piecewise2d", "--weights", "1,2;3"]),
+        "every row",
+    );
+    assert_one_line_error(
+        &pathlab(&["sample", "uniform-cone", "--cos-theta-max", "1"]),
+        "cos-theta-max",
+    );
+    assert_one_line_error(
+        &pathlab(&["sample", "exponential", "--plot", "out.jpg"]),
+        ".png or .svg",
+    );
+}
+
+#[test]
+fn bad_integrate_input_is_one_line_error() {
+    assert_one_line_error(
+        &pathlab(&["integrate", "x +* 2", "--domain", "0,1"]),
+        "cannot parse",
+    );
+    assert_one_line_error(&pathlab(&["integrate", "x", "--domain", "1,1"]), "empty");
+    assert_one_line_error(&pathlab(&["integrate", "x", "--domain", "2,1"]), "empty");
+    assert_one_line_error(&pathlab(&["integrate", "x", "--domain", "0"]), "two bounds");
+    assert_one_line_error(
+        &pathlab(&["integrate", "x", "--domain", "0,b"]),
+        "not a number",
+    );
+    assert_one_line_error(
+        &pathlab(&["integrate", "x + q", "--domain", "0,1"]),
+        "unknown variable 'q'",
+    );
+    assert_one_line_error(
+        &pathlab(&["integrate", "y", "--domain", "0,1"]),
+        "unknown variable 'y'",
+    );
+    assert_one_line_error(
+        &pathlab(&["integrate", "sqrt(x-2)", "--domain", "0,1", "-n", "16"]),
+        "not finite",
+    );
+    assert_one_line_error(
+        &pathlab(&["integrate", "exp(-x^2)", "--domain", "0,1"]),
+        "ambiguous",
+    );
+    assert_one_line_error(
+        &pathlab(&[
+            "integrate",
+            "-x",
+            "--domain",
+            "0,1",
+            "--sampler",
+            "sobol",
+            "-n",
+            "4",
+        ]),
+        "--reps",
+    );
+    assert_one_line_error(
+        &pathlab(&["integrate", "x", "--domain", "0,1", "--importance", "x-1"]),
+        "finite and >= 0",
+    );
+    assert_one_line_error(
+        &pathlab(&[
+            "integrate",
+            "x",
+            "-d",
+            "0,1",
+            "-d",
+            "0,1",
+            "-d",
+            "0,1",
+            "--importance",
+            "1",
+        ]),
+        "1 or 2 dimensions",
+    );
+}
+
+#[test]
+fn integrate_gaussian_within_four_standard_errors() {
+    // ∫∫ exp(-(x² + y²)/2) over [-2, 2]² = 2π erf(√2)².
+    let exact = 2.0 * std::f64::consts::PI * 0.954_499_736_103_641_6f64.powi(2);
+    for sampler in ["independent", "stratified", "sobol"] {
+        let v = json_of(&pathlab(&[
+            "integrate",
+            "exp(-(x^2+y^2)/2)",
+            "--domain",
+            "-2,2",
+            "--domain",
+            "-2,2",
+            "-n",
+            "200000",
+            "--sampler",
+            sampler,
+            "--json",
+        ]));
+        let (est, se) = (
+            v["estimate"].as_f64().unwrap(),
+            v["std_error"].as_f64().unwrap(),
+        );
+        assert!(
+            se > 0.0 && (est - exact).abs() <= 4.0 * se,
+            "{sampler}: {est} ± {se} vs {exact}"
+        );
+        let ci = v["ci95"].as_array().unwrap();
+        assert!(ci[0].as_f64().unwrap() < est && est < ci[1].as_f64().unwrap());
+    }
+}
+
+#[test]
+fn importance_sampling_is_unbiased_and_reduces_variance() {
+    let args = |importance: Option<&str>| {
+        let mut a = vec![
+            "integrate",
+            "exp(-(x^2))",
+            "--domain",
+            "-3,3",
+            "-n",
+            "100000",
+            "--json",
+        ];
+        if let Some(g) = importance {
+            a.extend(["--importance", g]);
+        }
+        json_of(&pathlab(&a))
+    };
+    let exact = std::f64::consts::PI.sqrt() * 0.999_977_909_503_001_4; // √π erf(3)
+    let uniform = args(None);
+    let is = args(Some("exp(-(x^2))"));
+    for v in [&uniform, &is] {
+        let (est, se) = (
+            v["estimate"].as_f64().unwrap(),
+            v["std_error"].as_f64().unwrap(),
+        );
+        assert!((est - exact).abs() <= 4.0 * se, "{est} ± {se} vs {exact}");
+    }
+    let var = |v: &Value| v["variance_per_sample"].as_f64().unwrap();
+    assert!(
+        var(&is) < var(&uniform) / 100.0,
+        "{} vs {}",
+        var(&is),
+        var(&uniform)
+    );
+}
+
+#[test]
+fn ten_dimensional_integral() {
+    let v = json_of(&pathlab(&[
+        "integrate",
+        "x1*x2*x3*x4*x5*x6*x7*x8*x9*x10",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-d",
+        "0,2",
+        "-n",
+        "400000",
+        "--json",
+    ]));
+    // ∏ ∫0^2 x dx = 2^10.
+    let (est, se) = (
+        v["estimate"].as_f64().unwrap(),
+        v["std_error"].as_f64().unwrap(),
+    );
+    assert!((est - 1024.0).abs() <= 4.0 * se, "{est} ± {se}");
+}
+
+#[test]
+fn same_seed_same_answer_for_any_thread_count() {
+    let args = [
+        "integrate",
+        "sin(x)*cos(y)",
+        "-d",
+        "0,pi",
+        "-d",
+        "0,1",
+        "-n",
+        "300000",
+        "--seed",
+        "7",
+        "--json",
+    ];
+    let est = |threads| json_of(&pathlab_with_threads(&args, threads))["estimate"].clone();
+    assert_eq!(est(1), est(2));
+    assert_eq!(est(1), est(3));
+    let other = json_of(&pathlab(&[
+        "integrate",
+        "sin(x)*cos(y)",
+        "-d",
+        "0,pi",
+        "-d",
+        "0,1",
+        "-n",
+        "300000",
+        "--seed",
+        "8",
+        "--json",
+    ]));
+    assert_ne!(est(1), other["estimate"]);
+}
+
+fn assert_image(path: &PathBuf, png: bool) {
+    let bytes = std::fs::read(path).expect("plot written");
+    if png {
+        assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
+        assert!(bytes.len() > 10_000, "suspiciously small PNG");
+    } else {
+        let text = String::from_utf8(bytes).unwrap();
+        assert!(
+            text.contains("<svg") && text.contains("<text"),
+            "not an SVG with text"
+        );
+    }
+}
+
+#[test]
+fn sample_plots_are_written() {
+    for (name, file) in [
+        ("exponential", "exp.png"),
+        ("cosine-hemisphere", "cos.svg"),
+        ("alias", "alias.png"),
+        ("piecewise2d", "pw2.png"),
+    ] {
+        let path = scratch(file);
+        let out = pathlab(&[
+            "sample",
+            name,
+            "-n",
+            "20000",
+            "--plot",
+            path.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_image(&path, file.ends_with(".png"));
+    }
+}
+
+#[test]
+fn convergence_plot_and_data() {
+    let path = scratch("conv.png");
+    let v = json_of(&pathlab(&[
+        "integrate",
+        "exp(-(x^2+y^2)/2)",
+        "-d",
+        "-2,2",
+        "-d",
+        "-2,2",
+        "-n",
+        "16384",
+        "--exact",
+        "2*pi*0.9544997361036416^2",
+        "--convergence",
+        path.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_image(&path, true);
+    let series = v["convergence"]["series"].as_array().unwrap();
+    assert_eq!(series.len(), 3);
+    let slope = |i: usize| series[i]["fitted_slope"].as_f64().unwrap();
+    // Independent sampling converges as N^-1/2; Sobol clearly faster on this smooth integrand.
+    assert!(
+        (slope(0) + 0.5).abs() < 0.2,
+        "independent slope {}",
+        slope(0)
+    );
+    assert!(slope(2) < -0.8, "sobol slope {}", slope(2));
+}
