@@ -3,6 +3,7 @@
 mod expr;
 mod integrate;
 mod plot;
+mod render_cmd;
 mod sample;
 
 use clap::{Parser, Subcommand};
@@ -18,6 +19,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Render a scene (default: the built-in Cornell box).
+    Render(render_cmd::RenderArgs),
     /// Draw samples from a distribution or warp and compare them with its exact pdf.
     Sample(sample::SampleArgs),
     /// Estimate an integral over a box by Monte Carlo, with its error.
@@ -27,6 +30,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
+        Command::Render(args) => render_cmd::run(args),
         Command::Sample(args) => sample::run(args),
         Command::Integrate(args) => integrate::run(args),
     };

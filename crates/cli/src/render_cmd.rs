@@ -1,0 +1,322 @@
+//! `pathlab render`: render a scene to EXR or PNG.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::film::Film;
+use pathlab_render::image_io::{write_exr, write_png, ExtraChannel};
+use pathlab_render::integrator::{
+    DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
+};
+use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::scene::Scene;
+use serde_json::json;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// Which integrator renders the image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum IntegratorName {
+    /// Path tracing with next-event estimation, MIS and Russian roulette.
+    Path,
+    /// Direct lighting only, by the strategy chosen with --direct.
+    Direct,
+    /// Debug view: shading normals.
+    Normals,
+    /// Debug view: distance to the first surface.
+    Depth,
+    /// Debug view: BVH nodes visited per camera ray.
+    Bvh,
+}
+
+/// Extra outputs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Aov {
+    /// Variance of each pixel's mean (squared standard error), per channel.
+    Variance,
+    /// Samples per pixel.
+    Samples,
+}
+
+/// Raw command-line arguments of `pathlab render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// The scene: a built-in scene's name (cornell-box).
+    #[arg(default_value = "cornell-box")]
+    pub scene: String,
+    /// Samples per pixel.
+    #[arg(short = 's', long, default_value_t = 64)]
+    pub spp: u32,
+    /// Light samples per surface point (direct lighting: directions or light points per pixel
+    /// sample).
+    #[arg(short = 'l', long, default_value_t = 1)]
+    pub light_samples: u32,
+    /// Largest bounce: 0 = light seen directly, 1 = direct lighting, 2 = one indirect bounce,
+    /// ..., inf = unbounded (with Russian roulette).
+    #[arg(short = 'm', long, default_value = "inf")]
+    pub max_depth: String,
+    /// First bounce at which Russian roulette may end a path.
+    #[arg(long, default_value_t = 5)]
+    pub rr_depth: u32,
+    /// Only the radiance of bounce K (0 = emission seen directly, 1 = direct, ...).
+    #[arg(long, value_name = "K")]
+    pub only_bounce: Option<u32>,
+    /// Worker threads (0: all cores).
+    #[arg(short = 't', long, default_value_t = 0)]
+    pub threads: usize,
+    /// Image size in pixels (default: the scene's).
+    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"])]
+    pub resolution: Option<Vec<u32>>,
+    /// Output image: .exr (linear) or .png (sRGB). Default: SCENE.png.
+    #[arg(short = 'o', long, visible_short_alias = 'f', value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// The integrator.
+    #[arg(long, value_enum, default_value_t = IntegratorName::Path)]
+    pub integrator: IntegratorName,
+    /// Direct-lighting strategy for --integrator direct: hemisphere, cosine, light or mis.
+    #[arg(long, default_value = "mis")]
+    pub direct: DirectStrategy,
+    /// Where the uniform numbers come from: independent, stratified or sobol.
+    #[arg(long, default_value = "independent")]
+    pub sampler: SamplerKind,
+    /// Seed of the random numbers.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Exposure in stops applied before PNG encoding.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Extra outputs, comma-separated: variance, samples (EXR channels, or files next to a PNG).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub aov: Vec<Aov>,
+    /// No progress bar.
+    #[arg(short = 'q', long)]
+    pub quiet: bool,
+    /// Print run statistics as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_max_depth(text: &str) -> Result<u32> {
+    if text.eq_ignore_ascii_case("inf") || text == "-1" {
+        return Ok(u32::MAX);
+    }
+    text.parse::<u32>().with_context(|| {
+        format!("--max-depth {text}: expected a number of bounces (0, 1, 2, ...) or inf")
+    })
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum OutputFormat {
+    Exr,
+    Png,
+}
+
+fn output_format(path: &Path) -> Result<OutputFormat> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .as_deref()
+    {
+        Some("exr") => Ok(OutputFormat::Exr),
+        Some("png") => Ok(OutputFormat::Png),
+        _ => bail!("{}: the output must end in .exr or .png", path.display()),
+    }
+}
+
+/// Set by Ctrl-C: the render stops and writes what it has.
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+/// Runs `pathlab render`.
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let max_depth = parse_max_depth(&args.max_depth)?;
+    if args.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
+    if args.light_samples == 0 {
+        bail!("--light-samples must be at least 1");
+    }
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.png", args.scene)));
+    let format = output_format(&output)?;
+    let mut desc = pathlab_scene::builtin::load(&args.scene).map_err(|e| {
+        anyhow::anyhow!("{e}; scene files (.dae, .xml, .obj, ...) are not read yet")
+    })?;
+    if let Some(r) = &args.resolution {
+        let (w, h) = (r[0], r[1]);
+        if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+            bail!("--resolution {w} {h}: width and height must be between 1 and 16384");
+        }
+        desc.resolution = [w, h];
+    }
+    let scene = Scene::build(&desc).context("cannot build the scene")?;
+    let integrator = match args.integrator {
+        IntegratorName::Path => IntegratorKind::Path(PathIntegrator {
+            max_depth,
+            rr_depth: args.rr_depth,
+            only_bounce: args.only_bounce,
+            light_samples: args.light_samples,
+        }),
+        IntegratorName::Direct => IntegratorKind::Direct(DirectIntegrator {
+            strategy: args.direct,
+            samples: args.light_samples,
+        }),
+        IntegratorName::Normals => IntegratorKind::Debug(DebugView::Normals),
+        IntegratorName::Depth => IntegratorKind::Debug(DebugView::Depth),
+        IntegratorName::Bvh => IntegratorKind::Debug(DebugView::BvhHeat),
+    };
+    let settings = RenderSettings {
+        spp: args.spp,
+        seed: args.seed,
+        sampler: args.sampler,
+    };
+    let [w, h] = desc.resolution;
+    let total = w as u64 * h as u64 * args.spp as u64;
+    let bar = if args.quiet || !std::io::stderr().is_terminal() {
+        ProgressBar::hidden()
+    } else {
+        let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template(
+                "{bar:40} {percent:>3}%  {human_pos}/{human_len} samples  {per_sec}  ETA {eta}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    };
+    let bar = Arc::new(bar);
+    let _ = ctrlc::set_handler(|| CANCEL.store(true, Ordering::Relaxed));
+    let progress_bar = Arc::clone(&bar);
+    let progress = move |n: u64| progress_bar.inc(n);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let threads = pool.current_num_threads();
+    let (film, stats) = pool.install(|| render(&scene, &integrator, &settings, &progress, &CANCEL));
+    bar.finish_and_clear();
+    if stats.cancelled {
+        eprintln!(
+            "interrupted: writing the {} samples done so far",
+            stats.samples
+        );
+    }
+    write_outputs(&film, &output, format, args)?;
+
+    let build = scene.stats();
+    let mean = film.image_mean();
+    if args.json {
+        let out = json!({
+            "scene": args.scene,
+            "output": output,
+            "resolution": [w, h],
+            "spp": args.spp,
+            "integrator": format!("{:?}", args.integrator).to_lowercase(),
+            "max_depth": if max_depth == u32::MAX { json!("inf") } else { json!(max_depth) },
+            "threads": threads,
+            "seconds": stats.seconds,
+            "samples": stats.samples,
+            "samples_per_second": stats.samples as f64 / stats.seconds.max(1e-9),
+            "rays": stats.rays,
+            "rays_per_second": stats.rays as f64 / stats.seconds.max(1e-9),
+            "bvh_build_seconds": build.bvh_seconds,
+            "bvh_nodes": build.bvh_nodes,
+            "triangles": build.triangles,
+            "image_mean_rgb": [mean.x, mean.y, mean.z],
+            "nonfinite_samples_discarded": stats.nonfinite_samples,
+            "cancelled": stats.cancelled,
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else if !args.quiet {
+        eprintln!(
+            "{}: {}x{}, {} spp, {:.2} s, {:.3e} samples/s, {:.3e} rays/s, BVH {} nodes in {:.1} ms; wrote {}",
+            args.scene,
+            w,
+            h,
+            args.spp,
+            stats.seconds,
+            stats.samples as f64 / stats.seconds.max(1e-9),
+            stats.rays as f64 / stats.seconds.max(1e-9),
+            build.bvh_nodes,
+            build.bvh_seconds * 1e3,
+            output.display()
+        );
+        if stats.nonfinite_samples > 0 {
+            eprintln!(
+                "warning: {} samples were NaN or infinite and were discarded",
+                stats.nonfinite_samples
+            );
+        }
+    }
+    Ok(())
+}
+
+fn write_outputs(
+    film: &Film,
+    output: &Path,
+    format: OutputFormat,
+    args: &RenderArgs,
+) -> Result<()> {
+    let (w, h) = (film.width(), film.height());
+    let mean = film.mean_image();
+    let variance = args
+        .aov
+        .contains(&Aov::Variance)
+        .then(|| film.variance_image());
+    let samples = args
+        .aov
+        .contains(&Aov::Samples)
+        .then(|| film.sample_counts());
+    match format {
+        OutputFormat::Exr => {
+            let var_channels: Vec<Vec<f32>> = variance
+                .iter()
+                .flat_map(|v| (0..3).map(move |c| v.iter().map(|p| p[c]).collect::<Vec<f32>>()))
+                .collect();
+            let mut extra: Vec<ExtraChannel> = var_channels
+                .iter()
+                .zip(["variance.R", "variance.G", "variance.B"])
+                .map(|(values, name)| ExtraChannel {
+                    name: name.to_string(),
+                    values,
+                })
+                .collect();
+            if let Some(s) = &samples {
+                extra.push(ExtraChannel {
+                    name: "samples.Y".to_string(),
+                    values: s,
+                });
+            }
+            write_exr(output, w, h, &mean, &extra)?;
+        }
+        OutputFormat::Png => {
+            write_png(output, w, h, &mean, args.exposure)?;
+            let stem = output.with_extension("");
+            if let Some(v) = &variance {
+                write_exr(
+                    &PathBuf::from(format!("{}_variance.exr", stem.display())),
+                    w,
+                    h,
+                    v,
+                    &[],
+                )?;
+            }
+            if let Some(s) = &samples {
+                let grey: Vec<glam::Vec3> = s.iter().map(|&n| glam::Vec3::splat(n)).collect();
+                write_exr(
+                    &PathBuf::from(format!("{}_samples.exr", stem.display())),
+                    w,
+                    h,
+                    &grey,
+                    &[],
+                )?;
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,170 @@
+//! Integrators: estimators of the radiance arriving along a camera ray.
+//!
+//! - [`PathIntegrator`]: unidirectional path tracing with next-event estimation, multiple
+//!   importance sampling of light and BSDF samples (power heuristic), Russian roulette and
+//!   per-bounce output;
+//! - [`DirectIntegrator`]: direct lighting only, by one of four strategies (uniform hemisphere,
+//!   cosine-weighted hemisphere, light sampling, MIS), the course's comparison;
+//! - debug views: shading normals, distance, BVH nodes visited.
+
+mod debug;
+mod direct;
+mod path;
+
+pub use debug::DebugView;
+pub use direct::{DirectIntegrator, DirectStrategy};
+pub use path::PathIntegrator;
+
+use crate::bsdf::Bsdf;
+use crate::desc::Rgb;
+use crate::geometry::{offset_ray_origin, spawn_ray_to, Ray};
+use crate::light::Light;
+use crate::scene::{Scene, SurfaceInteraction};
+use glam::{Vec2, Vec3};
+use pathlab_mc::sampler::AnySampler;
+
+/// Counters an integrator keeps while it works.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathStats {
+    /// Rays traced (closest-hit and shadow).
+    pub rays: u64,
+    /// BVH nodes visited by closest-hit rays.
+    pub nodes_visited: u64,
+}
+
+impl PathStats {
+    /// Adds another's counts.
+    pub fn merge(&mut self, o: &PathStats) {
+        self.rays += o.rays;
+        self.nodes_visited += o.nodes_visited;
+    }
+}
+
+/// Computes the radiance along camera rays.
+pub trait Integrator: Sync {
+    /// An estimate of the radiance arriving at the camera along `ray`, from the sampler's
+    /// next dimensions.
+    fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb;
+}
+
+/// Which integrator, with its settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IntegratorKind {
+    /// Path tracing.
+    Path(PathIntegrator),
+    /// Direct lighting.
+    Direct(DirectIntegrator),
+    /// A debug view.
+    Debug(DebugView),
+}
+
+impl Integrator for IntegratorKind {
+    fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
+        match self {
+            IntegratorKind::Path(i) => i.li(scene, ray, sampler, stats),
+            IntegratorKind::Direct(i) => i.li(scene, ray, sampler, stats),
+            IntegratorKind::Debug(i) => i.li(scene, ray, sampler, stats),
+        }
+    }
+}
+
+/// Closest hit, counting the ray.
+#[inline]
+pub(crate) fn trace(scene: &Scene, ray: &Ray, stats: &mut PathStats) -> Option<SurfaceInteraction> {
+    let (hit, visited) = scene.intersect(ray);
+    stats.rays += 1;
+    stats.nodes_visited += visited as u64;
+    hit
+}
+
+/// The power heuristic with exponent 2 (Veach 1997) for `nf` samples of density `f_pdf`
+/// against `ng` samples of density `g_pdf`.
+#[inline]
+pub fn power_heuristic(nf: u32, f_pdf: f32, ng: u32, g_pdf: f32) -> f32 {
+    let f = nf as f32 * f_pdf;
+    let g = ng as f32 * g_pdf;
+    if f.is_infinite() {
+        return 1.0;
+    }
+    let (f2, g2) = (f * f, g * g);
+    if f2 + g2 == 0.0 {
+        0.0
+    } else {
+        f2 / (f2 + g2)
+    }
+}
+
+/// A light sample's contribution f · Li · |cos θi| / p at a surface point, weighted by MIS
+/// against `bsdf_samples` BSDF samples when that is nonzero (delta lights always get weight 1).
+/// `light_samples` is how many such light samples the caller averages.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sample_light(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    u_select: f32,
+    u_light: Vec2,
+    light_samples: u32,
+    bsdf_samples: u32,
+    stats: &mut PathStats,
+) -> Rgb {
+    let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
+        return Rgb::ZERO;
+    };
+    let light = &scene.lights()[index];
+    let Some(ls) = light.sample_li(si.p, u_light) else {
+        return Rgb::ZERO;
+    };
+    if ls.pdf <= 0.0 || ls.li.max_element() <= 0.0 {
+        return Rgb::ZERO;
+    }
+    let f = bsdf.f(wo, ls.wi) * ls.wi.dot(si.ns).abs();
+    if f.max_element() <= 0.0 {
+        return Rgb::ZERO;
+    }
+    let shadow = match light {
+        Light::Environment { .. } => Ray::new(offset_ray_origin(si.p, si.ng, ls.wi), ls.wi),
+        _ => spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light),
+    };
+    stats.rays += 1;
+    if scene.occluded(&shadow) {
+        return Rgb::ZERO;
+    }
+    let pdf = pmf * ls.pdf;
+    let weight = if ls.is_delta || bsdf_samples == 0 {
+        1.0
+    } else {
+        power_heuristic(light_samples, pdf, bsdf_samples, bsdf.pdf(wo, ls.wi))
+    };
+    f * ls.li * (weight / pdf)
+}
+
+/// Radiance emitted towards the previous vertex by the surface a ray from `p_prev` hit, and the
+/// density with which light sampling at `p_prev` would have chosen that point (for MIS).
+#[inline]
+pub(crate) fn emitted(
+    scene: &Scene,
+    p_prev: Vec3,
+    ray: &Ray,
+    si: &SurfaceInteraction,
+) -> Option<(Rgb, f32)> {
+    let index = si.light?;
+    let light = &scene.lights()[index as usize];
+    let le = light.le(si.ng, -ray.d);
+    if le.max_element() <= 0.0 {
+        return None;
+    }
+    let pdf = scene.light_sampler().pmf(index as usize) * light.pdf_li(p_prev, ray.d, si.p, si.ng);
+    Some((le, pdf))
+}
+
+/// Environment radiance along a ray that left the scene, and the density with which light
+/// sampling would have chosen its direction.
+#[inline]
+pub(crate) fn escaped(scene: &Scene, ray: &Ray) -> Option<(Rgb, f32)> {
+    let index = scene.environment()?;
+    let light = &scene.lights()[index as usize];
+    let pdf = scene.light_sampler().pmf(index as usize) * light.pdf_li(ray.o, ray.d, ray.o, ray.d);
+    Some((scene.environment_le(ray.d), pdf))
+}

@@ -1,0 +1,241 @@
+//! Lights: area lights (emissive triangles and spheres), point lights and a uniform
+//! environment; and the choice of a light in proportion to its power.
+
+use crate::desc::Rgb;
+use crate::geometry::Aabb;
+use crate::shape::{Sphere, Triangle};
+use glam::{Vec2, Vec3};
+use pathlab_mc::distribution::AliasTable;
+use pathlab_mc::warp::{sample_uniform_sphere, uniform_sphere_pdf};
+use std::f32::consts::PI;
+
+/// The shape an area light emits from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AreaShape {
+    /// A triangle.
+    Triangle(Triangle),
+    /// A sphere.
+    Sphere(Sphere),
+}
+
+/// A light source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Uniform radiance from a surface.
+    Area {
+        /// The emitting surface.
+        shape: AreaShape,
+        /// Radiance of the front side.
+        radiance: Rgb,
+        /// Whether the back side emits too.
+        two_sided: bool,
+    },
+    /// Radiant intensity from a point (a delta light).
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Intensity.
+        intensity: Rgb,
+    },
+    /// Uniform radiance from every direction at infinity.
+    Environment {
+        /// Radiance.
+        radiance: Rgb,
+        /// Radius of a sphere bounding the scene (for the power estimate).
+        scene_radius: f32,
+    },
+}
+
+/// Incident radiance sampled from a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightLiSample {
+    /// Radiance arriving at the reference point along `wi` (before visibility).
+    pub li: Rgb,
+    /// Unit direction from the reference point towards the light.
+    pub wi: Vec3,
+    /// Density per unit solid angle (1 for delta lights).
+    pub pdf: f32,
+    /// The point on the light (for a shadow ray).
+    pub p_light: Vec3,
+    /// The light's surface normal there (none for points and the environment).
+    pub n_light: Option<Vec3>,
+    /// Whether the light is a delta distribution (no BSDF sample can hit it).
+    pub is_delta: bool,
+}
+
+/// Relative luminance of linear sRGB / Rec. 709 primaries.
+#[inline]
+pub fn luminance(c: Rgb) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+impl Light {
+    /// Radiance leaving an area light at a point with normal `n` in direction `w` (away from
+    /// the light).
+    #[inline]
+    pub fn le(&self, n: Vec3, w: Vec3) -> Rgb {
+        match *self {
+            Light::Area {
+                radiance,
+                two_sided,
+                ..
+            } => {
+                let c = n.dot(w);
+                if c > 0.0 || (two_sided && c < 0.0) {
+                    radiance
+                } else {
+                    Rgb::ZERO
+                }
+            }
+            Light::Environment { radiance, .. } => radiance,
+            Light::Point { .. } => Rgb::ZERO,
+        }
+    }
+
+    /// Samples incident radiance at `p`.
+    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightLiSample> {
+        match *self {
+            Light::Area { shape, .. } => {
+                let s = match shape {
+                    AreaShape::Triangle(t) => t.sample(u),
+                    AreaShape::Sphere(sph) => sph.sample(u),
+                };
+                let to_light = s.p - p;
+                let dist2 = to_light.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let wi = to_light / dist2.sqrt();
+                let cos_l = s.n.dot(-wi).abs();
+                if cos_l == 0.0 {
+                    return None;
+                }
+                let li = self.le(s.n, -wi);
+                Some(LightLiSample {
+                    li,
+                    wi,
+                    pdf: s.pdf_area * dist2 / cos_l,
+                    p_light: s.p,
+                    n_light: Some(s.n),
+                    is_delta: false,
+                })
+            }
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let to_light = position - p;
+                let dist2 = to_light.length_squared();
+                (dist2 > 0.0).then(|| LightLiSample {
+                    li: intensity / dist2,
+                    wi: to_light / dist2.sqrt(),
+                    pdf: 1.0,
+                    p_light: position,
+                    n_light: None,
+                    is_delta: true,
+                })
+            }
+            Light::Environment {
+                radiance,
+                scene_radius,
+            } => {
+                let wi = sample_uniform_sphere(u);
+                Some(LightLiSample {
+                    li: radiance,
+                    wi,
+                    pdf: uniform_sphere_pdf(),
+                    p_light: p + wi * (4.0 * scene_radius.max(1.0)),
+                    n_light: None,
+                    is_delta: false,
+                })
+            }
+        }
+    }
+
+    /// Density per unit solid angle with which [`Light::sample_li`] from `p` produces the point
+    /// `p_light` (normal `n_light`) on an area light, or the direction `wi` for the environment.
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3, p_light: Vec3, n_light: Vec3) -> f32 {
+        match *self {
+            Light::Area { shape, .. } => {
+                let area = match shape {
+                    AreaShape::Triangle(t) => t.area(),
+                    AreaShape::Sphere(s) => s.area(),
+                };
+                let dist2 = (p_light - p).length_squared();
+                let cos_l = n_light.dot(-wi).abs();
+                if cos_l == 0.0 {
+                    0.0
+                } else {
+                    dist2 / (cos_l * area)
+                }
+            }
+            Light::Environment { .. } => uniform_sphere_pdf(),
+            Light::Point { .. } => 0.0,
+        }
+    }
+
+    /// Total emitted power (luminance), for choosing lights.
+    pub fn phi(&self) -> f32 {
+        match *self {
+            Light::Area {
+                shape,
+                radiance,
+                two_sided,
+            } => {
+                let area = match shape {
+                    AreaShape::Triangle(t) => t.area(),
+                    AreaShape::Sphere(s) => s.area(),
+                };
+                let sides = if two_sided { 2.0 } else { 1.0 };
+                PI * area * sides * luminance(radiance)
+            }
+            Light::Point { intensity, .. } => 4.0 * PI * luminance(intensity),
+            Light::Environment {
+                radiance,
+                scene_radius,
+            } => 4.0 * PI * PI * scene_radius * scene_radius * luminance(radiance),
+        }
+    }
+}
+
+/// Chooses lights in proportion to their power (alias method); lights of zero power get a tiny
+/// share so that every light stays reachable.
+#[derive(Clone, Debug)]
+pub struct LightSampler {
+    table: Option<AliasTable>,
+}
+
+impl LightSampler {
+    /// The sampler for `lights`.
+    pub fn new(lights: &[Light]) -> Self {
+        let total: f64 = lights.iter().map(|l| l.phi().max(0.0) as f64).sum();
+        let floor = if total > 0.0 { total * 1e-6 } else { 1.0 };
+        let weights: Vec<f64> = lights
+            .iter()
+            .map(|l| (l.phi() as f64).max(0.0).max(floor))
+            .collect();
+        LightSampler {
+            table: AliasTable::new(&weights).ok(),
+        }
+    }
+
+    /// A light index and its probability, or `None` when there are no lights.
+    #[inline]
+    pub fn sample(&self, u: f32) -> Option<(usize, f32)> {
+        self.table.as_ref().map(|t| {
+            let s = t.sample(u);
+            (s.index, s.pmf as f32)
+        })
+    }
+
+    /// The probability of choosing light `index`.
+    #[inline]
+    pub fn pmf(&self, index: usize) -> f32 {
+        self.table.as_ref().map_or(0.0, |t| t.pmf(index) as f32)
+    }
+}
+
+/// Radius of the sphere around a box.
+pub fn bounding_radius(b: &Aabb) -> f32 {
+    0.5 * b.extent().length()
+}

@@ -1,0 +1,372 @@
+//! The renderable scene: flattened shapes, the BVH over them, materials, lights and camera.
+
+use crate::accel::{Bvh, BvhParams};
+use crate::bsdf::Material;
+use crate::camera::Camera;
+use crate::desc::{MaterialDesc, Rgb, SceneDesc};
+use crate::geometry::{Aabb, Ray};
+use crate::light::{bounding_radius, AreaShape, Light, LightSampler};
+use crate::shape::{Sphere, Triangle};
+use glam::Vec3;
+use std::time::Instant;
+use thiserror::Error;
+
+/// Marks a shape that emits no light.
+const NO_LIGHT: u32 = u32::MAX;
+
+/// What can be wrong with a scene description.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// A shape names a material that does not exist.
+    #[error("{shape}: material index {index} does not exist ({count} materials)")]
+    MissingMaterial {
+        /// Which shape.
+        shape: String,
+        /// The index it names.
+        index: usize,
+        /// How many materials there are.
+        count: usize,
+    },
+    /// A mesh's index list is malformed.
+    #[error("mesh '{mesh}': {message}")]
+    BadMesh {
+        /// Which mesh.
+        mesh: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value is out of range.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// A primitive of the BVH.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Prim {
+    Triangle(u32),
+    Sphere(u32),
+}
+
+/// A ray's nearest hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceInteraction {
+    /// The point.
+    pub p: Vec3,
+    /// Ray parameter.
+    pub t: f32,
+    /// Unit geometric normal on the shape's front side (winding or outward).
+    pub ng: Vec3,
+    /// Unit shading normal.
+    pub ns: Vec3,
+    /// Material index.
+    pub material: u32,
+    /// Index of the light the surface belongs to, if it emits.
+    pub light: Option<u32>,
+}
+
+/// Build statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BuildStats {
+    /// Seconds spent building the BVH.
+    pub bvh_seconds: f64,
+    /// Nodes of the BVH.
+    pub bvh_nodes: usize,
+    /// Triangles.
+    pub triangles: usize,
+    /// Spheres.
+    pub spheres: usize,
+    /// Lights.
+    pub lights: usize,
+}
+
+/// A scene ready to render.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    triangles: Vec<Triangle>,
+    tri_material: Vec<u32>,
+    tri_light: Vec<u32>,
+    spheres: Vec<Sphere>,
+    sphere_material: Vec<u32>,
+    sphere_light: Vec<u32>,
+    prims: Vec<Prim>,
+    bvh: Bvh,
+    materials: Vec<Material>,
+    lights: Vec<Light>,
+    light_sampler: LightSampler,
+    environment: Option<u32>,
+    camera: Camera,
+    stats: BuildStats,
+}
+
+impl Scene {
+    /// Builds the scene: flattens meshes into triangles, builds the BVH, creates the lights.
+    pub fn build(desc: &SceneDesc) -> Result<Scene, SceneError> {
+        let [w, h] = desc.resolution;
+        if w == 0 || h == 0 {
+            return Err(SceneError::Invalid(format!("resolution {w}x{h} is empty")));
+        }
+        let materials: Vec<Material> = desc.materials.iter().map(Material::from).collect();
+        let check_material = |shape: &str, index: usize| {
+            if index < materials.len() {
+                Ok(index as u32)
+            } else {
+                Err(SceneError::MissingMaterial {
+                    shape: shape.to_string(),
+                    index,
+                    count: materials.len(),
+                })
+            }
+        };
+        let mut triangles = Vec::new();
+        let mut tri_material = Vec::new();
+        let mut tri_light = Vec::new();
+        let mut lights = Vec::new();
+        for mesh in &desc.meshes {
+            let material = check_material(&mesh.name, mesh.material)?;
+            if mesh.indices.len() % 3 != 0 {
+                return Err(SceneError::BadMesh {
+                    mesh: mesh.name.clone(),
+                    message: format!("{} indices is not a multiple of 3", mesh.indices.len()),
+                });
+            }
+            for tri in mesh.indices.chunks_exact(3) {
+                let mut p = [Vec3::ZERO; 3];
+                for (k, &i) in tri.iter().enumerate() {
+                    p[k] = *mesh
+                        .positions
+                        .get(i as usize)
+                        .ok_or_else(|| SceneError::BadMesh {
+                            mesh: mesh.name.clone(),
+                            message: format!(
+                                "index {i} is out of range ({} vertices)",
+                                mesh.positions.len()
+                            ),
+                        })?;
+                }
+                let t = Triangle { p };
+                if t.area() <= 0.0 || !t.area().is_finite() {
+                    continue; // degenerate: invisible and unsampleable
+                }
+                triangles.push(t);
+                tri_material.push(material);
+                match mesh.emission {
+                    Some(e) if e.radiance.max_element() > 0.0 => {
+                        tri_light.push(lights.len() as u32);
+                        lights.push(Light::Area {
+                            shape: AreaShape::Triangle(t),
+                            radiance: e.radiance,
+                            two_sided: e.two_sided,
+                        });
+                    }
+                    _ => tri_light.push(NO_LIGHT),
+                }
+            }
+        }
+        let mut spheres = Vec::new();
+        let mut sphere_material = Vec::new();
+        let mut sphere_light = Vec::new();
+        for (i, s) in desc.spheres.iter().enumerate() {
+            let material = check_material(&format!("sphere {i}"), s.material)?;
+            if !(s.radius > 0.0 && s.radius.is_finite() && s.center.is_finite()) {
+                return Err(SceneError::Invalid(format!(
+                    "sphere {i}: radius must be positive and finite, got {}",
+                    s.radius
+                )));
+            }
+            let sphere = Sphere {
+                center: s.center,
+                radius: s.radius,
+            };
+            spheres.push(sphere);
+            sphere_material.push(material);
+            match s.emission {
+                Some(e) if e.radiance.max_element() > 0.0 => {
+                    sphere_light.push(lights.len() as u32);
+                    lights.push(Light::Area {
+                        shape: AreaShape::Sphere(sphere),
+                        radiance: e.radiance,
+                        two_sided: e.two_sided,
+                    });
+                }
+                _ => sphere_light.push(NO_LIGHT),
+            }
+        }
+        for pl in &desc.point_lights {
+            lights.push(Light::Point {
+                position: pl.position,
+                intensity: pl.intensity,
+            });
+        }
+        let prims: Vec<Prim> = (0..triangles.len() as u32)
+            .map(Prim::Triangle)
+            .chain((0..spheres.len() as u32).map(Prim::Sphere))
+            .collect();
+        let bounds: Vec<Aabb> = prims
+            .iter()
+            .map(|p| match *p {
+                Prim::Triangle(i) => triangles[i as usize].bounds(),
+                Prim::Sphere(i) => spheres[i as usize].bounds(),
+            })
+            .collect();
+        let start = Instant::now();
+        let bvh = Bvh::build(&bounds, BvhParams::default());
+        let bvh_seconds = start.elapsed().as_secs_f64();
+        let environment = desc
+            .environment
+            .filter(|e| e.max_element() > 0.0)
+            .map(|radiance| {
+                lights.push(Light::Environment {
+                    radiance,
+                    scene_radius: bounding_radius(&bvh.bounds()),
+                });
+                (lights.len() - 1) as u32
+            });
+        let light_sampler = LightSampler::new(&lights);
+        let stats = BuildStats {
+            bvh_seconds,
+            bvh_nodes: bvh.node_count(),
+            triangles: triangles.len(),
+            spheres: spheres.len(),
+            lights: lights.len(),
+        };
+        Ok(Scene {
+            triangles,
+            tri_material,
+            tri_light,
+            spheres,
+            sphere_material,
+            sphere_light,
+            prims,
+            bvh,
+            materials,
+            lights,
+            light_sampler,
+            environment,
+            camera: Camera::new(&desc.camera, desc.resolution),
+            stats,
+        })
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Build statistics.
+    pub fn stats(&self) -> BuildStats {
+        self.stats
+    }
+
+    /// Bounds of all shapes.
+    pub fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+
+    /// Material `i`.
+    #[inline]
+    pub fn material(&self, i: u32) -> &Material {
+        &self.materials[i as usize]
+    }
+
+    /// All lights.
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// The power-proportional light chooser.
+    pub fn light_sampler(&self) -> &LightSampler {
+        &self.light_sampler
+    }
+
+    /// The environment light's index, if there is one.
+    pub fn environment(&self) -> Option<u32> {
+        self.environment
+    }
+
+    /// Radiance from the environment along direction `w` (zero without one).
+    #[inline]
+    pub fn environment_le(&self, w: Vec3) -> Rgb {
+        self.environment
+            .map_or(Rgb::ZERO, |i| self.lights[i as usize].le(Vec3::ZERO, w))
+    }
+
+    /// The nearest surface along `ray`, and the number of BVH nodes visited.
+    pub fn intersect(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u32) {
+        let mut r = *ray;
+        let mut best: Option<(Prim, f32, f32)> = None; // (prim, b1, b2)
+        let (_, visited) = self.bvh.intersect(&mut r, |i, r| {
+            let prim = self.prims[i as usize];
+            match prim {
+                Prim::Triangle(t) => match self.triangles[t as usize].intersect(r) {
+                    Some(h) => {
+                        r.t_max = h.t;
+                        best = Some((prim, h.b1, h.b2));
+                        true
+                    }
+                    None => false,
+                },
+                Prim::Sphere(s) => match self.spheres[s as usize].intersect(r) {
+                    Some(t) => {
+                        r.t_max = t;
+                        best = Some((prim, 0.0, 0.0));
+                        true
+                    }
+                    None => false,
+                },
+            }
+        });
+        let hit = best.map(|(prim, b1, b2)| {
+            let t = r.t_max;
+            match prim {
+                Prim::Triangle(i) => {
+                    let tri = &self.triangles[i as usize];
+                    let p = (1.0 - b1 - b2) * tri.p[0] + b1 * tri.p[1] + b2 * tri.p[2];
+                    let ng = tri.normal();
+                    let light = self.tri_light[i as usize];
+                    SurfaceInteraction {
+                        p,
+                        t,
+                        ng,
+                        ns: ng,
+                        material: self.tri_material[i as usize],
+                        light: (light != NO_LIGHT).then_some(light),
+                    }
+                }
+                Prim::Sphere(i) => {
+                    let s = &self.spheres[i as usize];
+                    let p = ray.at(t);
+                    let ng = ((p - s.center) / s.radius).normalize();
+                    // Project onto the surface to remove the rounding of the ray parameter.
+                    let p = s.center + ng * s.radius;
+                    let light = self.sphere_light[i as usize];
+                    SurfaceInteraction {
+                        p,
+                        t,
+                        ng,
+                        ns: ng,
+                        material: self.sphere_material[i as usize],
+                        light: (light != NO_LIGHT).then_some(light),
+                    }
+                }
+            }
+        });
+        (hit, visited)
+    }
+
+    /// Whether anything blocks `ray` within its extent.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.bvh.occluded(ray, |i, r| match self.prims[i as usize] {
+            Prim::Triangle(t) => self.triangles[t as usize].intersect(r).is_some(),
+            Prim::Sphere(s) => self.spheres[s as usize].intersect(r).is_some(),
+        })
+    }
+}
+
+/// A material list with one diffuse entry, for tests and simple scenes.
+pub fn diffuse(reflectance: Rgb, two_sided: bool) -> MaterialDesc {
+    MaterialDesc::Diffuse {
+        reflectance,
+        two_sided,
+    }
+}

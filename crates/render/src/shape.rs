@@ -1,0 +1,213 @@
+//! Shapes: triangles and spheres, their intersection with rays and their uniform area sampling.
+
+use crate::geometry::{Aabb, Ray};
+use glam::{Vec2, Vec3};
+use pathlab_mc::warp::{sample_uniform_sphere, sample_uniform_triangle};
+use std::f32::consts::PI;
+
+/// A triangle's vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Vertex positions.
+    pub p: [Vec3; 3],
+}
+
+/// Where a ray meets a triangle: distance and barycentrics of vertices 1 and 2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    /// Ray parameter.
+    pub t: f32,
+    /// Barycentric coordinate of vertex 1.
+    pub b1: f32,
+    /// Barycentric coordinate of vertex 2.
+    pub b2: f32,
+}
+
+/// A point sampled on a shape's surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeSample {
+    /// The point.
+    pub p: Vec3,
+    /// Unit geometric normal there (the shape's outward / winding side).
+    pub n: Vec3,
+    /// Density per unit area.
+    pub pdf_area: f32,
+}
+
+impl Triangle {
+    /// Bounding box.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::point(self.p[0]).grow(self.p[1]).grow(self.p[2])
+    }
+
+    /// Area.
+    pub fn area(&self) -> f32 {
+        0.5 * (self.p[1] - self.p[0])
+            .cross(self.p[2] - self.p[0])
+            .length()
+    }
+
+    /// Unit normal of the counter-clockwise winding (zero for a degenerate triangle).
+    pub fn normal(&self) -> Vec3 {
+        (self.p[1] - self.p[0])
+            .cross(self.p[2] - self.p[0])
+            .normalize_or_zero()
+    }
+
+    /// Möller–Trumbore intersection ("Fast, Minimum Storage Ray/Triangle Intersection",
+    /// 1997), both sides, within `(0, ray.t_max)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<TriangleHit> {
+        let e1 = self.p[1] - self.p[0];
+        let e2 = self.p[2] - self.p[0];
+        let pvec = ray.d.cross(e2);
+        let det = e1.dot(pvec);
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let tvec = ray.o - self.p[0];
+        let b1 = tvec.dot(pvec) * inv_det;
+        if !(0.0..=1.0).contains(&b1) {
+            return None;
+        }
+        let qvec = tvec.cross(e1);
+        let b2 = ray.d.dot(qvec) * inv_det;
+        if b2 < 0.0 || b1 + b2 > 1.0 {
+            return None;
+        }
+        let t = e2.dot(qvec) * inv_det;
+        (t > 0.0 && t < ray.t_max).then_some(TriangleHit { t, b1, b2 })
+    }
+
+    /// A point uniform over the triangle.
+    pub fn sample(&self, u: Vec2) -> ShapeSample {
+        let b = sample_uniform_triangle(u);
+        ShapeSample {
+            p: b[0] * self.p[0] + b[1] * self.p[1] + b[2] * self.p[2],
+            n: self.normal(),
+            pdf_area: 1.0 / self.area(),
+        }
+    }
+}
+
+/// A sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius (> 0).
+    pub radius: f32,
+}
+
+impl Sphere {
+    /// Bounding box.
+    pub fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.center - Vec3::splat(self.radius),
+            max: self.center + Vec3::splat(self.radius),
+        }
+    }
+
+    /// Surface area.
+    pub fn area(&self) -> f32 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    /// The nearest intersection distance within `(0, ray.t_max)`, from either side.
+    ///
+    /// Solves a t² + 2b t + c = 0 in `f64` relative to the centre, with the discriminant
+    /// written as a (r² - |o - (b/a) d|²) to avoid cancellation for distant origins, and the
+    /// roots as q/a and c/q to avoid it for near-tangent ones.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<f32> {
+        let o = (ray.o - self.center).as_dvec3();
+        let d = ray.d.as_dvec3();
+        let r = self.radius as f64;
+        let a = d.length_squared();
+        if a == 0.0 {
+            return None;
+        }
+        let b = o.dot(d);
+        let c = o.length_squared() - r * r;
+        let l = o - (b / a) * d;
+        let disc = a * (r * r - l.length_squared());
+        if disc < 0.0 {
+            return None;
+        }
+        let q = -(b + disc.sqrt().copysign(b));
+        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
+        let (t0, t1) = (t0.min(t1), t0.max(t1));
+        let t_max = ray.t_max as f64;
+        [t0, t1]
+            .into_iter()
+            .find(|&t| t > 0.0 && t < t_max)
+            .map(|t| t as f32)
+    }
+
+    /// A point uniform over the surface.
+    pub fn sample(&self, u: Vec2) -> ShapeSample {
+        let n = sample_uniform_sphere(u);
+        ShapeSample {
+            p: self.center + self.radius * n,
+            n,
+            pdf_area: 1.0 / self.area(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_hits_inside_and_misses_outside() {
+        let tri = Triangle {
+            p: [
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
+        };
+        let hit = tri
+            .intersect(&Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::NEG_Z))
+            .unwrap();
+        assert!(
+            (hit.t - 1.0).abs() < 1e-6
+                && (hit.b1 - 0.25).abs() < 1e-6
+                && (hit.b2 - 0.25).abs() < 1e-6
+        );
+        // From behind too.
+        assert!(tri
+            .intersect(&Ray::new(Vec3::new(0.25, 0.25, -1.0), Vec3::Z))
+            .is_some());
+        assert!(tri
+            .intersect(&Ray::new(Vec3::new(0.75, 0.75, 1.0), Vec3::NEG_Z))
+            .is_none());
+        let mut short = Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::NEG_Z);
+        short.t_max = 0.5;
+        assert!(tri.intersect(&short).is_none());
+        assert_eq!(tri.normal(), Vec3::Z);
+        assert!((tri.area() - 0.5).abs() < 1e-7);
+    }
+
+    #[test]
+    fn sphere_from_outside_inside_and_on_surface() {
+        let s = Sphere {
+            center: Vec3::new(0.0, 0.0, -5.0),
+            radius: 1.0,
+        };
+        let t = s.intersect(&Ray::new(Vec3::ZERO, Vec3::NEG_Z)).unwrap();
+        assert!((t - 4.0).abs() < 1e-5);
+        let t = s
+            .intersect(&Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::X))
+            .unwrap();
+        assert!((t - 1.0).abs() < 1e-6);
+        // Leaving the surface outwards misses; inwards hits the far side.
+        let p = Vec3::new(0.0, 0.0, -4.0);
+        assert!(s.intersect(&Ray::new(p, Vec3::Z)).is_none());
+        let t = s.intersect(&Ray::new(p, Vec3::NEG_Z)).unwrap();
+        assert!((t - 2.0).abs() < 1e-5);
+        assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::X)).is_none());
+    }
+}
