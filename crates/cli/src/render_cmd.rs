@@ -70,6 +70,9 @@ pub struct RenderArgs {
     /// Image size in pixels (default: the scene's).
     #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"])]
     pub resolution: Option<Vec<u32>>,
+    /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black).
+    #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"])]
+    pub crop: Option<Vec<u32>>,
     /// Output image: .exr (linear) or .png (sRGB). Default: SCENE.png.
     #[arg(short = 'o', long, visible_short_alias = 'f', value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -170,13 +173,24 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         IntegratorName::Depth => IntegratorKind::Debug(DebugView::Depth),
         IntegratorName::Bvh => IntegratorKind::Debug(DebugView::BvhHeat),
     };
-    let settings = RenderSettings {
-        spp: args.spp,
-        seed: args.seed,
-        sampler: args.sampler,
-    };
+    let mut settings = RenderSettings::new(args.spp, args.seed, args.sampler);
+    if let Some(c) = &args.crop {
+        let [w, h] = desc.resolution;
+        if c[0] >= c[2] || c[1] >= c[3] || c[2] > w || c[3] > h {
+            bail!(
+                "--crop {} {} {} {}: need x0 < x1 <= {w} and y0 < y1 <= {h}",
+                c[0],
+                c[1],
+                c[2],
+                c[3]
+            );
+        }
+        settings.crop = Some([c[0], c[1], c[2], c[3]]);
+    }
     let [w, h] = desc.resolution;
-    let total = w as u64 * h as u64 * args.spp as u64;
+    let total = settings.crop.map_or(w as u64 * h as u64, |c| {
+        (c[2] - c[0]) as u64 * (c[3] - c[1]) as u64
+    }) * args.spp as u64;
     let bar = if args.quiet || !std::io::stderr().is_terminal() {
         ProgressBar::hidden()
     } else {

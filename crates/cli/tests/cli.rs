@@ -344,10 +344,14 @@ fn same_seed_same_answer_for_any_thread_count() {
 }
 
 fn assert_image(path: &PathBuf, png: bool) {
-    let bytes = std::fs::read(path).expect("plot written");
+    assert_image_at_least(path, png, 10_000);
+}
+
+fn assert_image_at_least(path: &PathBuf, png: bool, min_bytes: usize) {
+    let bytes = std::fs::read(path).expect("image written");
     if png {
         assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
-        assert!(bytes.len() > 10_000, "suspiciously small PNG");
+        assert!(bytes.len() > min_bytes, "suspiciously small PNG");
     } else {
         let text = String::from_utf8(bytes).unwrap();
         assert!(
@@ -412,4 +416,133 @@ fn convergence_plot_and_data() {
         slope(0)
     );
     assert!(slope(2) < -0.8, "sobol slope {}", slope(2));
+}
+
+#[test]
+fn render_writes_png_exr_and_aovs_with_statistics() {
+    let png = scratch("cornell.png");
+    let v = json_of(&pathlab(&[
+        "render",
+        "-s",
+        "2",
+        "-r",
+        "32",
+        "24",
+        "-o",
+        png.to_str().unwrap(),
+        "--aov",
+        "variance,samples",
+        "--json",
+    ]));
+    assert_image_at_least(&png, true, 100);
+    assert!(scratch_exists("cornell_variance.exr") && scratch_exists("cornell_samples.exr"));
+    assert_eq!(v["resolution"], serde_json::json!([32, 24]));
+    assert_eq!(v["samples"], 32 * 24 * 2);
+    for key in [
+        "seconds",
+        "samples_per_second",
+        "rays",
+        "rays_per_second",
+        "bvh_build_seconds",
+        "bvh_nodes",
+        "nonfinite_samples_discarded",
+    ] {
+        assert!(v[key].is_number(), "{key} missing");
+    }
+    assert_eq!(v["image_mean_rgb"].as_array().unwrap().len(), 3);
+    let exr = scratch("cornell.exr");
+    let out = pathlab(&[
+        "render",
+        "-s",
+        "1",
+        "-r",
+        "16",
+        "16",
+        "-f",
+        exr.to_str().unwrap(),
+        "--aov",
+        "samples",
+        "-m",
+        "1",
+        "-q",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (w, h, px) = pathlab_render::image_io::read_exr_rgb(&exr).unwrap();
+    assert_eq!((w, h, px.len()), (16, 16, 256));
+    for view in ["normals", "depth", "bvh"] {
+        let out = pathlab(&[
+            "render",
+            "--integrator",
+            view,
+            "-s",
+            "1",
+            "-r",
+            "8",
+            "8",
+            "-o",
+            scratch(&format!("{view}.png")).to_str().unwrap(),
+            "-q",
+        ]);
+        assert!(
+            out.status.success(),
+            "{view}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+fn scratch_exists(name: &str) -> bool {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli-tests")
+        .join(name)
+        .exists()
+}
+
+#[test]
+fn render_same_seed_same_image_for_any_thread_count() {
+    let run = |threads: &str, name: &str| {
+        let path = scratch(name);
+        let out = pathlab(&[
+            "render",
+            "-s",
+            "2",
+            "-r",
+            "24",
+            "24",
+            "-t",
+            threads,
+            "--seed",
+            "5",
+            "-o",
+            path.to_str().unwrap(),
+            "-q",
+        ]);
+        assert!(out.status.success());
+        pathlab_render::image_io::read_exr_rgb(&path).unwrap().2
+    };
+    assert_eq!(run("1", "t1.exr"), run("2", "t2.exr"));
+}
+
+#[test]
+fn bad_render_flags_are_one_line_errors() {
+    assert_one_line_error(&pathlab(&["render", "-m", "deep"]), "--max-depth");
+    assert_one_line_error(&pathlab(&["render", "-r", "0", "10"]), "--resolution");
+    assert_one_line_error(&pathlab(&["render", "-o", "out.jpg"]), ".exr or .png");
+    assert_one_line_error(&pathlab(&["render", "-s", "0"]), "--spp");
+    assert_one_line_error(
+        &pathlab(&["render", "no-such-scene"]),
+        "unknown built-in scene",
+    );
+    assert_one_line_error(
+        &pathlab(&["render", "--crop", "10", "10", "5", "20"]),
+        "--crop",
+    );
+    assert_one_line_error(
+        &pathlab(&["render", "-s", "1", "-o", "/nonexistent-dir/x.png"]),
+        "nonexistent-dir",
+    );
 }

@@ -32,7 +32,7 @@
 //! };
 //! let scene = Scene::build(&desc).unwrap();
 //! let integrator = IntegratorKind::Path(PathIntegrator { max_depth: 1, ..Default::default() });
-//! let settings = RenderSettings { spp: 256, seed: 1, sampler: SamplerKind::Independent };
+//! let settings = RenderSettings::new(256, 1, SamplerKind::Independent);
 //! let (film, _) = render(&scene, &integrator, &settings, &|_| {}, &Default::default());
 //! let m = film.image_mean();
 //! assert!((m.x - 0.5).abs() < 4.0 * film.image_mean_std_error().x + 1e-6);

@@ -21,6 +21,21 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Which sampler.
     pub sampler: SamplerKind,
+    /// Only the pixels `x0 <= x < x1`, `y0 <= y < y1` of `[x0, y0, x1, y1]`; the others get
+    /// no samples. `None`: the whole image.
+    pub crop: Option<[u32; 4]>,
+}
+
+impl RenderSettings {
+    /// `spp` samples per pixel of the whole image with the given seed and sampler.
+    pub fn new(spp: u32, seed: u64, sampler: SamplerKind) -> Self {
+        RenderSettings {
+            spp,
+            seed,
+            sampler,
+            crop: None,
+        }
+    }
 }
 
 /// What a render did.
@@ -64,17 +79,21 @@ pub fn render(
     cancel: &AtomicBool,
 ) -> (Film, RenderStats) {
     let [width, height] = scene.camera().resolution();
-    let tiles: Vec<(u32, u32)> = (0..height.div_ceil(TILE_SIZE))
-        .flat_map(|ty| {
-            (0..width.div_ceil(TILE_SIZE)).map(move |tx| (tx * TILE_SIZE, ty * TILE_SIZE))
-        })
+    let [cx0, cy0, cx1, cy1] = settings
+        .crop
+        .map_or([0, 0, width, height], |[x0, y0, x1, y1]| {
+            [x0.min(width), y0.min(height), x1.min(width), y1.min(height)]
+        });
+    let tiles: Vec<(u32, u32)> = (cy0..cy1)
+        .step_by(TILE_SIZE as usize)
+        .flat_map(|y| (cx0..cx1).step_by(TILE_SIZE as usize).map(move |x| (x, y)))
         .collect();
     let start = Instant::now();
     let results: Vec<TileResult> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
-            let w = TILE_SIZE.min(width - x0);
-            let h = TILE_SIZE.min(height - y0);
+            let w = TILE_SIZE.min(cx1 - x0);
+            let h = TILE_SIZE.min(cy1 - y0);
             let mut sampler = settings.sampler.build(settings.spp, settings.seed);
             let mut out = TileResult {
                 x0,

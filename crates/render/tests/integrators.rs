@@ -1,0 +1,441 @@
+//! Integrators on scenes with known answers: furnaces, bounce decomposition, strategy
+//! agreement, determinism and the NaN guard. Tolerances are multiples of the standard errors
+//! the renders estimate themselves.
+
+use glam::{DVec3, Vec3};
+use pathlab_mc::sampler::{AnySampler, SamplerKind};
+use pathlab_mc::stats::z_test_two_sample;
+use pathlab_render::desc::*;
+use pathlab_render::film::Film;
+use pathlab_render::geometry::Ray;
+use pathlab_render::integrator::*;
+use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::scene::{diffuse, Scene};
+
+const MAX_Z: f64 = 4.0;
+
+fn run(desc: &SceneDesc, integrator: IntegratorKind, spp: u32, seed: u64) -> Film {
+    let scene = Scene::build(desc).unwrap();
+    let settings = RenderSettings::new(spp, seed, SamplerKind::Independent);
+    render(&scene, &integrator, &settings, &|_| {}, &Default::default()).0
+}
+
+fn path(max_depth: u32) -> IntegratorKind {
+    IntegratorKind::Path(PathIntegrator {
+        max_depth,
+        ..Default::default()
+    })
+}
+
+/// Asserts that every channel of the image mean is within 4 standard errors of `truth`.
+fn assert_mean(name: &str, film: &Film, truth: DVec3) {
+    let (m, se) = (film.image_mean(), film.image_mean_std_error());
+    eprintln!("{name}: mean {m:.5?} ± {se:.5?}, expected {truth:?}");
+    for c in 0..3 {
+        assert!(
+            // The second term is the single-precision rounding of the radiance computation.
+            (m[c] - truth[c]).abs() <= MAX_Z * se[c] + 1e-6 * truth[c].abs(),
+            "{name}: channel {c}: {} vs {} (se {})",
+            m[c],
+            truth[c],
+            se[c]
+        );
+    }
+}
+
+/// The camera at the centre of a closed sphere that emits 1 everywhere and reflects albedo a.
+fn closed_furnace(albedo: f32) -> SceneDesc {
+    SceneDesc {
+        spheres: vec![SphereDesc {
+            center: Vec3::ZERO,
+            radius: 1.0,
+            material: 0,
+            emission: Some(Emission {
+                radiance: Vec3::ONE,
+                two_sided: true,
+            }),
+        }],
+        materials: vec![diffuse(Vec3::splat(albedo), true)],
+        camera: CameraDesc {
+            origin: Vec3::new(0.1, -0.2, 0.05),
+            target: Vec3::new(1.0, 0.3, 0.2),
+            fov_degrees: 90.0,
+            ..Default::default()
+        },
+        resolution: [16, 16],
+        ..Default::default()
+    }
+}
+
+#[test]
+fn closed_furnace_converges_to_geometric_series() {
+    // L = Le + a L  =>  L = 1/(1 - a), reached only with unbounded depth (Russian roulette).
+    for albedo in [0.5f32, 0.8] {
+        let film = run(&closed_furnace(albedo), path(u32::MAX), 256, 3);
+        let truth = 1.0 / (1.0 - albedo as f64);
+        assert_mean(
+            &format!("closed furnace, albedo {albedo}"),
+            &film,
+            DVec3::splat(truth),
+        );
+    }
+}
+
+#[test]
+fn closed_furnace_depths_are_partial_sums() {
+    // With max depth d, L = 1 + a + ... + a^d.
+    let albedo = 0.6f64;
+    for d in [0u32, 1, 3] {
+        let film = run(&closed_furnace(albedo as f32), path(d), 64, 4 + d as u64);
+        let truth: f64 = (0..=d).map(|k| albedo.powi(k as i32)).sum();
+        assert_mean(
+            &format!("closed furnace, -m {d}"),
+            &film,
+            DVec3::splat(truth),
+        );
+    }
+}
+
+/// An albedo-0.8 sphere filling the view under a uniform white sky.
+fn sky_sphere() -> SceneDesc {
+    SceneDesc {
+        spheres: vec![SphereDesc {
+            center: Vec3::ZERO,
+            radius: 1.0,
+            material: 0,
+            emission: None,
+        }],
+        materials: vec![diffuse(Vec3::splat(0.8), false)],
+        environment: Some(Vec3::ONE),
+        camera: CameraDesc {
+            origin: Vec3::new(0.0, 0.0, 5.0),
+            target: Vec3::ZERO,
+            fov_degrees: 8.0,
+            ..Default::default()
+        },
+        resolution: [16, 16],
+        ..Default::default()
+    }
+}
+
+#[test]
+fn white_sky_furnace_reflects_the_albedo() {
+    // A convex surface sees the sky over its whole hemisphere: L = a at every depth >= 1.
+    for integrator in [
+        path(1),
+        path(u32::MAX),
+        IntegratorKind::Direct(DirectIntegrator {
+            strategy: DirectStrategy::Hemisphere,
+            samples: 4,
+        }),
+        IntegratorKind::Direct(DirectIntegrator {
+            strategy: DirectStrategy::Cosine,
+            samples: 1,
+        }),
+        IntegratorKind::Direct(DirectIntegrator {
+            strategy: DirectStrategy::Light,
+            samples: 4,
+        }),
+        IntegratorKind::Direct(DirectIntegrator {
+            strategy: DirectStrategy::Mis,
+            samples: 1,
+        }),
+    ] {
+        let film = run(&sky_sphere(), integrator, 64, 5);
+        assert_mean(
+            &format!("sky furnace {integrator:?}"),
+            &film,
+            DVec3::splat(0.8),
+        );
+    }
+    // Cosine sampling is exact here: f cos / p = a for every sample.
+    let film = run(
+        &sky_sphere(),
+        IntegratorKind::Direct(DirectIntegrator {
+            strategy: DirectStrategy::Cosine,
+            samples: 1,
+        }),
+        16,
+        6,
+    );
+    assert!(film.image_mean_std_error().max_element() < 1e-6);
+}
+
+/// A diffuse floor under a large square light close above it: every strategy matters here,
+/// and every point of the floor sees the light over a good part of its hemisphere (so that
+/// hemisphere sampling finds it often enough for per-pixel variance estimates to be reliable).
+fn big_light() -> SceneDesc {
+    let quad = |y: f32, s: f32, flip: bool| {
+        let p = vec![
+            Vec3::new(-s, y, -s),
+            Vec3::new(s, y, -s),
+            Vec3::new(s, y, s),
+            Vec3::new(-s, y, s),
+        ];
+        let i = if flip {
+            vec![0, 1, 2, 0, 2, 3]
+        } else {
+            vec![0, 2, 1, 0, 3, 2]
+        };
+        (p, i)
+    };
+    let (fp, fi) = quad(0.0, 1.0, false); // faces +y
+    let (lp, li) = quad(0.5, 0.6, true); // faces -y
+    SceneDesc {
+        meshes: vec![
+            MeshDesc {
+                name: "floor".into(),
+                positions: fp,
+                indices: fi,
+                material: 0,
+                emission: None,
+            },
+            MeshDesc {
+                name: "light".into(),
+                positions: lp,
+                indices: li,
+                material: 0,
+                emission: Some(Emission {
+                    radiance: Vec3::new(4.0, 3.0, 2.0),
+                    two_sided: false,
+                }),
+            },
+        ],
+        point_lights: vec![PointLightDesc {
+            position: Vec3::new(1.2, 0.8, 0.3),
+            intensity: Vec3::splat(0.3),
+        }],
+        materials: vec![diffuse(Vec3::new(0.7, 0.5, 0.3), false)],
+        camera: CameraDesc {
+            origin: Vec3::new(0.0, 2.5, 2.5),
+            target: Vec3::ZERO,
+            fov_degrees: 50.0,
+            ..Default::default()
+        },
+        resolution: [24, 24],
+        ..Default::default()
+    }
+}
+
+#[test]
+fn direct_strategies_agree_and_match_the_path_tracer() {
+    // The point light is found only by light sampling; the area light by all. Compare the
+    // strategies that see both (light, MIS, path -m 1) pixel by pixel, and hemisphere/cosine on
+    // a scene without the point light.
+    let desc = big_light();
+    let reference = run(&desc, path(1), 256, 10);
+    for (i, strategy) in [DirectStrategy::Light, DirectStrategy::Mis]
+        .into_iter()
+        .enumerate()
+    {
+        let film = run(
+            &desc,
+            IntegratorKind::Direct(DirectIntegrator {
+                strategy,
+                samples: 1,
+            }),
+            256,
+            11 + i as u64,
+        );
+        assert_same_image(strategy.name(), &film, &reference);
+    }
+    let mut no_point = big_light();
+    no_point.point_lights.clear();
+    let reference = run(
+        &no_point,
+        IntegratorKind::Direct(DirectIntegrator {
+            strategy: DirectStrategy::Mis,
+            samples: 1,
+        }),
+        256,
+        20,
+    );
+    for (i, strategy) in DirectStrategy::ALL.into_iter().enumerate() {
+        let film = run(
+            &no_point,
+            IntegratorKind::Direct(DirectIntegrator {
+                strategy,
+                samples: 4,
+            }),
+            256,
+            21 + i as u64,
+        );
+        assert_same_image(strategy.name(), &film, &reference);
+    }
+}
+
+/// Per-pixel two-sample z-tests: at most 0.1% of pixel channels beyond 4σ (rounded up to 1),
+/// and image means within 3 combined standard errors.
+fn assert_same_image(name: &str, a: &Film, b: &Film) {
+    let mut outliers = 0;
+    for (p, q) in a.pixels().iter().zip(b.pixels()) {
+        let (va, vb) = (p.variance_of_mean(), q.variance_of_mean());
+        for c in 0..3 {
+            let z = z_test_two_sample(p.mean()[c], va[c].sqrt(), q.mean()[c], vb[c].sqrt());
+            outliers += (!z.within(MAX_Z)) as usize;
+        }
+    }
+    let allowed = (a.pixels().len() * 3) / 1000 + 1;
+    assert!(
+        outliers <= allowed,
+        "{name}: {outliers} pixel channels beyond {MAX_Z} sigma"
+    );
+    let (ma, mb) = (a.image_mean(), b.image_mean());
+    let (sa, sb) = (a.image_mean_std_error(), b.image_mean_std_error());
+    for c in 0..3 {
+        let z = z_test_two_sample(ma[c], sa[c], mb[c], sb[c]);
+        assert!(
+            z.within(3.0),
+            "{name}: image mean channel {c}: {} vs {} (z {})",
+            ma[c],
+            mb[c],
+            z.z
+        );
+    }
+}
+
+#[test]
+fn bounces_add_up_to_the_full_image() {
+    // The images of bounces 0..=3 alone sum to the -m 3 image.
+    let mut desc = big_light();
+    desc.resolution = [16, 16];
+    let full = run(&desc, path(3), 128, 30);
+    let parts: Vec<Film> = (0..=3)
+        .map(|k| {
+            let i = IntegratorKind::Path(PathIntegrator {
+                max_depth: 3,
+                only_bounce: Some(k),
+                ..Default::default()
+            });
+            run(&desc, i, 128, 31 + k as u64)
+        })
+        .collect();
+    let mut outliers = 0;
+    for (idx, f) in full.pixels().iter().enumerate() {
+        let sum: DVec3 = parts.iter().map(|p| p.pixels()[idx].mean()).sum();
+        let var: DVec3 = parts
+            .iter()
+            .map(|p| p.pixels()[idx].variance_of_mean())
+            .sum::<DVec3>()
+            + f.variance_of_mean();
+        for c in 0..3 {
+            let d = (sum[c] - f.mean()[c]).abs();
+            outliers += (d > MAX_Z * var[c].sqrt() + 1e-6 * f.mean()[c].abs()) as usize;
+        }
+    }
+    assert!(
+        outliers <= 1,
+        "{outliers} pixel channels differ beyond 4 sigma"
+    );
+    // Bounce 0 alone is the emission seen directly, i.e. the -m 0 image: with the same seed the
+    // camera rays are the same, so the two agree exactly.
+    assert_eq!(
+        parts[0].mean_image(),
+        run(&desc, path(0), 128, 31).mean_image()
+    );
+}
+
+#[test]
+fn same_seed_same_image_for_any_thread_count() {
+    let desc = big_light();
+    let scene = Scene::build(&desc).unwrap();
+    let settings = RenderSettings::new(8, 42, SamplerKind::Independent);
+    let render_with = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            render(
+                &scene,
+                &path(u32::MAX),
+                &settings,
+                &|_| {},
+                &Default::default(),
+            )
+            .0
+        })
+    };
+    let one = render_with(1);
+    assert_eq!(one, render_with(2));
+    assert_eq!(one, render_with(3));
+    let other = render(
+        &scene,
+        &path(u32::MAX),
+        &RenderSettings::new(8, 43, SamplerKind::Independent),
+        &|_| {},
+        &Default::default(),
+    )
+    .0;
+    assert_ne!(one, other);
+}
+
+/// An integrator that returns NaN or infinity for some samples.
+struct Broken;
+
+impl Integrator for Broken {
+    fn li(&self, _: &Scene, ray: Ray, _: &mut AnySampler, _: &mut PathStats) -> Rgb {
+        if ray.d.x > 0.05 {
+            Rgb::new(f32::NAN, 0.0, 0.0)
+        } else if ray.d.x < -0.05 {
+            Rgb::splat(f32::INFINITY)
+        } else {
+            Rgb::ONE
+        }
+    }
+}
+
+#[test]
+fn nonfinite_samples_never_reach_the_film() {
+    let scene = Scene::build(&big_light()).unwrap();
+    let settings = RenderSettings::new(4, 1, SamplerKind::Independent);
+    let (film, stats) = render(&scene, &Broken, &settings, &|_| {}, &Default::default());
+    assert!(stats.nonfinite_samples > 0);
+    assert_eq!(stats.samples + stats.nonfinite_samples, 24 * 24 * 4);
+    assert!(film
+        .pixels()
+        .iter()
+        .all(|p| p.mean().is_finite() && p.variance().is_finite()));
+    assert!(film
+        .pixels()
+        .iter()
+        .any(|p| p.count() == 4 && p.mean() == DVec3::ONE));
+}
+
+#[test]
+fn cancelled_render_keeps_what_was_done() {
+    let scene = Scene::build(&big_light()).unwrap();
+    let cancel = std::sync::atomic::AtomicBool::new(true);
+    let (film, stats) = render(
+        &scene,
+        &path(1),
+        &RenderSettings::new(4, 1, SamplerKind::Independent),
+        &|_| {},
+        &cancel,
+    );
+    assert!(stats.cancelled);
+    assert_eq!(stats.samples, 0);
+    assert!(film.pixels().iter().all(|p| p.count() == 0));
+}
+
+#[test]
+fn bad_scenes_are_errors() {
+    let mut desc = big_light();
+    desc.meshes[0].material = 7;
+    assert!(Scene::build(&desc)
+        .unwrap_err()
+        .to_string()
+        .contains("material index 7"));
+    let mut desc = big_light();
+    desc.meshes[0].indices.push(99);
+    assert!(Scene::build(&desc).is_err());
+    let mut desc = big_light();
+    desc.meshes[0].indices = vec![0, 1, 99];
+    assert!(Scene::build(&desc)
+        .unwrap_err()
+        .to_string()
+        .contains("out of range"));
+    let mut desc = big_light();
+    desc.resolution = [0, 10];
+    assert!(Scene::build(&desc).is_err());
+}
