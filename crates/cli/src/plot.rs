@@ -299,12 +299,7 @@ fn draw_samples<DB: DrawingBackend>(
                 .map_err(err)?
                 .label("pdf")
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RED.stroke_width(2)));
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            legend(&mut chart, SeriesLabelPosition::UpperRight)?;
 
             let mut chart = ChartBuilder::on(&panels[1])
                 .caption("CDF: U = P(X ≤ x), inverted to sample", ("sans-serif", 18))
@@ -351,13 +346,7 @@ fn draw_samples<DB: DrawingBackend>(
                     )))
                     .map_err(err)?;
             }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::LowerRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         }
         SamplePlot::Discrete { freq, pmf } => {
             let k = freq.len();
@@ -396,12 +385,7 @@ fn draw_samples<DB: DrawingBackend>(
                 .map_err(err)?
                 .label("pmf")
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RED.stroke_width(3)));
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }
         SamplePlot::TwoD {
             points,
@@ -449,6 +433,20 @@ fn draw_samples<DB: DrawingBackend>(
         }
     }
     Ok(())
+}
+
+/// Draws the legend of `chart`'s labelled series at `position`.
+fn legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
 }
 
 fn heat_map<DB: DrawingBackend>(
@@ -625,12 +623,7 @@ fn draw_convergence<DB: DrawingBackend>(
             .label("exact")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
 
     let errs = || all().map(|p| p.rmse).filter(|&e| e > 0.0 && e.is_finite());
     let emin = errs().fold(f64::INFINITY, f64::min);
@@ -691,12 +684,6 @@ fn draw_convergence<DB: DrawingBackend>(
             .label("N^-1/2")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
     Ok(())
 }

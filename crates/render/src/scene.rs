@@ -3,7 +3,7 @@
 use crate::accel::{Bvh, BvhParams};
 use crate::bsdf::Material;
 use crate::camera::Camera;
-use crate::desc::{MaterialDesc, Rgb, SceneDesc};
+use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc};
 use crate::geometry::{Aabb, Ray};
 use crate::light::{bounding_radius, AreaShape, Light, LightSampler};
 use crate::shape::{Sphere, Triangle};
@@ -150,17 +150,11 @@ impl Scene {
                 }
                 triangles.push(t);
                 tri_material.push(material);
-                match mesh.emission {
-                    Some(e) if e.radiance.max_element() > 0.0 => {
-                        tri_light.push(lights.len() as u32);
-                        lights.push(Light::Area {
-                            shape: AreaShape::Triangle(t),
-                            radiance: e.radiance,
-                            two_sided: e.two_sided,
-                        });
-                    }
-                    _ => tri_light.push(NO_LIGHT),
-                }
+                tri_light.push(add_area_light(
+                    &mut lights,
+                    AreaShape::Triangle(t),
+                    mesh.emission,
+                ));
             }
         }
         let mut spheres = Vec::new();
@@ -180,17 +174,11 @@ impl Scene {
             };
             spheres.push(sphere);
             sphere_material.push(material);
-            match s.emission {
-                Some(e) if e.radiance.max_element() > 0.0 => {
-                    sphere_light.push(lights.len() as u32);
-                    lights.push(Light::Area {
-                        shape: AreaShape::Sphere(sphere),
-                        radiance: e.radiance,
-                        two_sided: e.two_sided,
-                    });
-                }
-                _ => sphere_light.push(NO_LIGHT),
-            }
+            sphere_light.push(add_area_light(
+                &mut lights,
+                AreaShape::Sphere(sphere),
+                s.emission,
+            ));
         }
         for pl in &desc.point_lights {
             lights.push(Light::Point {
@@ -363,7 +351,22 @@ impl Scene {
     }
 }
 
-/// A material list with one diffuse entry, for tests and simple scenes.
+/// Adds an area light for `shape` if it emits; returns its index, or [`NO_LIGHT`].
+fn add_area_light(lights: &mut Vec<Light>, shape: AreaShape, emission: Option<Emission>) -> u32 {
+    match emission {
+        Some(e) if e.radiance.max_element() > 0.0 => {
+            lights.push(Light::Area {
+                shape,
+                radiance: e.radiance,
+                two_sided: e.two_sided,
+            });
+            (lights.len() - 1) as u32
+        }
+        _ => NO_LIGHT,
+    }
+}
+
+/// A diffuse material description, for tests and simple scenes.
 pub fn diffuse(reflectance: Rgb, two_sided: bool) -> MaterialDesc {
     MaterialDesc::Diffuse {
         reflectance,

@@ -103,31 +103,16 @@ impl Integrator for DirectIntegrator {
         let mut sum = Rgb::ZERO;
         for _ in 0..n {
             match self.strategy {
-                DirectStrategy::Hemisphere => {
-                    let w = sample_uniform_hemisphere(sampler.next_2d());
-                    sum += Self::gather(
-                        scene,
-                        &si,
-                        &bsdf,
-                        wo,
-                        frame.to_world(w),
-                        uniform_hemisphere_pdf(),
-                        stats,
-                    )
-                    .0;
-                }
-                DirectStrategy::Cosine => {
-                    let w = sample_cosine_hemisphere(sampler.next_2d());
-                    sum += Self::gather(
-                        scene,
-                        &si,
-                        &bsdf,
-                        wo,
-                        frame.to_world(w),
-                        cosine_hemisphere_pdf(w.z),
-                        stats,
-                    )
-                    .0;
+                DirectStrategy::Hemisphere | DirectStrategy::Cosine => {
+                    let u = sampler.next_2d();
+                    let (w, pdf) = if self.strategy == DirectStrategy::Hemisphere {
+                        (sample_uniform_hemisphere(u), uniform_hemisphere_pdf())
+                    } else {
+                        let w = sample_cosine_hemisphere(u);
+                        (w, cosine_hemisphere_pdf(w.z))
+                    };
+                    let wi = frame.to_world(w);
+                    sum += Self::gather(scene, &si, &bsdf, wo, wi, pdf, stats).0;
                 }
                 DirectStrategy::Light => {
                     let u_select = sampler.next_1d();
