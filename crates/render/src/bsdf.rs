@@ -38,19 +38,35 @@ pub struct Material {
 }
 
 impl From<&MaterialDesc> for Material {
+    /// The material for a description. Materials whose BSDF is not implemented yet (mirror,
+    /// glass, conductor) are approximated by a two-sided diffuse surface of a similar overall
+    /// colour; loaders warn when they produce one.
     fn from(d: &MaterialDesc) -> Self {
+        let diffuse = |reflectance: Rgb, two_sided| Material {
+            bxdf: Bxdf::Diffuse {
+                reflectance: reflectance.clamp(Vec3::ZERO, Vec3::ONE),
+            },
+            two_sided,
+        };
         match *d {
             MaterialDesc::Diffuse {
                 reflectance,
                 two_sided,
-            } => Material {
-                bxdf: Bxdf::Diffuse {
-                    reflectance: reflectance.clamp(Vec3::ZERO, Vec3::ONE),
-                },
-                two_sided,
-            },
+            } => diffuse(reflectance, two_sided),
+            MaterialDesc::Mirror { reflectance } => diffuse(reflectance * 0.8, true),
+            MaterialDesc::Glass { transmittance, .. } => diffuse(transmittance * 0.8, true),
+            MaterialDesc::Conductor { eta, k, .. } => {
+                // Normal-incidence Fresnel reflectance of the conductor.
+                let f0 = ((eta - 1.0) * (eta - 1.0) + k * k) / ((eta + 1.0) * (eta + 1.0) + k * k);
+                diffuse(f0, true)
+            }
         }
     }
+}
+
+/// Whether the renderer draws this material as described (false: a diffuse stand-in).
+pub fn is_supported(d: &MaterialDesc) -> bool {
+    matches!(d, MaterialDesc::Diffuse { .. })
 }
 
 /// A material at a surface point: the BxDF and the shading frame.

@@ -32,11 +32,16 @@ impl Camera {
         }
         let up = right.cross(forward);
         let (w, h) = (resolution[0].max(1) as f32, resolution[1].max(1) as f32);
-        let tan = (desc.fov_degrees.to_radians() * 0.5).tan();
-        let along = match desc.fov_axis {
-            FovAxis::X => w,
-            FovAxis::Y => h,
-            FovAxis::Smaller => w.min(h),
+        let (tan, along) = match desc.focal_pixels {
+            Some(d) if d > 0.0 && d.is_finite() => (0.5, d),
+            _ => (
+                (desc.fov_degrees.to_radians() * 0.5).tan(),
+                match desc.fov_axis {
+                    FovAxis::X => w,
+                    FovAxis::Y => h,
+                    FovAxis::Smaller => w.min(h),
+                },
+            ),
         };
         Camera {
             origin: desc.origin,

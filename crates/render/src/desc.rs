@@ -1,6 +1,6 @@
 //! The plain scene description that loaders produce and [`crate::scene::Scene::build`] consumes.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// Linear RGB.
 pub type Rgb = Vec3;
@@ -16,12 +16,51 @@ pub struct SceneDesc {
     pub materials: Vec<MaterialDesc>,
     /// Point lights.
     pub point_lights: Vec<PointLightDesc>,
+    /// Spot lights.
+    pub spot_lights: Vec<SpotLightDesc>,
+    /// Directional (distant) lights.
+    pub directional_lights: Vec<DirectionalLightDesc>,
     /// Uniform environment radiance seen by rays that leave the scene (none: black).
     pub environment: Option<Rgb>,
     /// The camera.
     pub camera: CameraDesc,
     /// Image size in pixels `[width, height]`.
     pub resolution: [u32; 2],
+    /// What the loader noticed and worked around (unsupported features, missing textures).
+    pub warnings: Vec<String>,
+}
+
+/// Which rays see a shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Visibility {
+    /// Camera rays (the first segment of a path).
+    pub camera: bool,
+    /// Every other ray: bounces, shadow rays, light sampling.
+    pub indirect: bool,
+}
+
+impl Default for Visibility {
+    fn default() -> Self {
+        Visibility::ALL
+    }
+}
+
+impl Visibility {
+    /// Seen by every ray.
+    pub const ALL: Visibility = Visibility {
+        camera: true,
+        indirect: true,
+    };
+    /// Seen only by camera rays (an emitter shown to the camera but lit by something else).
+    pub const CAMERA_ONLY: Visibility = Visibility {
+        camera: true,
+        indirect: false,
+    };
+    /// Hidden from camera rays.
+    pub const INDIRECT_ONLY: Visibility = Visibility {
+        camera: false,
+        indirect: true,
+    };
 }
 
 /// A triangle mesh in world space.
@@ -37,6 +76,12 @@ pub struct MeshDesc {
     pub material: usize,
     /// Emitted radiance, if the mesh is an area light.
     pub emission: Option<Emission>,
+    /// Per-vertex shading normals (empty: flat shading).
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates (empty: none).
+    pub uvs: Vec<Vec2>,
+    /// Which rays see the mesh.
+    pub visibility: Visibility,
 }
 
 /// A sphere in world space.
@@ -71,15 +116,85 @@ pub enum MaterialDesc {
         /// Whether the back side reflects too (otherwise it is black, as Mitsuba's `diffuse`).
         two_sided: bool,
     },
+    /// Perfect specular reflection.
+    Mirror {
+        /// Reflectance per channel.
+        reflectance: Rgb,
+    },
+    /// A smooth or rough dielectric.
+    Glass {
+        /// Reflectance scale.
+        reflectance: Rgb,
+        /// Transmittance scale.
+        transmittance: Rgb,
+        /// Roughness (0: smooth).
+        roughness: f32,
+        /// Index of refraction inside.
+        ior: f32,
+    },
+    /// A rough conductor (microfacet model).
+    Conductor {
+        /// Roughness α of the normal distribution.
+        alpha: f32,
+        /// Real part of the complex index of refraction, per channel.
+        eta: Rgb,
+        /// Imaginary part (absorption), per channel.
+        k: Rgb,
+    },
 }
 
-/// A point light.
+impl MaterialDesc {
+    /// The kind of material, for summaries.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            MaterialDesc::Diffuse { .. } => "diffuse",
+            MaterialDesc::Mirror { .. } => "mirror",
+            MaterialDesc::Glass { .. } => "glass",
+            MaterialDesc::Conductor { .. } => "conductor",
+        }
+    }
+}
+
+/// A point light: radiance arriving from it at distance d is
+/// intensity / (c + l d + q d²) with `attenuation = [c, l, q]` (`[0, 0, 1]`: inverse square).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointLightDesc {
     /// Position.
     pub position: Vec3,
     /// Radiant intensity (W/sr per channel).
     pub intensity: Rgb,
+    /// Constant, linear and quadratic attenuation coefficients.
+    pub attenuation: [f32; 3],
+}
+
+/// The attenuation of a physical point light: inverse square.
+pub const INVERSE_SQUARE: [f32; 3] = [0.0, 0.0, 1.0];
+
+/// A spot light: a point light whose intensity is scaled by cos^exponent θ inside a cone of
+/// half-angle `cutoff_degrees` around `direction` and is zero outside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotLightDesc {
+    /// Position.
+    pub position: Vec3,
+    /// Axis of the cone (unit).
+    pub direction: Vec3,
+    /// Intensity on the axis.
+    pub intensity: Rgb,
+    /// Half-angle of the cone in degrees.
+    pub cutoff_degrees: f32,
+    /// Falloff exponent of cos θ.
+    pub exponent: f32,
+    /// Constant, linear and quadratic attenuation coefficients.
+    pub attenuation: [f32; 3],
+}
+
+/// A distant light: radiance arriving along a single direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLightDesc {
+    /// The direction the light travels (unit).
+    pub direction: Vec3,
+    /// Irradiance on a surface facing the light.
+    pub irradiance: Rgb,
 }
 
 /// Which image axis the field of view is measured along.
@@ -111,6 +226,10 @@ pub struct CameraDesc {
     pub lens_radius: f32,
     /// Distance to the plane in focus.
     pub focal_distance: f32,
+    /// When set, the distance to the image plane in pixels: the field of view then follows
+    /// from the resolution (a larger image shows more, at the same scale), as the CS184
+    /// renderer does; `fov_degrees` is ignored.
+    pub focal_pixels: Option<f32>,
 }
 
 impl Default for CameraDesc {
@@ -123,6 +242,7 @@ impl Default for CameraDesc {
             fov_axis: FovAxis::Smaller,
             lens_radius: 0.0,
             focal_distance: 1.0,
+            focal_pixels: None,
         }
     }
 }

@@ -30,12 +30,38 @@ pub enum Light {
         /// Whether the back side emits too.
         two_sided: bool,
     },
-    /// Radiant intensity from a point (a delta light).
+    /// Radiant intensity from a point (a delta light), divided by c + l d + q d².
     Point {
         /// Position.
         position: Vec3,
         /// Intensity.
         intensity: Rgb,
+        /// Constant, linear and quadratic attenuation.
+        attenuation: [f32; 3],
+    },
+    /// A point light limited to a cone, with a cos^exponent falloff.
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Cone axis (unit).
+        direction: Vec3,
+        /// Intensity on the axis.
+        intensity: Rgb,
+        /// Cosine of the cone's half-angle.
+        cos_cutoff: f32,
+        /// Exponent of the falloff.
+        exponent: f32,
+        /// Constant, linear and quadratic attenuation.
+        attenuation: [f32; 3],
+    },
+    /// Light arriving along one direction from infinitely far (a delta light).
+    Directional {
+        /// Direction of travel (unit).
+        direction: Vec3,
+        /// Irradiance on a surface facing the light.
+        irradiance: Rgb,
+        /// Radius of a sphere bounding the scene (for the power estimate).
+        scene_radius: f32,
     },
     /// Uniform radiance from every direction at infinity.
     Environment {
@@ -63,6 +89,18 @@ pub struct LightLiSample {
     pub is_delta: bool,
 }
 
+/// 1 / (c + l d + q d²), or 0 where that is not positive.
+#[inline]
+fn attenuate(attenuation: [f32; 3], dist2: f32) -> f32 {
+    let [c, l, q] = attenuation;
+    let denom = c + l * dist2.sqrt() + q * dist2;
+    if denom > 0.0 {
+        1.0 / denom
+    } else {
+        0.0
+    }
+}
+
 /// Relative luminance of linear sRGB / Rec. 709 primaries.
 #[inline]
 pub fn luminance(c: Rgb) -> f32 {
@@ -70,6 +108,11 @@ pub fn luminance(c: Rgb) -> f32 {
 }
 
 impl Light {
+    /// Whether the light is at infinity (shadow rays towards it have no end).
+    pub fn is_infinite(&self) -> bool {
+        matches!(self, Light::Environment { .. } | Light::Directional { .. })
+    }
+
     /// Radiance leaving an area light at a point with normal `n` in direction `w` (away from
     /// the light).
     #[inline]
@@ -88,7 +131,7 @@ impl Light {
                 }
             }
             Light::Environment { radiance, .. } => radiance,
-            Light::Point { .. } => Rgb::ZERO,
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => Rgb::ZERO,
         }
     }
 
@@ -123,11 +166,12 @@ impl Light {
             Light::Point {
                 position,
                 intensity,
+                attenuation,
             } => {
                 let to_light = position - p;
                 let dist2 = to_light.length_squared();
                 (dist2 > 0.0).then(|| LightLiSample {
-                    li: intensity / dist2,
+                    li: intensity * attenuate(attenuation, dist2),
                     wi: to_light / dist2.sqrt(),
                     pdf: 1.0,
                     p_light: position,
@@ -135,6 +179,45 @@ impl Light {
                     is_delta: true,
                 })
             }
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_cutoff,
+                exponent,
+                attenuation,
+            } => {
+                let to_light = position - p;
+                let dist2 = to_light.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let wi = to_light / dist2.sqrt();
+                let cos = direction.dot(-wi);
+                if cos < cos_cutoff {
+                    return None;
+                }
+                Some(LightLiSample {
+                    li: intensity * (cos.max(0.0).powf(exponent) * attenuate(attenuation, dist2)),
+                    wi,
+                    pdf: 1.0,
+                    p_light: position,
+                    n_light: None,
+                    is_delta: true,
+                })
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+                scene_radius,
+            } => Some(LightLiSample {
+                li: irradiance,
+                wi: -direction,
+                pdf: 1.0,
+                p_light: p - direction * (4.0 * scene_radius.max(1.0)),
+                n_light: None,
+                is_delta: true,
+            }),
             Light::Environment {
                 radiance,
                 scene_radius,
@@ -170,7 +253,7 @@ impl Light {
                 }
             }
             Light::Environment { .. } => uniform_sphere_pdf(),
-            Light::Point { .. } => 0.0,
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
         }
     }
 
@@ -190,6 +273,16 @@ impl Light {
                 PI * area * sides * luminance(radiance)
             }
             Light::Point { intensity, .. } => 4.0 * PI * luminance(intensity),
+            Light::Spot {
+                intensity,
+                cos_cutoff,
+                ..
+            } => 2.0 * PI * (1.0 - cos_cutoff) * luminance(intensity),
+            Light::Directional {
+                irradiance,
+                scene_radius,
+                ..
+            } => PI * scene_radius * scene_radius * luminance(irradiance),
             Light::Environment {
                 radiance,
                 scene_radius,
@@ -198,21 +291,22 @@ impl Light {
     }
 }
 
-/// Chooses lights in proportion to their power (alias method); lights of zero power get a tiny
-/// share so that every light stays reachable.
+/// Chooses lights in proportion to their power (alias method). Lights that may be sampled but
+/// have zero power get a tiny share so that every one stays reachable; lights that must not be
+/// sampled (seen by camera rays only) get none.
 #[derive(Clone, Debug)]
 pub struct LightSampler {
     table: Option<AliasTable>,
 }
 
 impl LightSampler {
-    /// The sampler for `lights`.
-    pub fn new(lights: &[Light]) -> Self {
-        let total: f64 = lights.iter().map(|l| l.phi().max(0.0) as f64).sum();
+    /// The sampler for `lights`, of which those with `sampleable[i] == false` are never chosen.
+    pub fn new(lights: &[Light], sampleable: &[bool]) -> Self {
+        let phi = |i: usize| (lights[i].phi() as f64).max(0.0);
+        let total: f64 = (0..lights.len()).filter(|&i| sampleable[i]).map(phi).sum();
         let floor = if total > 0.0 { total * 1e-6 } else { 1.0 };
-        let weights: Vec<f64> = lights
-            .iter()
-            .map(|l| (l.phi() as f64).max(0.0).max(floor))
+        let weights: Vec<f64> = (0..lights.len())
+            .map(|i| if sampleable[i] { phi(i).max(floor) } else { 0.0 })
             .collect();
         LightSampler {
             table: AliasTable::new(&weights).ok(),

@@ -3,7 +3,7 @@
 use crate::accel::{Bvh, BvhParams};
 use crate::bsdf::Material;
 use crate::camera::Camera;
-use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc};
+use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc, Visibility};
 use crate::geometry::{Aabb, Ray};
 use crate::light::{bounding_radius, AreaShape, Light, LightSampler};
 use crate::shape::{Sphere, Triangle};
@@ -90,6 +90,10 @@ pub struct Scene {
     sphere_material: Vec<u32>,
     sphere_light: Vec<u32>,
     prims: Vec<Prim>,
+    /// Per primitive (BVH index): whether camera rays and other rays see it.
+    prim_visibility: Vec<Visibility>,
+    /// Whether every primitive is seen by every ray (the common case, checked once).
+    all_visible: bool,
     bvh: Bvh,
     materials: Vec<Material>,
     lights: Vec<Light>,
@@ -121,7 +125,9 @@ impl Scene {
         let mut triangles = Vec::new();
         let mut tri_material = Vec::new();
         let mut tri_light = Vec::new();
+        let mut tri_visibility = Vec::new();
         let mut lights = Vec::new();
+        let mut sampleable = Vec::new();
         for mesh in &desc.meshes {
             let material = check_material(&mesh.name, mesh.material)?;
             if mesh.indices.len() % 3 != 0 {
@@ -150,10 +156,13 @@ impl Scene {
                 }
                 triangles.push(t);
                 tri_material.push(material);
+                tri_visibility.push(mesh.visibility);
                 tri_light.push(add_area_light(
                     &mut lights,
+                    &mut sampleable,
                     AreaShape::Triangle(t),
                     mesh.emission,
+                    mesh.visibility,
                 ));
             }
         }
@@ -176,15 +185,30 @@ impl Scene {
             sphere_material.push(material);
             sphere_light.push(add_area_light(
                 &mut lights,
+                &mut sampleable,
                 AreaShape::Sphere(sphere),
                 s.emission,
+                Visibility::ALL,
             ));
         }
         for pl in &desc.point_lights {
             lights.push(Light::Point {
                 position: pl.position,
                 intensity: pl.intensity,
+                attenuation: pl.attenuation,
             });
+            sampleable.push(true);
+        }
+        for sl in &desc.spot_lights {
+            lights.push(Light::Spot {
+                position: sl.position,
+                direction: sl.direction.normalize_or(Vec3::NEG_Y),
+                intensity: sl.intensity,
+                cos_cutoff: sl.cutoff_degrees.to_radians().cos(),
+                exponent: sl.exponent.max(0.0),
+                attenuation: sl.attenuation,
+            });
+            sampleable.push(true);
         }
         let prims: Vec<Prim> = (0..triangles.len() as u32)
             .map(Prim::Triangle)
@@ -200,17 +224,35 @@ impl Scene {
         let start = Instant::now();
         let bvh = Bvh::build(&bounds, BvhParams::default());
         let bvh_seconds = start.elapsed().as_secs_f64();
+        let scene_radius = bounding_radius(&bvh.bounds());
+        for dl in &desc.directional_lights {
+            lights.push(Light::Directional {
+                direction: dl.direction.normalize_or(Vec3::NEG_Y),
+                irradiance: dl.irradiance,
+                scene_radius,
+            });
+            sampleable.push(true);
+        }
         let environment = desc
             .environment
             .filter(|e| e.max_element() > 0.0)
             .map(|radiance| {
                 lights.push(Light::Environment {
                     radiance,
-                    scene_radius: bounding_radius(&bvh.bounds()),
+                    scene_radius,
                 });
+                sampleable.push(true);
                 (lights.len() - 1) as u32
             });
-        let light_sampler = LightSampler::new(&lights);
+        let light_sampler = LightSampler::new(&lights, &sampleable);
+        let prim_visibility: Vec<Visibility> = prims
+            .iter()
+            .map(|p| match *p {
+                Prim::Triangle(i) => tri_visibility[i as usize],
+                Prim::Sphere(_) => Visibility::ALL,
+            })
+            .collect();
+        let all_visible = prim_visibility.iter().all(|v| *v == Visibility::ALL);
         let stats = BuildStats {
             bvh_seconds,
             bvh_nodes: bvh.node_count(),
@@ -226,6 +268,8 @@ impl Scene {
             sphere_material,
             sphere_light,
             prims,
+            prim_visibility,
+            all_visible,
             bvh,
             materials,
             lights,
@@ -279,11 +323,36 @@ impl Scene {
             .map_or(Rgb::ZERO, |i| self.lights[i as usize].le(Vec3::ZERO, w))
     }
 
-    /// The nearest surface along `ray`, and the number of BVH nodes visited.
+    /// Whether primitive `i` is seen by a camera ray (`camera`) or another ray.
+    #[inline]
+    fn visible(&self, i: u32, camera: bool) -> bool {
+        self.all_visible || {
+            let v = self.prim_visibility[i as usize];
+            if camera {
+                v.camera
+            } else {
+                v.indirect
+            }
+        }
+    }
+
+    /// The nearest surface along a camera ray, and the number of BVH nodes visited.
+    pub fn intersect_camera(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u32) {
+        self.intersect_as(ray, true)
+    }
+
+    /// The nearest surface along any other ray, and the number of BVH nodes visited.
     pub fn intersect(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u32) {
+        self.intersect_as(ray, false)
+    }
+
+    fn intersect_as(&self, ray: &Ray, camera: bool) -> (Option<SurfaceInteraction>, u32) {
         let mut r = *ray;
         let mut best: Option<(Prim, f32, f32)> = None; // (prim, b1, b2)
         let (_, visited) = self.bvh.intersect(&mut r, |i, r| {
+            if !self.visible(i, camera) {
+                return false;
+            }
             let prim = self.prims[i as usize];
             match prim {
                 Prim::Triangle(t) => match self.triangles[t as usize].intersect(r) {
@@ -342,17 +411,27 @@ impl Scene {
         (hit, visited)
     }
 
-    /// Whether anything blocks `ray` within its extent.
+    /// Whether anything seen by non-camera rays blocks `ray` within its extent.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.bvh.occluded(ray, |i, r| match self.prims[i as usize] {
-            Prim::Triangle(t) => self.triangles[t as usize].intersect(r).is_some(),
-            Prim::Sphere(s) => self.spheres[s as usize].intersect(r).is_some(),
+        self.bvh.occluded(ray, |i, r| {
+            self.visible(i, false)
+                && match self.prims[i as usize] {
+                    Prim::Triangle(t) => self.triangles[t as usize].intersect(r).is_some(),
+                    Prim::Sphere(s) => self.spheres[s as usize].intersect(r).is_some(),
+                }
         })
     }
 }
 
-/// Adds an area light for `shape` if it emits; returns its index, or [`NO_LIGHT`].
-fn add_area_light(lights: &mut Vec<Light>, shape: AreaShape, emission: Option<Emission>) -> u32 {
+/// Adds an area light for `shape` if it emits; returns its index, or [`NO_LIGHT`]. Shapes that
+/// only camera rays see show their emission but are never sampled as lights.
+fn add_area_light(
+    lights: &mut Vec<Light>,
+    sampleable: &mut Vec<bool>,
+    shape: AreaShape,
+    emission: Option<Emission>,
+    visibility: Visibility,
+) -> u32 {
     match emission {
         Some(e) if e.radiance.max_element() > 0.0 => {
             lights.push(Light::Area {
@@ -360,6 +439,7 @@ fn add_area_light(lights: &mut Vec<Light>, shape: AreaShape, emission: Option<Em
                 radiance: e.radiance,
                 two_sided: e.two_sided,
             });
+            sampleable.push(visibility.indirect);
             (lights.len() - 1) as u32
         }
         _ => NO_LIGHT,

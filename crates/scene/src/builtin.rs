@@ -75,6 +75,7 @@ pub fn cornell_box() -> Result<SceneDesc, Error> {
                 indices: m.mesh.indices,
                 material,
                 emission,
+                ..Default::default()
             }
         })
         .collect();
@@ -89,6 +90,7 @@ pub fn cornell_box() -> Result<SceneDesc, Error> {
             fov_axis: FovAxis::Smaller,
             lens_radius: 0.0,
             focal_distance: 3.9,
+            focal_pixels: None,
         },
         resolution: [256, 256],
         ..Default::default()

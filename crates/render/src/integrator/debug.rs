@@ -20,7 +20,7 @@ pub enum DebugView {
 impl Integrator for DebugView {
     fn li(&self, scene: &Scene, ray: Ray, _sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
         let before = stats.nodes_visited;
-        let hit = trace(scene, &ray, stats);
+        let hit = trace(scene, &ray, true, stats);
         match self {
             DebugView::Normals => hit.map_or(Rgb::ZERO, |si| 0.5 * (si.ns + Rgb::ONE)),
             DebugView::Depth => hit.map_or(Rgb::ZERO, |si| {

@@ -79,7 +79,7 @@ impl DirectIntegrator {
             return (Rgb::ZERO, None);
         }
         let ray = spawn_ray(si.p, si.ng, wi);
-        let found = match trace(scene, &ray, stats) {
+        let found = match trace(scene, &ray, false, stats) {
             Some(hit) => emitted(scene, si.p, &ray, &hit),
             None => escaped(scene, &ray),
         };
@@ -92,7 +92,7 @@ impl DirectIntegrator {
 
 impl Integrator for DirectIntegrator {
     fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
-        let Some(si) = trace(scene, &ray, stats) else {
+        let Some(si) = trace(scene, &ray, true, stats) else {
             return escaped(scene, &ray).map_or(Rgb::ZERO, |(le, _)| le);
         };
         let wo = -ray.d;

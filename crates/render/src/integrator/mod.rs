@@ -18,7 +18,6 @@ pub use path::PathIntegrator;
 use crate::bsdf::Bsdf;
 use crate::desc::Rgb;
 use crate::geometry::{offset_ray_origin, spawn_ray_to, Ray};
-use crate::light::Light;
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::{Vec2, Vec3};
 use pathlab_mc::sampler::AnySampler;
@@ -68,10 +67,14 @@ impl Integrator for IntegratorKind {
     }
 }
 
-/// Closest hit, counting the ray.
+/// Closest hit of a camera ray (`camera`) or another ray, counting the ray.
 #[inline]
-pub(crate) fn trace(scene: &Scene, ray: &Ray, stats: &mut PathStats) -> Option<SurfaceInteraction> {
-    let (hit, visited) = scene.intersect(ray);
+pub(crate) fn trace(scene: &Scene, ray: &Ray, camera: bool, stats: &mut PathStats) -> Option<SurfaceInteraction> {
+    let (hit, visited) = if camera {
+        scene.intersect_camera(ray)
+    } else {
+        scene.intersect(ray)
+    };
     stats.rays += 1;
     stats.nodes_visited += visited as u64;
     hit
@@ -123,9 +126,10 @@ pub(crate) fn sample_light(
     if f.max_element() <= 0.0 {
         return Rgb::ZERO;
     }
-    let shadow = match light {
-        Light::Environment { .. } => Ray::new(offset_ray_origin(si.p, si.ng, ls.wi), ls.wi),
-        _ => spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light),
+    let shadow = if light.is_infinite() {
+        Ray::new(offset_ray_origin(si.p, si.ng, ls.wi), ls.wi)
+    } else {
+        spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light)
     };
     stats.rays += 1;
     if scene.occluded(&shadow) {

@@ -55,7 +55,7 @@ impl Integrator for PathIntegrator {
         let mut prev: Option<(glam::Vec3, f32)> = None;
         let mut depth = 0u32;
         loop {
-            let Some(si) = trace(scene, &ray, stats) else {
+            let Some(si) = trace(scene, &ray, depth == 0, stats) else {
                 if let Some((le, pdf_light)) = escaped(scene, &ray) {
                     let w = prev.map_or(1.0, |(_, pdf_bsdf)| {
                         power_heuristic(1, pdf_bsdf, n_light, pdf_light)
