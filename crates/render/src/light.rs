@@ -306,7 +306,13 @@ impl LightSampler {
         let total: f64 = (0..lights.len()).filter(|&i| sampleable[i]).map(phi).sum();
         let floor = if total > 0.0 { total * 1e-6 } else { 1.0 };
         let weights: Vec<f64> = (0..lights.len())
-            .map(|i| if sampleable[i] { phi(i).max(floor) } else { 0.0 })
+            .map(|i| {
+                if sampleable[i] {
+                    phi(i).max(floor)
+                } else {
+                    0.0
+                }
+            })
             .collect();
         LightSampler {
             table: AliasTable::new(&weights).ok(),

@@ -187,23 +187,23 @@ fn big_light() -> SceneDesc {
                 name: "floor".into(),
                 positions: fp,
                 indices: fi,
-                material: 0,
-                emission: None,
+                ..Default::default()
             },
             MeshDesc {
                 name: "light".into(),
                 positions: lp,
                 indices: li,
-                material: 0,
                 emission: Some(Emission {
                     radiance: Vec3::new(4.0, 3.0, 2.0),
                     two_sided: false,
                 }),
+                ..Default::default()
             },
         ],
         point_lights: vec![PointLightDesc {
             position: Vec3::new(1.2, 0.8, 0.3),
             intensity: Vec3::splat(0.3),
+            attenuation: INVERSE_SQUARE,
         }],
         materials: vec![diffuse(Vec3::new(0.7, 0.5, 0.3), false)],
         camera: CameraDesc {

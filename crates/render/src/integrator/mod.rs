@@ -69,7 +69,12 @@ impl Integrator for IntegratorKind {
 
 /// Closest hit of a camera ray (`camera`) or another ray, counting the ray.
 #[inline]
-pub(crate) fn trace(scene: &Scene, ray: &Ray, camera: bool, stats: &mut PathStats) -> Option<SurfaceInteraction> {
+pub(crate) fn trace(
+    scene: &Scene,
+    ray: &Ray,
+    camera: bool,
+    stats: &mut PathStats,
+) -> Option<SurfaceInteraction> {
     let (hit, visited) = if camera {
         scene.intersect_camera(ray)
     } else {
