@@ -1,6 +1,7 @@
 //! `pathlab`: the command-line front end of the pathlab renderer and Monte Carlo toolkit.
 
 mod expr;
+mod info_cmd;
 mod integrate;
 mod plot;
 mod render_cmd;
@@ -21,6 +22,8 @@ struct Cli {
 enum Command {
     /// Render a scene (default: the built-in Cornell box).
     Render(render_cmd::RenderArgs),
+    /// Show what a scene contains (shapes, materials, lights, camera, bounds, warnings).
+    Info(info_cmd::InfoArgs),
     /// Draw samples from a distribution or warp and compare them with its exact pdf.
     Sample(sample::SampleArgs),
     /// Estimate an integral over a box by Monte Carlo, with its error.
@@ -31,6 +34,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render_cmd::run(args),
+        Command::Info(args) => info_cmd::run(args),
         Command::Sample(args) => sample::run(args),
         Command::Integrate(args) => integrate::run(args),
     };

@@ -44,7 +44,7 @@ pub enum Aov {
 /// Raw command-line arguments of `pathlab render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The scene: a built-in scene's name (cornell-box).
+    /// The scene: a file (.dae) or a built-in scene's name (cornell-box).
     #[arg(default_value = "cornell-box")]
     pub scene: String,
     /// Samples per pixel.
@@ -142,14 +142,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.light_samples == 0 {
         bail!("--light-samples must be at least 1");
     }
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{}.png", args.scene)));
+    let output = args.output.clone().unwrap_or_else(|| {
+        let stem = Path::new(&args.scene)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("render");
+        PathBuf::from(format!("{stem}.png"))
+    });
     let format = output_format(&output)?;
-    let mut desc = pathlab_scene::builtin::load(&args.scene).map_err(|e| {
-        anyhow::anyhow!("{e}; scene files (.dae, .xml, .obj, ...) are not read yet")
-    })?;
+    let mut desc = pathlab_scene::load(&args.scene)?;
+    if !args.quiet {
+        for w in &desc.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
     if let Some(r) = &args.resolution {
         let (w, h) = (r[0], r[1]);
         if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {

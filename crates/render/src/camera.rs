@@ -65,6 +65,11 @@ impl Camera {
         self.origin
     }
 
+    /// The vertical field of view in degrees.
+    pub fn vertical_fov_degrees(&self) -> f32 {
+        2.0 * self.half.y.atan().to_degrees()
+    }
+
     /// The ray through film position `film` (pixels), through the lens point chosen by
     /// `u_lens` when the camera has an aperture. The direction has unit length.
     pub fn generate_ray(&self, film: Vec2, u_lens: Vec2) -> Ray {

@@ -46,6 +46,8 @@ pub fn cornell_box() -> Result<SceneDesc, Error> {
     )
     .map_err(|e| Error::Parse {
         path: "built-in cornell-box.obj".into(),
+        line: 0,
+        column: 0,
         message: e.to_string(),
     })?;
     let meshes = models

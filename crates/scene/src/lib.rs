@@ -1,7 +1,9 @@
 //! # pathlab-scene: scenes for the renderer
 //!
-//! Turns scene sources into the renderer's plain [`SceneDesc`]. Today: the built-in scenes
-//! ([`builtin`]), compiled into the binary so that `pathlab render` needs no files.
+//! Turns scene sources into the renderer's plain [`SceneDesc`]: the built-in scenes
+//! ([`builtin`], compiled into the binary) and files: the CS184 course's COLLADA scenes
+//! ([`collada`]). [`load`] picks the loader by extension; every loader returns an [`Error`]
+//! naming the file, the line and column, and what was expected.
 //!
 //! ```
 //! let desc = pathlab_scene::builtin::load("cornell-box").unwrap();
@@ -11,9 +13,13 @@
 #![deny(missing_docs)]
 
 pub mod builtin;
+pub mod collada;
+pub mod info;
+mod xml;
 
 pub use pathlab_render::desc::SceneDesc;
 
+use std::path::Path;
 use thiserror::Error;
 
 /// What went wrong loading a scene.
@@ -28,12 +34,60 @@ pub enum Error {
         /// The names that exist.
         known: String,
     },
-    /// A file could not be parsed.
+    /// A file could not be read.
     #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// A file's content is not what the format expects.
+    #[error("{path}:{line}:{column}: {message}")]
     Parse {
         /// The file (or built-in source).
         path: String,
-        /// What was expected.
+        /// Line, from 1 (0 when unknown).
+        line: usize,
+        /// Column, from 1 (0 when unknown).
+        column: usize,
+        /// What was found and what was expected.
         message: String,
     },
+    /// The file's extension names no format pathlab reads.
+    #[error("{path}: unknown scene format (expected .dae, or a built-in scene name: {known})")]
+    UnknownFormat {
+        /// The file.
+        path: String,
+        /// Built-in scene names.
+        known: String,
+    },
+}
+
+impl Error {
+    /// An I/O error on `path`.
+    pub fn io(path: &Path, e: std::io::Error) -> Self {
+        Error::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// Loads a scene: a built-in scene's name, or a file whose extension picks the loader.
+pub fn load(source: &str) -> Result<SceneDesc, Error> {
+    let path = Path::new(source);
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("dae") => collada::load(path),
+        None if builtin::NAMES.contains(&source) => builtin::load(source),
+        None if !path.exists() => builtin::load(source),
+        _ => Err(Error::UnknownFormat {
+            path: source.to_string(),
+            known: builtin::NAMES.join(", "),
+        }),
+    }
 }

@@ -1,0 +1,83 @@
+//! What a scene contains, for `pathlab info`.
+
+use glam::Vec3;
+use pathlab_render::desc::{SceneDesc, Visibility};
+use std::collections::BTreeMap;
+
+/// A summary of a scene description.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneInfo {
+    /// Number of meshes (area lights not counted).
+    pub meshes: usize,
+    /// Number of triangles over all meshes (area lights not counted).
+    pub triangles: usize,
+    /// Number of spheres.
+    pub spheres: usize,
+    /// Materials by kind (diffuse, mirror, ...).
+    pub materials: BTreeMap<String, usize>,
+    /// Lights by kind (area meshes, area spheres, point, spot, directional, environment).
+    pub lights: BTreeMap<String, usize>,
+    /// Camera position, target, vertical field of view (degrees) and image size.
+    pub camera: (Vec3, Vec3, f32, [u32; 2]),
+    /// Bounds of all shapes (min, max), or `None` for an empty scene.
+    pub bounds: Option<(Vec3, Vec3)>,
+    /// The loader's warnings.
+    pub warnings: Vec<String>,
+}
+
+/// Summarises `desc`.
+pub fn summarize(desc: &SceneDesc) -> SceneInfo {
+    let mut materials = BTreeMap::new();
+    for m in &desc.materials {
+        *materials.entry(m.kind().to_string()).or_insert(0) += 1;
+    }
+    let mut lights = BTreeMap::new();
+    let mut add = |k: &str, n: usize| {
+        if n > 0 {
+            *lights.entry(k.to_string()).or_insert(0) += n;
+        }
+    };
+    // CGL area lights arrive as parallelograms hidden from the camera; emissive meshes they
+    // replace are shown to the camera only.
+    let is_area_light = |m: &&pathlab_render::desc::MeshDesc| {
+        m.emission.is_some() && m.visibility == Visibility::INDIRECT_ONLY
+    };
+    add("area (parallelogram)", desc.meshes.iter().filter(is_area_light).count());
+    add(
+        "emissive mesh",
+        desc.meshes.iter().filter(|m| m.emission.is_some() && m.visibility == Visibility::ALL).count(),
+    );
+    add(
+        "emissive mesh (camera only)",
+        desc.meshes.iter().filter(|m| m.emission.is_some() && !m.visibility.indirect).count(),
+    );
+    add("area (sphere)", desc.spheres.iter().filter(|s| s.emission.is_some()).count());
+    add("point", desc.point_lights.len());
+    add("spot", desc.spot_lights.len());
+    add("directional", desc.directional_lights.len());
+    add("environment", desc.environment.is_some() as usize);
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for m in &desc.meshes {
+        for &p in &m.positions {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    for s in &desc.spheres {
+        lo = lo.min(s.center - Vec3::splat(s.radius));
+        hi = hi.max(s.center + Vec3::splat(s.radius));
+    }
+    let cam = pathlab_render::camera::Camera::new(&desc.camera, desc.resolution);
+    let shapes = || desc.meshes.iter().filter(|m| !is_area_light(m));
+    SceneInfo {
+        meshes: shapes().count(),
+        triangles: shapes().map(|m| m.indices.len() / 3).sum(),
+        spheres: desc.spheres.len(),
+        materials,
+        lights,
+        camera: (desc.camera.origin, desc.camera.target, cam.vertical_fov_degrees(), desc.resolution),
+        bounds: (lo.x <= hi.x).then_some((lo, hi)),
+        warnings: desc.warnings.clone(),
+    }
+}
