@@ -43,11 +43,17 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         if m.is_empty() {
             "none".to_string()
         } else {
-            m.iter().map(|(k, v)| format!("{v} {k}")).collect::<Vec<_>>().join(", ")
+            m.iter()
+                .map(|(k, v)| format!("{v} {k}"))
+                .collect::<Vec<_>>()
+                .join(", ")
         }
     };
     println!("{}", args.scene);
-    println!("  shapes     {} meshes ({} triangles), {} spheres", info.meshes, info.triangles, info.spheres);
+    println!(
+        "  shapes     {} meshes ({} triangles), {} spheres",
+        info.meshes, info.triangles, info.spheres
+    );
     println!("  materials  {}", list(&info.materials));
     println!("  lights     {}", list(&info.lights));
     println!(

@@ -65,8 +65,12 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneDesc, Error> {
         .map(str::trim)
         .unwrap_or("Y_UP");
     let entry = match up {
-        "Z_UP" => Mat4::from_cols_array(&[-1., 0., 0., 0., 0., 0., 1., 0., 0., 1., 0., 0., 0., 0., 0., 1.]),
-        "X_UP" => Mat4::from_cols_array(&[0., 1., 0., 0., 1., 0., 0., 0., 0., 0., -1., 0., 0., 0., 0., 1.]),
+        "Z_UP" => Mat4::from_cols_array(&[
+            -1., 0., 0., 0., 0., 0., 1., 0., 0., 1., 0., 0., 0., 0., 0., 1.,
+        ]),
+        "X_UP" => Mat4::from_cols_array(&[
+            0., 1., 0., 0., 1., 0., 0., 0., 0., 0., -1., 0., 0., 0., 0., 1.,
+        ]),
         _ => Mat4::IDENTITY,
     };
     let scene = loader.visual_scene(root)?;
@@ -108,10 +112,10 @@ struct Effect {
 impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
     fn lookup(&self, from: Node, url: &str) -> Result<Node<'a, 'input>, Error> {
         let id = url.strip_prefix('#').unwrap_or(url);
-        self.ids
-            .get(id)
-            .copied()
-            .ok_or_else(|| self.file.error(from, format!("reference to undefined id '{url}'")))
+        self.ids.get(id).copied().ok_or_else(|| {
+            self.file
+                .error(from, format!("reference to undefined id '{url}'"))
+        })
     }
 
     fn visual_scene(&self, root: Node<'a, 'input>) -> Result<Node<'a, 'input>, Error> {
@@ -180,7 +184,11 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
     }
 
     /// The material a primitive's symbol is bound to in an instance.
-    fn bound_material(&mut self, instance: Node, symbol: Option<&str>) -> Result<(usize, Option<Vec3>), Error> {
+    fn bound_material(
+        &mut self,
+        instance: Node,
+        symbol: Option<&str>,
+    ) -> Result<(usize, Option<Vec3>), Error> {
         let mut target = symbol.map(|s| s.to_string());
         if let Some(tc) = xpath(instance, &["bind_material", "technique_common"]) {
             for im in children(tc, "instance_material") {
@@ -195,9 +203,9 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         };
         let id = target.strip_prefix('#').unwrap_or(&target).to_string();
         let Some(&material) = self.ids.get(id.as_str()) else {
-            self.desc
-                .warnings
-                .push(format!("material '{id}' is not defined; using grey diffuse"));
+            self.desc.warnings.push(format!(
+                "material '{id}' is not defined; using grey diffuse"
+            ));
             return Ok((self.default_material(), None));
         };
         let effect = self.effect(material)?;
@@ -205,7 +213,8 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             Some(&i) => i,
             None => {
                 self.desc.materials.push(effect.material);
-                self.material_index.insert(id, self.desc.materials.len() - 1);
+                self.material_index
+                    .insert(id, self.desc.materials.len() - 1);
                 self.desc.materials.len() - 1
             }
         };
@@ -244,7 +253,9 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             }
         }
         let cgl = effect.descendants().find(|n| {
-            n.is_element() && n.tag_name().name() == "technique" && n.attribute("profile") == Some("CGL")
+            n.is_element()
+                && n.tag_name().name() == "technique"
+                && n.attribute("profile") == Some("CGL")
         });
         let mut out = Effect {
             material: MaterialDesc::Diffuse {
@@ -315,7 +326,10 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         let name = texture.attribute("texture").unwrap_or("?");
         let image = self.ids.get(name).copied().or_else(|| {
             // Textures usually name a sampler or surface param whose source is the image.
-            self.ids.values().copied().find(|n| n.tag_name().name() == "image")
+            self.ids
+                .values()
+                .copied()
+                .find(|n| n.tag_name().name() == "image")
         });
         let file = image
             .and_then(|i| xpath(i, &["init_from"]))
@@ -331,7 +345,10 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
 
     fn instance_geometry(&mut self, inst: Node<'a, 'input>, world: Mat4) -> Result<(), Error> {
         let geom = self.lookup(inst, inst.attribute("url").unwrap_or(""))?;
-        if let Some(sphere) = geom.descendants().find(|n| n.is_element() && n.tag_name().name() == "sphere") {
+        if let Some(sphere) = geom
+            .descendants()
+            .find(|n| n.is_element() && n.tag_name().name() == "sphere")
+        {
             let radius = child(sphere, "radius")
                 .map(|r| self.file.floats_n(r, 1))
                 .transpose()?
@@ -340,7 +357,10 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             let scale = (world.transform_point3(Vec3::X) - center).length();
             let radius = radius * scale;
             if !(radius > 0.0 && radius.is_finite()) {
-                return Err(self.file.error(sphere, format!("sphere radius must be positive, got {radius}")));
+                return Err(self.file.error(
+                    sphere,
+                    format!("sphere radius must be positive, got {radius}"),
+                ));
             }
             let (material, emission) = self.bound_material(inst, None)?;
             self.grow(center - Vec3::splat(radius));
@@ -371,7 +391,11 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             }
             let (material, emission) = self.bound_material(inst, prim.attribute("material"))?;
             let tri = self.primitive(mesh, prim)?;
-            let positions: Vec<Vec3> = tri.positions.iter().map(|&p| world.transform_point3(p)).collect();
+            let positions: Vec<Vec3> = tri
+                .positions
+                .iter()
+                .map(|&p| world.transform_point3(p))
+                .collect();
             for &p in &positions {
                 self.grow(p);
             }
@@ -408,9 +432,10 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             .ok_or_else(|| self.file.error(source, "expected a <float_array>"))?;
         let values = self.file.floats(array)?;
         if let Some(count) = array.attribute("count") {
-            let count: usize = count
-                .parse()
-                .map_err(|_| self.file.error(array, format!("count '{count}' is not a number")))?;
+            let count: usize = count.parse().map_err(|_| {
+                self.file
+                    .error(array, format!("count '{count}' is not a number"))
+            })?;
             if count != values.len() {
                 return Err(self.file.error(
                     array,
@@ -424,7 +449,12 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 .parse::<usize>()
                 .ok()
                 .filter(|&s| s >= want)
-                .ok_or_else(|| self.file.error(source, format!("accessor stride '{s}' must be at least {want}")))?,
+                .ok_or_else(|| {
+                    self.file.error(
+                        source,
+                        format!("accessor stride '{s}' must be at least {want}"),
+                    )
+                })?,
             None => want,
         };
         Ok(values
@@ -433,7 +463,11 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             .collect())
     }
 
-    fn primitive(&self, mesh: Node<'a, 'input>, prim: Node<'a, 'input>) -> Result<Triangles, Error> {
+    fn primitive(
+        &self,
+        mesh: Node<'a, 'input>,
+        prim: Node<'a, 'input>,
+    ) -> Result<Triangles, Error> {
         // Inputs: semantic, source, offset.
         let mut stride = 0usize;
         let mut pos: Option<(Vec<Vec3>, usize)> = None;
@@ -446,7 +480,9 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 .parse()
                 .map_err(|_| self.file.error(input, "offset is not a number"))?;
             if offset > 64 {
-                return Err(self.file.error(input, format!("offset {offset} is implausibly large")));
+                return Err(self
+                    .file
+                    .error(input, format!("offset {offset} is implausibly large")));
             }
             stride = stride.max(offset + 1);
             let semantic = input.attribute("semantic").unwrap_or("");
@@ -459,7 +495,9 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                         .ok_or_else(|| self.file.error(src, "expected a POSITION input"))?;
                     let psrc = self.lookup(p, p.attribute("source").unwrap_or(""))?;
                     pos = Some((vec3s(self.source(psrc, 3)?), offset));
-                    if let Some(n) = children(src, "input").find(|i| i.attribute("semantic") == Some("NORMAL")) {
+                    if let Some(n) =
+                        children(src, "input").find(|i| i.attribute("semantic") == Some("NORMAL"))
+                    {
                         let nsrc = self.lookup(n, n.attribute("source").unwrap_or(""))?;
                         nor = Some((vec3s(self.source(nsrc, 3)?), offset));
                     }
@@ -473,7 +511,8 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 _ => {}
             }
         }
-        let (positions, pos_offset) = pos.ok_or_else(|| self.file.error(prim, "expected a VERTEX input"))?;
+        let (positions, pos_offset) =
+            pos.ok_or_else(|| self.file.error(prim, "expected a VERTEX input"))?;
         let stride = stride.max(1);
         // Polygons: vertex counts and index lists.
         let polygons: Vec<Vec<u32>> = match prim.tag_name().name() {
@@ -481,7 +520,10 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 .map(|p| self.file.indices(p))
                 .collect::<Result<_, _>>()?,
             kind => {
-                let p = child(prim, "p").map(|p| self.file.indices(p)).transpose()?.unwrap_or_default();
+                let p = child(prim, "p")
+                    .map(|p| self.file.indices(p))
+                    .transpose()?
+                    .unwrap_or_default();
                 let counts: Vec<u32> = if kind == "polylist" {
                     child(prim, "vcount")
                         .map(|v| self.file.indices(v))
@@ -497,7 +539,10 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                     let Some(slice) = p.get(at..at + len) else {
                         return Err(self.file.error(
                             prim,
-                            format!("<p> has {} indices but the polygon counts need more", p.len()),
+                            format!(
+                                "<p> has {} indices but the polygon counts need more",
+                                p.len()
+                            ),
                         ));
                     };
                     out.push(slice.to_vec());
@@ -506,38 +551,66 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 out
             }
         };
-        if let Some(count) = prim.attribute("count").and_then(|c| c.parse::<usize>().ok()) {
+        if let Some(count) = prim
+            .attribute("count")
+            .and_then(|c| c.parse::<usize>().ok())
+        {
             if count != polygons.len() {
                 return Err(self.file.error(
                     prim,
-                    format!("count says {count} polygons but {} are given", polygons.len()),
+                    format!(
+                        "count says {count} polygons but {} are given",
+                        polygons.len()
+                    ),
                 ));
             }
         }
         let mut out = Triangles::default();
-        let fetch = |list: &[u32], corner: usize, offset: usize| list[corner * stride + offset] as usize;
+        let fetch =
+            |list: &[u32], corner: usize, offset: usize| list[corner * stride + offset] as usize;
         for poly in &polygons {
             if poly.len() % stride != 0 {
-                return Err(self.file.error(prim, "a polygon's index count is not a multiple of the input count"));
+                return Err(self.file.error(
+                    prim,
+                    "a polygon's index count is not a multiple of the input count",
+                ));
             }
             let corners = poly.len() / stride;
             for k in 1..corners.saturating_sub(1) {
                 for corner in [0, k, k + 1] {
                     let pi = fetch(poly, corner, pos_offset);
                     let p = *positions.get(pi).ok_or_else(|| {
-                        self.file.error(prim, format!("position index {pi} out of range ({} positions)", positions.len()))
+                        self.file.error(
+                            prim,
+                            format!(
+                                "position index {pi} out of range ({} positions)",
+                                positions.len()
+                            ),
+                        )
                     })?;
                     out.positions.push(p);
                     if let Some((normals, off)) = &nor {
                         let ni = fetch(poly, corner, *off);
                         out.normals.push(*normals.get(ni).ok_or_else(|| {
-                            self.file.error(prim, format!("normal index {ni} out of range ({} normals)", normals.len()))
+                            self.file.error(
+                                prim,
+                                format!(
+                                    "normal index {ni} out of range ({} normals)",
+                                    normals.len()
+                                ),
+                            )
                         })?);
                     }
                     if let Some((uvs, off)) = &tex {
                         let ti = fetch(poly, corner, *off);
                         out.uvs.push(*uvs.get(ti).ok_or_else(|| {
-                            self.file.error(prim, format!("texture coordinate index {ti} out of range ({})", uvs.len()))
+                            self.file.error(
+                                prim,
+                                format!(
+                                    "texture coordinate index {ti} out of range ({})",
+                                    uvs.len()
+                                ),
+                            )
                         })?);
                     }
                 }
@@ -549,7 +622,9 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
 
     fn light(&mut self, light: Node<'a, 'input>, world: Mat4) -> Result<(), Error> {
         let cgl = light.descendants().find(|n| {
-            n.is_element() && n.tag_name().name() == "technique" && n.attribute("profile") == Some("CGL")
+            n.is_element()
+                && n.tag_name().name() == "technique"
+                && n.attribute("profile") == Some("CGL")
         });
         let common = child(light, "technique_common");
         let (technique, is_cgl) = match (cgl, common) {
@@ -577,9 +652,13 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 None => Ok(default),
             }
         };
-        let attenuation = if ["constant_attenuation", "linear_attenuation", "quadratic_attenuation"]
-            .iter()
-            .any(|n| child(kind, n).is_some())
+        let attenuation = if [
+            "constant_attenuation",
+            "linear_attenuation",
+            "quadratic_attenuation",
+        ]
+        .iter()
+        .any(|n| child(kind, n).is_some())
         {
             [
                 scalar("constant_attenuation", 1.0)?,
@@ -623,7 +702,10 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             "ambient" => {
                 self.desc.environment = Some(self.desc.environment.unwrap_or(Vec3::ZERO) + color)
             }
-            other => self.desc.warnings.push(format!("light type '{other}' is not supported; skipped")),
+            other => self
+                .desc
+                .warnings
+                .push(format!("light type '{other}' is not supported; skipped")),
         }
         Ok(())
     }
@@ -645,7 +727,12 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         }
         for (k, a) in self.cgl_area_lights.iter().enumerate() {
             let (hx, hy) = (0.5 * a.dim_x, 0.5 * a.dim_y);
-            let mut positions = vec![a.center - hx - hy, a.center + hx - hy, a.center + hx + hy, a.center - hx + hy];
+            let mut positions = vec![
+                a.center - hx - hy,
+                a.center + hx - hy,
+                a.center + hx + hy,
+                a.center - hx + hy,
+            ];
             // Wind the parallelogram so that its front (counter-clockwise) side faces `direction`.
             let n = (positions[1] - positions[0]).cross(positions[2] - positions[0]);
             if n.dot(a.direction) < 0.0 {
@@ -671,8 +758,12 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             || d.spot_lights.iter().any(|l| bright(l.intensity))
             || d.directional_lights.iter().any(|l| bright(l.irradiance))
             || d.environment.is_some_and(bright)
-            || d.meshes.iter().any(|m| m.emission.is_some_and(|e| bright(e.radiance)))
-            || d.spheres.iter().any(|s| s.emission.is_some_and(|e| bright(e.radiance)));
+            || d.meshes
+                .iter()
+                .any(|m| m.emission.is_some_and(|e| bright(e.radiance)))
+            || d.spheres
+                .iter()
+                .any(|s| s.emission.is_some_and(|e| bright(e.radiance)));
         if !has_light {
             self.desc.environment = Some(Vec3::ONE);
             self.desc
@@ -704,7 +795,9 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                         .transpose()
                 };
                 (
-                    world.transform_point3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z),
+                    world
+                        .transform_point3(Vec3::NEG_Z)
+                        .normalize_or(Vec3::NEG_Z),
                     get("xfov")?,
                     get("yfov")?,
                     get("aspect_ratio")?,
@@ -716,7 +809,9 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             }
         };
         let half_tan = |deg: f32| (deg.to_radians() * 0.5).tan();
-        let aspect = aspect.filter(|a| *a > 0.0 && a.is_finite()).unwrap_or(4.0 / 3.0);
+        let aspect = aspect
+            .filter(|a| *a > 0.0 && a.is_finite())
+            .unwrap_or(4.0 / 3.0);
         let (mut tx, mut ty) = match (xfov, yfov) {
             (Some(x), Some(y)) => (half_tan(x), half_tan(y)),
             (Some(x), None) => (half_tan(x), half_tan(x) / aspect),
@@ -735,7 +830,11 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         let theta = dir.x.atan2(dir.z);
         let r = 1.5 * extent;
         let offset = r * Vec3::new(phi.sin() * theta.sin(), phi.cos(), phi.sin() * theta.cos());
-        let up = if phi.sin() < 0.0 { Vec3::NEG_Y } else { Vec3::Y };
+        let up = if phi.sin() < 0.0 {
+            Vec3::NEG_Y
+        } else {
+            Vec3::Y
+        };
         Ok(CameraDesc {
             origin: center + offset,
             target: center,

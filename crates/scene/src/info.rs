@@ -42,16 +42,28 @@ pub fn summarize(desc: &SceneDesc) -> SceneInfo {
     let is_area_light = |m: &&pathlab_render::desc::MeshDesc| {
         m.emission.is_some() && m.visibility == Visibility::INDIRECT_ONLY
     };
-    add("area (parallelogram)", desc.meshes.iter().filter(is_area_light).count());
+    add(
+        "area (parallelogram)",
+        desc.meshes.iter().filter(is_area_light).count(),
+    );
     add(
         "emissive mesh",
-        desc.meshes.iter().filter(|m| m.emission.is_some() && m.visibility == Visibility::ALL).count(),
+        desc.meshes
+            .iter()
+            .filter(|m| m.emission.is_some() && m.visibility == Visibility::ALL)
+            .count(),
     );
     add(
         "emissive mesh (camera only)",
-        desc.meshes.iter().filter(|m| m.emission.is_some() && !m.visibility.indirect).count(),
+        desc.meshes
+            .iter()
+            .filter(|m| m.emission.is_some() && !m.visibility.indirect)
+            .count(),
     );
-    add("area (sphere)", desc.spheres.iter().filter(|s| s.emission.is_some()).count());
+    add(
+        "area (sphere)",
+        desc.spheres.iter().filter(|s| s.emission.is_some()).count(),
+    );
     add("point", desc.point_lights.len());
     add("spot", desc.spot_lights.len());
     add("directional", desc.directional_lights.len());
@@ -76,7 +88,12 @@ pub fn summarize(desc: &SceneDesc) -> SceneInfo {
         spheres: desc.spheres.len(),
         materials,
         lights,
-        camera: (desc.camera.origin, desc.camera.target, cam.vertical_fov_degrees(), desc.resolution),
+        camera: (
+            desc.camera.origin,
+            desc.camera.target,
+            cam.vertical_fov_degrees(),
+            desc.resolution,
+        ),
         bounds: (lo.x <= hi.x).then_some((lo, hi)),
         warnings: desc.warnings.clone(),
     }

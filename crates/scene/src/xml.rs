@@ -41,7 +41,9 @@ impl<'a, 'input> XmlFile<'a, 'input> {
             .map(|t| match t.parse::<f32>() {
                 Ok(v) if v.is_finite() => Ok(v),
                 Ok(v) => Err(self.error(node, format!("expected a finite number, found {v}"))),
-                Err(_) => Err(self.error(node, format!("expected a number, found '{}'", truncate(t)))),
+                Err(_) => {
+                    Err(self.error(node, format!("expected a number, found '{}'", truncate(t))))
+                }
             })
             .collect()
     }
@@ -52,7 +54,13 @@ impl<'a, 'input> XmlFile<'a, 'input> {
         text.split_ascii_whitespace()
             .map(|t| {
                 t.parse::<u32>().map_err(|_| {
-                    self.error(node, format!("expected a non-negative integer index, found '{}'", truncate(t)))
+                    self.error(
+                        node,
+                        format!(
+                            "expected a non-negative integer index, found '{}'",
+                            truncate(t)
+                        ),
+                    )
                 })
             })
             .collect()
@@ -70,12 +78,17 @@ impl<'a, 'input> XmlFile<'a, 'input> {
 
 /// The first child element called `name` (namespace ignored).
 pub fn child<'a, 'input>(node: Node<'a, 'input>, name: &str) -> Option<Node<'a, 'input>> {
-    node.children().find(|c| c.is_element() && c.tag_name().name() == name)
+    node.children()
+        .find(|c| c.is_element() && c.tag_name().name() == name)
 }
 
 /// All child elements called `name`.
-pub fn children<'a, 'input: 'a>(node: Node<'a, 'input>, name: &'a str) -> impl Iterator<Item = Node<'a, 'input>> + 'a {
-    node.children().filter(move |c| c.is_element() && c.tag_name().name() == name)
+pub fn children<'a, 'input: 'a>(
+    node: Node<'a, 'input>,
+    name: &'a str,
+) -> impl Iterator<Item = Node<'a, 'input>> + 'a {
+    node.children()
+        .filter(move |c| c.is_element() && c.tag_name().name() == name)
 }
 
 /// The element at a path of child names.
@@ -98,7 +111,11 @@ pub fn read_text(path: &Path) -> Result<String, Error> {
     if meta.len() as usize > MAX_XML_BYTES {
         return Err(Error::Io {
             path: path.display().to_string(),
-            message: format!("{} bytes is larger than the {} MiB limit", meta.len(), MAX_XML_BYTES >> 20),
+            message: format!(
+                "{} bytes is larger than the {} MiB limit",
+                meta.len(),
+                MAX_XML_BYTES >> 20
+            ),
         });
     }
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
