@@ -1,0 +1,86 @@
+//! Corrupted scene files: truncated, bit-flipped and number-mangled variants of the course's
+//! scenes must load or fail with an error, never panic; what loads must build and render.
+
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
+use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::scene::Scene;
+use pathlab_scene::collada;
+use proptest::prelude::*;
+use std::path::{Path, PathBuf};
+
+fn sample(name: &str) -> String {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cs184").join(name);
+    std::fs::read_to_string(path).unwrap()
+}
+
+const SAMPLES: [&str; 3] = ["cube.dae", "CBspheres.dae", "plane.dae"];
+
+/// Loads corrupted text; whatever loads must also build and render a tiny image.
+fn exercise(text: &str) {
+    if let Ok(mut desc) = collada::parse(text, Path::new("corrupt.dae")) {
+        desc.resolution = [4, 3];
+        if let Ok(scene) = Scene::build(&desc) {
+            let settings = RenderSettings::new(1, 0, SamplerKind::Independent);
+            let integrator = IntegratorKind::Path(PathIntegrator::default());
+            let (film, _) = render(&scene, &integrator, &settings, &|_| {}, &Default::default());
+            assert!(film.pixels().iter().all(|p| p.mean().is_finite()));
+        }
+    }
+}
+
+/// Byte offsets of number tokens in `text`.
+fn number_spans(text: &str) -> Vec<(usize, usize)> {
+    let b = text.as_bytes();
+    let mut spans = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        if b[i].is_ascii_digit() {
+            let start = i;
+            while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'.' || b[i] == b'e' || b[i] == b'-') {
+                i += 1;
+            }
+            spans.push((start, i));
+        } else {
+            i += 1;
+        }
+    }
+    spans
+}
+
+const MANGLED: [&str; 10] = ["NaN", "-1", "1e39", "99999999999999", "", "-0", "1e-45", "inf", "4294967295", "0.5.5"];
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn truncated(which in 0usize..3, cut in 0.0f64..1.0) {
+        let text = sample(SAMPLES[which]);
+        let mut at = (cut * text.len() as f64) as usize;
+        while !text.is_char_boundary(at) {
+            at -= 1;
+        }
+        exercise(&text[..at]);
+    }
+
+    #[test]
+    fn bit_flipped(which in 0usize..3, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 1..8)) {
+        let mut bytes = sample(SAMPLES[which]).into_bytes();
+        for (pos, bit) in flips {
+            let i = ((pos * bytes.len() as f64) as usize).min(bytes.len() - 1);
+            bytes[i] ^= 1 << bit;
+        }
+        exercise(&String::from_utf8_lossy(&bytes));
+    }
+
+    #[test]
+    fn numbers_mangled(which in 0usize..3, edits in prop::collection::vec((0.0f64..1.0, 0usize..MANGLED.len()), 1..6)) {
+        let mut text = sample(SAMPLES[which]);
+        for (pos, k) in edits {
+            let spans = number_spans(&text);
+            let (s, e) = spans[((pos * spans.len() as f64) as usize).min(spans.len() - 1)];
+            text.replace_range(s..e, MANGLED[k]);
+        }
+        exercise(&text);
+    }
+}
