@@ -2,7 +2,7 @@
 //!
 //! Turns scene sources into the renderer's plain [`SceneDesc`]: the built-in scenes
 //! ([`builtin`], compiled into the binary) and files: the CS184 course's COLLADA scenes
-//! ([`collada`]). [`load`] picks the loader by extension; every loader returns an [`Error`]
+//! ([`collada`]), OBJ and PLY meshes ([`meshfile`]). [`load`] picks the loader by extension; every loader returns an [`Error`]
 //! naming the file, the line and column, and what was expected.
 //!
 //! ```
@@ -15,6 +15,7 @@
 pub mod builtin;
 pub mod collada;
 pub mod info;
+pub mod meshfile;
 mod xml;
 
 pub use pathlab_render::desc::SceneDesc;
@@ -55,7 +56,7 @@ pub enum Error {
         message: String,
     },
     /// The file's extension names no format pathlab reads.
-    #[error("{path}: unknown scene format (expected .dae, or a built-in scene name: {known})")]
+    #[error("{path}: unknown scene format (expected .dae, .obj or .ply, or a built-in scene name: {known})")]
     UnknownFormat {
         /// The file.
         path: String,
@@ -83,6 +84,8 @@ pub fn load(source: &str) -> Result<SceneDesc, Error> {
         .map(|e| e.to_ascii_lowercase());
     match ext.as_deref() {
         Some("dae") => collada::load(path),
+        Some("obj") => meshfile::load_obj(path),
+        Some("ply") => meshfile::load_ply(path),
         None if builtin::NAMES.contains(&source) => builtin::load(source),
         None if !path.exists() => builtin::load(source),
         _ => Err(Error::UnknownFormat {

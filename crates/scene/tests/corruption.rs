@@ -10,7 +10,9 @@ use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
 fn sample(name: &str) -> String {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cs184").join(name);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/cs184")
+        .join(name);
     std::fs::read_to_string(path).unwrap()
 }
 
@@ -37,7 +39,9 @@ fn number_spans(text: &str) -> Vec<(usize, usize)> {
     while i < b.len() {
         if b[i].is_ascii_digit() {
             let start = i;
-            while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'.' || b[i] == b'e' || b[i] == b'-') {
+            while i < b.len()
+                && (b[i].is_ascii_digit() || b[i] == b'.' || b[i] == b'e' || b[i] == b'-')
+            {
                 i += 1;
             }
             spans.push((start, i));
@@ -48,7 +52,18 @@ fn number_spans(text: &str) -> Vec<(usize, usize)> {
     spans
 }
 
-const MANGLED: [&str; 10] = ["NaN", "-1", "1e39", "99999999999999", "", "-0", "1e-45", "inf", "4294967295", "0.5.5"];
+const MANGLED: [&str; 10] = [
+    "NaN",
+    "-1",
+    "1e39",
+    "99999999999999",
+    "",
+    "-0",
+    "1e-45",
+    "inf",
+    "4294967295",
+    "0.5.5",
+];
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 200, failure_persistence: None, ..ProptestConfig::default() })]
@@ -82,5 +97,51 @@ proptest! {
             text.replace_range(s..e, MANGLED[k]);
         }
         exercise(&text);
+    }
+}
+
+/// A small binary PLY (a square) to corrupt.
+fn ply_square() -> Vec<u8> {
+    let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+    for c in [0.0f32, 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.] {
+        b.extend(c.to_le_bytes());
+    }
+    b.push(4);
+    for i in [0i32, 1, 2, 3] {
+        b.extend(i.to_le_bytes());
+    }
+    b
+}
+
+/// Loads corrupted PLY bytes from a file; whatever loads must build and render.
+fn exercise_ply(bytes: &[u8], case: u64) {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("case{case}.ply"));
+    std::fs::write(&path, bytes).unwrap();
+    if let Ok(mut desc) = pathlab_scene::load(path.to_str().unwrap()) {
+        desc.resolution = [4, 3];
+        if let Ok(scene) = Scene::build(&desc) {
+            let settings = RenderSettings::new(1, 0, SamplerKind::Independent);
+            let integrator = IntegratorKind::Path(PathIntegrator::default());
+            let (film, _) = render(&scene, &integrator, &settings, &|_| {}, &Default::default());
+            assert!(film.pixels().iter().all(|p| p.mean().is_finite()));
+        }
+    }
+    let _ = std::fs::remove_file(path);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 100, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn ply_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6), case in 0u64..1_000_000) {
+        let mut bytes = ply_square();
+        for (pos, bit) in flips {
+            let i = ((pos * bytes.len() as f64) as usize).min(bytes.len() - 1);
+            bytes[i] ^= 1 << bit;
+        }
+        let keep = ((cut * 1.2).min(1.0) * bytes.len() as f64) as usize;
+        exercise_ply(&bytes[..keep], case);
     }
 }

@@ -1,0 +1,307 @@
+//! Standalone meshes: Wavefront OBJ (with MTL materials, via `tobj`) and PLY (ASCII and binary,
+//! via `ply-rs-bw`). They carry no camera or lights, so the scene gets a default camera that
+//! frames the mesh's bounding box from the front and a default light (a uniform sky plus a key
+//! light from the upper left) unless the mesh emits light itself.
+
+use crate::Error;
+use glam::{Vec2, Vec3};
+use pathlab_render::desc::*;
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, Property};
+use std::path::Path;
+
+/// Default image size of standalone meshes.
+pub const DEFAULT_RESOLUTION: [u32; 2] = [640, 480];
+
+/// Loads a Wavefront OBJ file and the MTL files it names.
+pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
+    let (models, materials) = tobj::load_obj(
+        path,
+        &tobj::LoadOptions {
+            triangulate: true,
+            single_index: true,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| obj_error(path, e))?;
+    let mut desc = SceneDesc::default();
+    let mtl = match materials {
+        Ok(m) => m,
+        Err(e) => {
+            desc.warnings
+                .push(format!("materials: {e}; using grey diffuse"));
+            Vec::new()
+        }
+    };
+    // One material per MTL entry, plus a grey default at the end.
+    let mut emissions = Vec::new();
+    for m in &mtl {
+        let kd = m.diffuse.map_or(Vec3::splat(0.8), Vec3::from_array);
+        desc.materials.push(MaterialDesc::Diffuse {
+            reflectance: kd.clamp(Vec3::ZERO, Vec3::ONE),
+            two_sided: true,
+        });
+        let ke = m
+            .emissive
+            .map(Vec3::from_array)
+            .filter(|e| e.is_finite() && e.max_element() > 0.0);
+        emissions.push(ke);
+        if m.shininess.is_some_and(|ns| ns > 100.0) {
+            desc.warnings.push(format!(
+                "material '{}': Ns {} asks for a glossy surface; rendered as diffuse",
+                m.name,
+                m.shininess.unwrap_or(0.0)
+            ));
+        }
+    }
+    let default = desc.materials.len();
+    desc.materials.push(MaterialDesc::Diffuse {
+        reflectance: Vec3::splat(0.8),
+        two_sided: true,
+    });
+    for model in models {
+        let m = &model.mesh;
+        let positions = vec3s(path, &m.positions, "vertex")?;
+        check_indices(path, &model.name, &m.indices, positions.len())?;
+        let normals = if m.normals.len() == m.positions.len() {
+            vec3s(path, &m.normals, "normal")?
+        } else {
+            Vec::new()
+        };
+        let uvs = if m.texcoords.len() / 2 == positions.len() {
+            m.texcoords.chunks_exact(2).map(Vec2::from_slice).collect()
+        } else {
+            Vec::new()
+        };
+        let material = m.material_id.filter(|&i| i < mtl.len()).unwrap_or(default);
+        let emission = emissions
+            .get(material)
+            .copied()
+            .flatten()
+            .map(|radiance| Emission {
+                radiance,
+                two_sided: false,
+            });
+        desc.meshes.push(MeshDesc {
+            name: model.name,
+            positions,
+            indices: m.indices.clone(),
+            material,
+            emission,
+            normals,
+            uvs,
+            visibility: Visibility::ALL,
+        });
+    }
+    standalone(path, desc)
+}
+
+fn obj_error(path: &Path, e: tobj::LoadError) -> Error {
+    match e {
+        tobj::LoadError::OpenFileFailed | tobj::LoadError::ReadError => Error::Io {
+            path: path.display().to_string(),
+            message: format!("cannot read the file ({e})"),
+        },
+        other => Error::Parse {
+            path: path.display().to_string(),
+            line: 0,
+            column: 0,
+            message: format!("not a valid OBJ file: {other}"),
+        },
+    }
+}
+
+fn vec3s(path: &Path, values: &[f32], what: &str) -> Result<Vec<Vec3>, Error> {
+    values
+        .chunks_exact(3)
+        .enumerate()
+        .map(|(i, c)| {
+            let v = Vec3::from_slice(c);
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(Error::Parse {
+                    path: path.display().to_string(),
+                    line: 0,
+                    column: 0,
+                    message: format!(
+                        "{what} {i} has a coordinate that is not a finite number: {v}"
+                    ),
+                })
+            }
+        })
+        .collect()
+}
+
+fn check_indices(path: &Path, mesh: &str, indices: &[u32], vertices: usize) -> Result<(), Error> {
+    match indices.iter().find(|&&i| i as usize >= vertices) {
+        Some(i) => Err(Error::Parse {
+            path: path.display().to_string(),
+            line: 0,
+            column: 0,
+            message: format!("mesh '{mesh}': vertex index {i} out of range ({vertices} vertices)"),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Loads a PLY file (ASCII, binary little or big endian): vertex positions (and normals when
+/// present) and faces (polygons are fanned into triangles).
+pub fn load_ply(path: &Path) -> Result<SceneDesc, Error> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut reader = std::io::BufReader::new(file);
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut reader)
+        .map_err(|e| Error::Parse {
+            path: path.display().to_string(),
+            line: 0,
+            column: 0,
+            // The parser's message spans lines; keep it on one.
+            message: format!(
+                "not a valid PLY file: {}",
+                e.to_string()
+                    .split_whitespace()
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            ),
+        })?;
+    let err = |message: String| Error::Parse {
+        path: path.display().to_string(),
+        line: 0,
+        column: 0,
+        message,
+    };
+    let vertices = ply
+        .payload
+        .get("vertex")
+        .ok_or_else(|| err("no 'vertex' element".into()))?;
+    let scalar = |e: &DefaultElement, key: &str| -> Option<f32> {
+        match e.get(key)? {
+            Property::Float(v) => Some(*v),
+            Property::Double(v) => Some(*v as f32),
+            Property::Char(v) => Some(*v as f32),
+            Property::UChar(v) => Some(*v as f32),
+            Property::Short(v) => Some(*v as f32),
+            Property::UShort(v) => Some(*v as f32),
+            Property::Int(v) => Some(*v as f32),
+            Property::UInt(v) => Some(*v as f32),
+            _ => None,
+        }
+    };
+    let mut positions = Vec::with_capacity(vertices.len());
+    let mut normals = Vec::new();
+    for (i, v) in vertices.iter().enumerate() {
+        let p = match (scalar(v, "x"), scalar(v, "y"), scalar(v, "z")) {
+            (Some(x), Some(y), Some(z)) => Vec3::new(x, y, z),
+            _ => return Err(err(format!("vertex {i} lacks a numeric x, y or z"))),
+        };
+        if !p.is_finite() {
+            return Err(err(format!(
+                "vertex {i} has a coordinate that is not a finite number: {p}"
+            )));
+        }
+        positions.push(p);
+        if let (Some(x), Some(y), Some(z)) = (scalar(v, "nx"), scalar(v, "ny"), scalar(v, "nz")) {
+            normals.push(Vec3::new(x, y, z));
+        }
+    }
+    if normals.len() != positions.len() {
+        normals.clear();
+    }
+    let mut indices = Vec::new();
+    if let Some(faces) = ply.payload.get("face") {
+        for (f, face) in faces.iter().enumerate() {
+            let list: Vec<i64> = match face
+                .get("vertex_indices")
+                .or_else(|| face.get("vertex_index"))
+            {
+                Some(Property::ListInt(v)) => v.iter().map(|&x| x as i64).collect(),
+                Some(Property::ListUInt(v)) => v.iter().map(|&x| x as i64).collect(),
+                Some(Property::ListShort(v)) => v.iter().map(|&x| x as i64).collect(),
+                Some(Property::ListUShort(v)) => v.iter().map(|&x| x as i64).collect(),
+                Some(Property::ListChar(v)) => v.iter().map(|&x| x as i64).collect(),
+                Some(Property::ListUChar(v)) => v.iter().map(|&x| x as i64).collect(),
+                _ => return Err(err(format!("face {f} has no integer vertex_indices list"))),
+            };
+            if let Some(&bad) = list
+                .iter()
+                .find(|&&i| i < 0 || i as usize >= positions.len())
+            {
+                return Err(err(format!(
+                    "face {f}: vertex index {bad} out of range ({} vertices)",
+                    positions.len()
+                )));
+            }
+            for k in 1..list.len().saturating_sub(1) {
+                indices.extend([list[0] as u32, list[k] as u32, list[k + 1] as u32]);
+            }
+        }
+    }
+    let name = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("ply")
+        .to_string();
+    let desc = SceneDesc {
+        meshes: vec![MeshDesc {
+            name,
+            positions,
+            indices,
+            material: 0,
+            emission: None,
+            normals,
+            uvs: Vec::new(),
+            visibility: Visibility::ALL,
+        }],
+        materials: vec![MaterialDesc::Diffuse {
+            reflectance: Vec3::splat(0.8),
+            two_sided: true,
+        }],
+        ..Default::default()
+    };
+    standalone(path, desc)
+}
+
+/// Adds the default camera, resolution and (when nothing emits) lights of a standalone mesh.
+fn standalone(path: &Path, mut desc: SceneDesc) -> Result<SceneDesc, Error> {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for m in &desc.meshes {
+        for &p in &m.positions {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    if lo.x > hi.x {
+        return Err(Error::Parse {
+            path: path.display().to_string(),
+            line: 0,
+            column: 0,
+            message: "the file holds no geometry".into(),
+        });
+    }
+    let center = 0.5 * (lo + hi);
+    let radius = (0.5 * (hi - lo).length()).max(1e-6);
+    let fov: f32 = 40.0;
+    // Far enough that the bounding sphere fits the vertical field of view, with a margin.
+    let distance = 1.1 * radius / (0.5 * fov).to_radians().sin();
+    let dir = Vec3::new(0.35, 0.3, 1.0).normalize();
+    desc.camera = CameraDesc {
+        origin: center + dir * distance,
+        target: center,
+        up: Vec3::Y,
+        fov_degrees: fov,
+        fov_axis: FovAxis::Y,
+        lens_radius: 0.0,
+        focal_distance: distance,
+        focal_pixels: None,
+    };
+    desc.resolution = DEFAULT_RESOLUTION;
+    if !desc.meshes.iter().any(|m| m.emission.is_some()) {
+        desc.environment = Some(Vec3::splat(0.5));
+        desc.directional_lights.push(DirectionalLightDesc {
+            direction: Vec3::new(0.5, -1.0, -0.6).normalize(),
+            irradiance: Vec3::splat(2.0),
+        });
+    }
+    Ok(desc)
+}

@@ -1,0 +1,171 @@
+//! OBJ and PLY meshes written by the tests themselves: counts and bounds round-trip, they render
+//! with the default camera and light, and bad files give errors that name them.
+
+use glam::Vec3;
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
+use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::scene::Scene;
+use pathlab_scene::{info, load, Error};
+use std::path::PathBuf;
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("meshfile-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// A box [-1, 2] x [0, 1] x [-3, 0.5] as 8 vertices and 6 quads.
+fn box_vertices() -> Vec<[f32; 3]> {
+    let (x, y, z) = ([-1.0, 2.0], [0.0, 1.0], [-3.0, 0.5]);
+    let mut v = Vec::new();
+    for &a in &x {
+        for &b in &y {
+            for &c in &z {
+                v.push([a, b, c]);
+            }
+        }
+    }
+    v
+}
+
+const QUADS: [[u32; 4]; 6] = [
+    [0, 1, 3, 2],
+    [4, 6, 7, 5],
+    [0, 4, 5, 1],
+    [2, 3, 7, 6],
+    [0, 2, 6, 4],
+    [1, 5, 7, 3],
+];
+
+fn check_box(source: &str, emissive: bool) {
+    let desc = load(source).unwrap_or_else(|e| panic!("{e}"));
+    let s = info::summarize(&desc);
+    assert_eq!(s.triangles, 12, "{source}");
+    let (lo, hi) = s.bounds.unwrap();
+    assert_eq!(
+        (lo, hi),
+        (Vec3::new(-1.0, 0.0, -3.0), Vec3::new(2.0, 1.0, 0.5)),
+        "{source}"
+    );
+    assert_eq!(desc.meshes.iter().any(|m| m.emission.is_some()), emissive);
+    let mut desc = desc;
+    desc.resolution = [32, 24];
+    let scene = Scene::build(&desc).unwrap();
+    let (film, stats) = render(
+        &scene,
+        &IntegratorKind::Path(PathIntegrator::default()),
+        &RenderSettings::new(16, 1, SamplerKind::Independent),
+        &|_| {},
+        &Default::default(),
+    );
+    assert_eq!(stats.nonfinite_samples, 0);
+    let m = film.image_mean();
+    assert!(m.is_finite() && m.max_element() > 1e-3, "{source}: {m:?}");
+}
+
+#[test]
+fn obj_with_mtl_round_trips_and_renders() {
+    let obj = scratch("box.obj");
+    let mut text = String::from("mtllib box.mtl\no box\nusemtl red\n");
+    for v in box_vertices() {
+        text += &format!("v {} {} {}\n", v[0], v[1], v[2]);
+    }
+    for q in QUADS {
+        text += &format!("f {} {} {} {}\n", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
+    }
+    std::fs::write(&obj, text).unwrap();
+    std::fs::write(scratch("box.mtl"), "newmtl red\nKd 0.8 0.1 0.1\nNs 10\n").unwrap();
+    check_box(obj.to_str().unwrap(), false);
+    let desc = load(obj.to_str().unwrap()).unwrap();
+    assert!(desc.materials.iter().any(|m| matches!(m,
+        pathlab_render::desc::MaterialDesc::Diffuse { reflectance, .. } if (*reflectance - Vec3::new(0.8, 0.1, 0.1)).length() < 1e-6)));
+    // An emissive material (Ke) makes the mesh a light; no default lights are added then.
+    std::fs::write(scratch("box.mtl"), "newmtl red\nKd 0.8 0.1 0.1\nKe 2 2 2\n").unwrap();
+    check_box(obj.to_str().unwrap(), true);
+}
+
+fn ply_header(format: &str, vertices: usize, faces: usize) -> String {
+    format!(
+        "ply\nformat {format} 1.0\nelement vertex {vertices}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {faces}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+}
+
+#[test]
+fn ascii_and_binary_ply_round_trip_and_render() {
+    let ascii = scratch("box_ascii.ply");
+    let mut text = ply_header("ascii", 8, 6);
+    for v in box_vertices() {
+        text += &format!("{} {} {}\n", v[0], v[1], v[2]);
+    }
+    for q in QUADS {
+        text += &format!("4 {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    std::fs::write(&ascii, text).unwrap();
+    check_box(ascii.to_str().unwrap(), false);
+
+    let binary = scratch("box_binary.ply");
+    std::fs::write(&binary, binary_box(6)).unwrap();
+    check_box(binary.to_str().unwrap(), false);
+}
+
+fn binary_box(declared_faces: usize) -> Vec<u8> {
+    let mut bytes = ply_header("binary_little_endian", 8, declared_faces).into_bytes();
+    for v in box_vertices() {
+        for c in v {
+            bytes.extend(c.to_le_bytes());
+        }
+    }
+    for q in QUADS {
+        bytes.push(4);
+        for i in q {
+            bytes.extend((i as i32).to_le_bytes());
+        }
+    }
+    bytes
+}
+
+#[test]
+fn bad_mesh_files_are_errors_naming_the_file() {
+    let check = |name: &str, bytes: Vec<u8>, expected: &str| {
+        let path = scratch(name);
+        std::fs::write(&path, bytes).unwrap();
+        let e = load(path.to_str().unwrap()).expect_err(name);
+        let msg = e.to_string();
+        assert!(msg.contains(name), "{msg}");
+        assert!(
+            msg.to_lowercase().contains(expected),
+            "expected '{expected}' in: {msg}"
+        );
+    };
+    // Truncated binary PLY, and one whose header declares far more faces than it holds.
+    let full = binary_box(6);
+    check("truncated.ply", full[..full.len() - 7].to_vec(), "ply");
+    check("huge.ply", binary_box(4_000_000_000), "ply");
+    let mut nan = ply_header("binary_little_endian", 3, 1).into_bytes();
+    for c in [0.0f32, 0.0, 0.0, 1.0, 0.0, f32::NAN, 0.0, 1.0, 0.0] {
+        nan.extend(c.to_le_bytes());
+    }
+    nan.push(3);
+    for i in [0i32, 1, 2] {
+        nan.extend(i.to_le_bytes());
+    }
+    check("nan.ply", nan, "finite");
+    let mut text_nan = ply_header("ascii", 3, 1);
+    text_nan += "0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n";
+    check("text_nan.ply", text_nan.into_bytes(), "line 11");
+    let mut range = ply_header("ascii", 3, 1);
+    range += "0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n";
+    check("range.ply", range.into_bytes(), "out of range");
+    check(
+        "range.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n".to_vec(),
+        "obj",
+    );
+    check("empty.obj", b"# nothing\n".to_vec(), "no geometry");
+    let missing = load("/no/such/mesh.ply").unwrap_err();
+    assert!(matches!(missing, Error::Io { .. }), "{missing}");
+    let unknown = load("scene.fbx").unwrap_err();
+    assert!(unknown.to_string().contains("unknown scene format"));
+}
