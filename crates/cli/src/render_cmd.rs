@@ -47,17 +47,17 @@ pub struct RenderArgs {
     /// The scene: a file (.dae, .obj, .ply) or a built-in scene's name (cornell-box).
     #[arg(default_value = "cornell-box")]
     pub scene: String,
-    /// Samples per pixel.
-    #[arg(short = 's', long, default_value_t = 64)]
-    pub spp: u32,
+    /// Samples per pixel (default: the scene file's, else 64).
+    #[arg(short = 's', long)]
+    pub spp: Option<u32>,
     /// Light samples per surface point (direct lighting: directions or light points per pixel
     /// sample).
     #[arg(short = 'l', long, default_value_t = 1)]
     pub light_samples: u32,
     /// Largest bounce: 0 = light seen directly, 1 = direct lighting, 2 = one indirect bounce,
-    /// ..., inf = unbounded (with Russian roulette).
-    #[arg(short = 'm', long, default_value = "inf")]
-    pub max_depth: String,
+    /// ..., inf = unbounded (with Russian roulette). Default: the scene file's, else inf.
+    #[arg(short = 'm', long)]
+    pub max_depth: Option<String>,
     /// First bounce at which Russian roulette may end a path.
     #[arg(long, default_value_t = 5)]
     pub rr_depth: u32,
@@ -135,8 +135,8 @@ static CANCEL: AtomicBool = AtomicBool::new(false);
 
 /// Runs `pathlab render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let max_depth = parse_max_depth(&args.max_depth)?;
-    if args.spp == 0 {
+    let cli_depth = args.max_depth.as_deref().map(parse_max_depth).transpose()?;
+    if args.spp == Some(0) {
         bail!("--spp must be at least 1");
     }
     if args.light_samples == 0 {
@@ -156,6 +156,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             eprintln!("warning: {w}");
         }
     }
+    let spp = args.spp.or(desc.hints.spp).unwrap_or(64);
+    let max_depth = cli_depth.or(desc.hints.max_depth).unwrap_or(u32::MAX);
     if let Some(r) = &args.resolution {
         let (w, h) = (r[0], r[1]);
         if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
@@ -179,7 +181,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         IntegratorName::Depth => IntegratorKind::Debug(DebugView::Depth),
         IntegratorName::Bvh => IntegratorKind::Debug(DebugView::BvhHeat),
     };
-    let mut settings = RenderSettings::new(args.spp, args.seed, args.sampler);
+    let mut settings = RenderSettings::new(spp, args.seed, args.sampler);
     if let Some(c) = &args.crop {
         let [w, h] = desc.resolution;
         if c[0] >= c[2] || c[1] >= c[3] || c[2] > w || c[3] > h {
@@ -196,7 +198,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let [w, h] = desc.resolution;
     let total = settings.crop.map_or(w as u64 * h as u64, |c| {
         (c[2] - c[0]) as u64 * (c[3] - c[1]) as u64
-    }) * args.spp as u64;
+    }) * spp as u64;
     let bar = if args.quiet || !std::io::stderr().is_terminal() {
         ProgressBar::hidden()
     } else {
@@ -235,7 +237,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "scene": args.scene,
             "output": output,
             "resolution": [w, h],
-            "spp": args.spp,
+            "spp": spp,
             "integrator": format!("{:?}", args.integrator).to_lowercase(),
             "max_depth": if max_depth == u32::MAX { json!("inf") } else { json!(max_depth) },
             "threads": threads,
@@ -258,7 +260,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             args.scene,
             w,
             h,
-            args.spp,
+            spp,
             stats.seconds,
             stats.samples as f64 / stats.seconds.max(1e-9),
             stats.rays as f64 / stats.seconds.max(1e-9),

@@ -40,6 +40,8 @@ impl Camera {
                     FovAxis::X => w,
                     FovAxis::Y => h,
                     FovAxis::Smaller => w.min(h),
+                    FovAxis::Larger => w.max(h),
+                    FovAxis::Diagonal => (w * w + h * h).sqrt(),
                 },
             ),
         };

@@ -28,6 +28,17 @@ pub struct SceneDesc {
     pub resolution: [u32; 2],
     /// What the loader noticed and worked around (unsupported features, missing textures).
     pub warnings: Vec<String>,
+    /// Render settings the scene file asks for (command-line flags take precedence).
+    pub hints: RenderHints,
+}
+
+/// Render settings a scene file can suggest.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderHints {
+    /// Samples per pixel.
+    pub spp: Option<u32>,
+    /// Largest bounce in pathlab's counting (`u32::MAX`: unbounded).
+    pub max_depth: Option<u32>,
 }
 
 /// Which rays see a shape.
@@ -204,9 +215,13 @@ pub enum FovAxis {
     X,
     /// Vertical.
     Y,
-    /// The smaller of the two image dimensions (Mitsuba's default).
+    /// The smaller of the two image dimensions.
     #[default]
     Smaller,
+    /// The larger of the two image dimensions.
+    Larger,
+    /// The image diagonal.
+    Diagonal,
 }
 
 /// A perspective camera (pinhole when `lens_radius` is zero).

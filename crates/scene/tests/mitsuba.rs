@@ -1,0 +1,177 @@
+//! Mitsuba 3 XML: the reference Cornell box's own scene.xml gives the built-in Cornell box's
+//! image (statistically), and malformed files give located errors.
+
+use glam::DVec3;
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_mc::stats::z_test_two_sample;
+use pathlab_render::desc::SceneDesc;
+use pathlab_render::film::Film;
+use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
+use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::scene::Scene;
+use pathlab_scene::{builtin, info, mitsuba, Error};
+use std::path::{Path, PathBuf};
+
+fn scene_xml() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-box/scene.xml")
+}
+
+fn run(desc: &SceneDesc, seed: u64) -> Film {
+    let scene = Scene::build(desc).unwrap();
+    let integrator = IntegratorKind::Path(PathIntegrator::default());
+    render(
+        &scene,
+        &integrator,
+        &RenderSettings::new(64, seed, SamplerKind::Independent),
+        &|_| {},
+        &Default::default(),
+    )
+    .0
+}
+
+#[test]
+fn scene_xml_reads_the_cornell_box() {
+    let xml = mitsuba::load(&scene_xml()).unwrap();
+    let built = builtin::cornell_box().unwrap();
+    let (a, b) = (info::summarize(&xml), info::summarize(&built));
+    assert_eq!(a.triangles, 36);
+    assert_eq!(a.bounds, b.bounds);
+    assert_eq!(xml.resolution, [256, 256]);
+    assert_eq!(xml.hints.spp, Some(256));
+    assert_eq!(xml.hints.max_depth, Some(u32::MAX)); // Mitsuba's -1
+    assert_eq!(xml.camera.origin, built.camera.origin);
+    assert!(xml.warnings.is_empty(), "{:?}", xml.warnings);
+}
+
+#[test]
+fn scene_xml_renders_the_built_in_image() {
+    let xml = run(&mitsuba::load(&scene_xml()).unwrap(), 1);
+    let built = run(&builtin::cornell_box().unwrap(), 2);
+    // 8 x 8 blocks (each mean averages 64 pixels' samples) and the image mean, two-sample z.
+    let w = 256usize;
+    let mut outliers = 0;
+    for by in 0..32 {
+        for bx in 0..32 {
+            let (mut d, mut v) = (DVec3::ZERO, DVec3::ZERO);
+            for y in by * 8..by * 8 + 8 {
+                for x in bx * 8..bx * 8 + 8 {
+                    let (p, q) = (&xml.pixels()[y * w + x], &built.pixels()[y * w + x]);
+                    d += p.mean() - q.mean();
+                    v += p.variance_of_mean() + q.variance_of_mean();
+                }
+            }
+            for c in 0..3 {
+                outliers += (d[c].abs() > 4.0 * v[c].sqrt()) as usize;
+            }
+        }
+    }
+    assert!(
+        outliers <= 3,
+        "{outliers} block channels beyond 4 sigma of 3072"
+    );
+    let (ma, mb) = (xml.image_mean(), built.image_mean());
+    let (sa, sb) = (xml.image_mean_std_error(), built.image_mean_std_error());
+    for c in 0..3 {
+        let z = z_test_two_sample(ma[c], sa[c], mb[c], sb[c]);
+        assert!(
+            z.within(3.0),
+            "channel {c}: {} vs {} (z {})",
+            ma[c],
+            mb[c],
+            z.z
+        );
+    }
+}
+
+fn write(name: &str, text: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mitsuba-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn defaults_includes_and_shapes() {
+    write(
+        "inc.xml",
+        r#"<scene version="3.0.0"><bsdf type="twosided" id="w"><bsdf type="diffuse"><rgb name="reflectance" value="0.2 0.4 0.6"/></bsdf></bsdf></scene>"#,
+    );
+    let main = write(
+        "main.xml",
+        r#"<scene version="3.0.0">
+  <default name="res" value="32"/>
+  <include filename="inc.xml"/>
+  <sensor type="thinlens"><float name="fov" value="45"/><float name="aperture_radius" value="0.1"/>
+    <float name="focus_distance" value="4"/>
+    <transform name="to_world"><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="$res"/><integer name="height" value="$res"/></film>
+  </sensor>
+  <shape type="cube"><transform name="to_world"><scale value="0.5"/><translate x="1"/></transform><ref id="w"/></shape>
+  <shape type="sphere"><float name="radius" value="0.25"/><bsdf type="diffuse"/></shape>
+  <shape type="disk"><emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>
+  <emitter type="constant"><rgb name="radiance" value="0.1"/></emitter>
+  <emitter type="point"><point name="position" x="0" y="3" z="0"/><rgb name="intensity" value="5"/></emitter>
+</scene>"#,
+    );
+    let desc = mitsuba::load(&main).unwrap();
+    assert_eq!(desc.resolution, [32, 32]);
+    assert!((desc.camera.lens_radius - 0.1).abs() < 1e-6);
+    let s = info::summarize(&desc);
+    assert_eq!((s.triangles, s.spheres), (12 + 64, 1));
+    let (lo, hi) = s.bounds.unwrap();
+    assert!((hi.x - 1.5).abs() < 1e-5 && (lo.x + 1.0).abs() < 1e-5);
+    assert_eq!(desc.point_lights.len(), 1);
+    assert!(desc.environment.is_some());
+    let film = run(&desc, 3);
+    assert!(film.image_mean().max_element() > 1e-3 && film.image_mean().is_finite());
+}
+
+#[test]
+fn malformed_xml_gives_located_errors() {
+    let cases = [
+        (
+            r#"<scene><shape type="rectangle"><ref id="nope"/></shape></scene>"#,
+            "undefined BSDF id 'nope'",
+        ),
+        (
+            r#"<scene><sensor type="perspective"><film type="hdrfilm"><integer name="width" value="$w"/></film></sensor></scene>"#,
+            "'$w' has no <default>",
+        ),
+        (
+            r#"<scene><shape type="rectangle"><transform name="to_world"><translate x="NaN"/></transform></shape></scene>"#,
+            "finite number",
+        ),
+        (
+            r#"<scene><shape type="rectangle"><transform name="to_world"><matrix value="1 2 3"/></transform></shape></scene>"#,
+            "16 numbers",
+        ),
+        (r#"<scene><shape type="rectangle">"#, "malformed XML"),
+        (r#"<notscene/>"#, "expected a <scene>"),
+        (
+            r#"<scene><include filename="missing.xml"/></scene>"#,
+            "missing.xml",
+        ),
+        (
+            r#"<scene><include filename="loop.xml"/></scene>"#,
+            "nest too deeply",
+        ),
+    ];
+    for (i, (text, expected)) in cases.into_iter().enumerate() {
+        let path = if expected == "nest too deeply" {
+            write("loop.xml", text)
+        } else {
+            write(&format!("bad{i}.xml"), text)
+        };
+        let e = mitsuba::load(&path).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains(expected), "expected '{expected}' in: {msg}");
+        if let Error::Parse { line, .. } = e {
+            assert!(line >= 1);
+        }
+    }
+    assert!(matches!(
+        mitsuba::load(Path::new("/no/scene.xml")),
+        Err(Error::Io { .. })
+    ));
+}
