@@ -2,7 +2,8 @@
 //!
 //! Turns scene sources into the renderer's plain [`SceneDesc`]: the built-in scenes
 //! ([`builtin`], compiled into the binary) and files: the CS184 course's COLLADA scenes
-//! ([`collada`]), Mitsuba 3 XML ([`mitsuba`]), OBJ and PLY meshes ([`meshfile`]). [`load`] picks the loader by extension; every loader returns an [`Error`]
+//! ([`collada`]), Mitsuba 3 XML ([`mitsuba`]), OBJ and PLY meshes ([`meshfile`]), glTF 2.0
+//! ([`gltf_scene`]). [`load`] picks the loader by extension; every loader returns an [`Error`]
 //! naming the file, the line and column, and what was expected.
 //!
 //! ```
@@ -14,6 +15,7 @@
 
 pub mod builtin;
 pub mod collada;
+pub mod gltf_scene;
 pub mod info;
 pub mod meshfile;
 pub mod mitsuba;
@@ -57,7 +59,7 @@ pub enum Error {
         message: String,
     },
     /// The file's extension names no format pathlab reads.
-    #[error("{path}: unknown scene format (expected .dae, .xml, .obj or .ply, or a built-in scene name: {known})")]
+    #[error("{path}: unknown scene format (expected .dae, .xml, .obj, .ply, .gltf or .glb, or a built-in scene name: {known})")]
     UnknownFormat {
         /// The file.
         path: String,
@@ -88,6 +90,7 @@ pub fn load(source: &str) -> Result<SceneDesc, Error> {
         Some("obj") => meshfile::load_obj(path),
         Some("ply") => meshfile::load_ply(path),
         Some("xml") => mitsuba::load(path),
+        Some("gltf") | Some("glb") => gltf_scene::load(path),
         None if builtin::NAMES.contains(&source) => builtin::load(source),
         None if !path.exists() => builtin::load(source),
         _ => Err(Error::UnknownFormat {

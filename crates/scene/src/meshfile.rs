@@ -264,12 +264,36 @@ pub fn load_ply(path: &Path) -> Result<SceneDesc, Error> {
 
 /// Adds the default camera, resolution and (when nothing emits) lights of a standalone mesh.
 fn standalone(path: &Path, mut desc: SceneDesc) -> Result<SceneDesc, Error> {
+    desc.camera = framing_camera(path, &desc)?;
+    desc.resolution = DEFAULT_RESOLUTION;
+    if !desc.meshes.iter().any(|m| m.emission.is_some()) {
+        add_default_lights(&mut desc);
+    }
+    Ok(desc)
+}
+
+/// A uniform sky and a key light from the upper left, for scenes that bring no light.
+pub(crate) fn add_default_lights(desc: &mut SceneDesc) {
+    desc.environment = Some(Vec3::splat(0.5));
+    desc.directional_lights.push(DirectionalLightDesc {
+        direction: Vec3::new(0.5, -1.0, -0.6).normalize(),
+        irradiance: Vec3::splat(2.0),
+    });
+}
+
+/// A camera that frames the bounding box of all shapes from the front, slightly above and to
+/// the right, with a 40° vertical field of view.
+pub(crate) fn framing_camera(path: &Path, desc: &SceneDesc) -> Result<CameraDesc, Error> {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for m in &desc.meshes {
         for &p in &m.positions {
             lo = lo.min(p);
             hi = hi.max(p);
         }
+    }
+    for s in &desc.spheres {
+        lo = lo.min(s.center - Vec3::splat(s.radius));
+        hi = hi.max(s.center + Vec3::splat(s.radius));
     }
     if lo.x > hi.x {
         return Err(Error::Parse {
@@ -285,7 +309,7 @@ fn standalone(path: &Path, mut desc: SceneDesc) -> Result<SceneDesc, Error> {
     // Far enough that the bounding sphere fits the vertical field of view, with a margin.
     let distance = 1.1 * radius / (0.5 * fov).to_radians().sin();
     let dir = Vec3::new(0.35, 0.3, 1.0).normalize();
-    desc.camera = CameraDesc {
+    Ok(CameraDesc {
         origin: center + dir * distance,
         target: center,
         up: Vec3::Y,
@@ -294,14 +318,5 @@ fn standalone(path: &Path, mut desc: SceneDesc) -> Result<SceneDesc, Error> {
         lens_radius: 0.0,
         focal_distance: distance,
         focal_pixels: None,
-    };
-    desc.resolution = DEFAULT_RESOLUTION;
-    if !desc.meshes.iter().any(|m| m.emission.is_some()) {
-        desc.environment = Some(Vec3::splat(0.5));
-        desc.directional_lights.push(DirectionalLightDesc {
-            direction: Vec3::new(0.5, -1.0, -0.6).normalize(),
-            irradiance: Vec3::splat(2.0),
-        });
-    }
-    Ok(desc)
+    })
 }

@@ -169,3 +169,92 @@ fn bad_mesh_files_are_errors_naming_the_file() {
     let unknown = load("scene.fbx").unwrap_err();
     assert!(unknown.to_string().contains("unknown scene format"));
 }
+
+/// A glTF with the test box as an indexed mesh under a translated node, a camera and a point
+/// light; its buffer in a separate .bin file.
+fn write_gltf(name: &str, translate_x: f32, bad_index: bool) -> PathBuf {
+    let mut bin = Vec::new();
+    for v in box_vertices() {
+        for c in v {
+            bin.extend(c.to_le_bytes());
+        }
+    }
+    let mut tris: Vec<u16> = Vec::new();
+    for q in QUADS {
+        tris.extend([
+            q[0] as u16,
+            q[1] as u16,
+            q[2] as u16,
+            q[0] as u16,
+            q[2] as u16,
+            q[3] as u16,
+        ]);
+    }
+    if bad_index {
+        tris[5] = 40;
+    }
+    for i in &tris {
+        bin.extend(i.to_le_bytes());
+    }
+    let bin_name = format!("{name}.bin");
+    std::fs::write(scratch(&bin_name), &bin).unwrap();
+    let json = format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "extensionsUsed": ["KHR_lights_punctual"],
+  "extensions": {{"KHR_lights_punctual": {{"lights": [{{"type": "point", "color": [1, 1, 1], "intensity": 20}}]}}}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0, 1, 2]}}],
+  "nodes": [
+    {{"mesh": 0, "translation": [{translate_x}, 0, 0]}},
+    {{"camera": 0, "translation": [0, 0.5, 8]}},
+    {{"translation": [0, 4, 2], "extensions": {{"KHR_lights_punctual": {{"light": 0}}}}}}
+  ],
+  "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.8, "aspectRatio": 1.5, "znear": 0.1}}}}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.2, 0.7, 0.3, 1], "metallicFactor": 0}}}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 0}}]}}],
+  "buffers": [{{"uri": "{bin_name}", "byteLength": {len}}}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 96}},
+    {{"buffer": 0, "byteOffset": 96, "byteLength": 72}}
+  ],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [-1, 0, -3], "max": [2, 1, 0.5]}},
+    {{"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"}}
+  ]
+}}"#,
+        len = bin.len()
+    );
+    let path = scratch(&format!("{name}.gltf"));
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+#[test]
+fn gltf_round_trips_and_renders() {
+    let path = write_gltf("box", 0.0, false);
+    check_box(path.to_str().unwrap(), false);
+    let desc = load(path.to_str().unwrap()).unwrap();
+    assert_eq!(desc.point_lights.len(), 1);
+    assert_eq!(desc.camera.origin, Vec3::new(0.0, 0.5, 8.0));
+    assert_eq!(desc.resolution, [720, 480]);
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    // Node transforms apply.
+    let moved = load(write_gltf("moved", 3.0, false).to_str().unwrap()).unwrap();
+    let (lo, _) = info::summarize(&moved).bounds.unwrap();
+    assert_eq!(lo.x, 2.0);
+    // Bad input names the file.
+    let bad = write_gltf("bad", 0.0, true);
+    let msg = load(bad.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        msg.contains("bad.gltf") && msg.contains("out of range"),
+        "{msg}"
+    );
+    let garbage = scratch("garbage.gltf");
+    std::fs::write(&garbage, "{ not json").unwrap();
+    let msg = load(garbage.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        msg.contains("garbage.gltf") && msg.contains("glTF"),
+        "{msg}"
+    );
+}

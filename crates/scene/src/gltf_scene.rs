@@ -1,0 +1,226 @@
+//! glTF 2.0 (`.gltf` with its buffers, or `.glb`), via the `gltf` crate: triangle meshes with
+//! their node transforms, the first perspective camera, metallic-roughness materials mapped to
+//! the closest BSDF (base colour → diffuse; metallic → conductor with that normal-incidence
+//! reflectance), emissive materials as area lights, and `KHR_lights_punctual` point, spot and
+//! directional lights. Without a camera or lights, the defaults of standalone meshes apply.
+
+use crate::meshfile::{add_default_lights, framing_camera, DEFAULT_RESOLUTION};
+use crate::Error;
+use glam::{Mat4, Vec2, Vec3};
+use gltf::khr_lights_punctual::Kind;
+use pathlab_render::desc::*;
+use std::path::Path;
+
+/// Loads a glTF 2.0 file.
+pub fn load(path: &Path) -> Result<SceneDesc, Error> {
+    let err = |message: String| Error::Parse {
+        path: path.display().to_string(),
+        line: 0,
+        column: 0,
+        message,
+    };
+    let (doc, buffers, _images) = gltf::import(path).map_err(|e| match e {
+        gltf::Error::Io(io) => Error::io(path, io),
+        other => err(format!("not a valid glTF file: {other}")),
+    })?;
+    let mut desc = SceneDesc {
+        resolution: DEFAULT_RESOLUTION,
+        ..Default::default()
+    };
+    let mut camera = None;
+    let scene = doc
+        .default_scene()
+        .or_else(|| doc.scenes().next())
+        .ok_or_else(|| err("the file has no scene".into()))?;
+    let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    let mut visited = 0usize;
+    while let Some((node, parent)) = stack.pop() {
+        visited += 1;
+        if visited > 1_000_000 {
+            return Err(err("node hierarchy is too large or cyclic".into()));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(err(format!(
+                "node {} has a non-finite transform",
+                node.index()
+            )));
+        }
+        if let Some(mesh) = node.mesh() {
+            for (k, prim) in mesh.primitives().enumerate() {
+                if prim.mode() != gltf::mesh::Mode::Triangles {
+                    desc.warnings.push(format!(
+                        "mesh {}: primitive {k} is not triangles; skipped",
+                        mesh.index()
+                    ));
+                    continue;
+                }
+                let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+                let positions: Vec<Vec3> = reader
+                    .read_positions()
+                    .ok_or_else(|| {
+                        err(format!(
+                            "mesh {}: primitive {k} has no positions",
+                            mesh.index()
+                        ))
+                    })?
+                    .map(|p| world.transform_point3(Vec3::from_array(p)))
+                    .collect();
+                if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+                    return Err(err(format!(
+                        "mesh {}: a position is not finite: {p}",
+                        mesh.index()
+                    )));
+                }
+                let indices: Vec<u32> = match reader.read_indices() {
+                    Some(i) => i.into_u32().collect(),
+                    None => (0..positions.len() as u32).collect(),
+                };
+                if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                    return Err(err(format!(
+                        "mesh {}: index {bad} out of range ({} vertices)",
+                        mesh.index(),
+                        positions.len()
+                    )));
+                }
+                let normal_matrix = world.inverse().transpose();
+                let normals = reader
+                    .read_normals()
+                    .map(|n| {
+                        n.map(|n| {
+                            normal_matrix
+                                .transform_vector3(Vec3::from_array(n))
+                                .normalize_or_zero()
+                        })
+                        .collect()
+                    })
+                    .unwrap_or_default();
+                let uvs = reader
+                    .read_tex_coords(0)
+                    .map(|t| t.into_f32().map(Vec2::from_array).collect())
+                    .unwrap_or_default();
+                let m = prim.material();
+                let pbr = m.pbr_metallic_roughness();
+                let base = Vec3::from_slice(&pbr.base_color_factor()[..3]);
+                if pbr.base_color_texture().is_some() {
+                    desc.warnings.push(format!(
+                        "material {}: base-colour textures are not rendered yet; using the base colour factor",
+                        m.index().map_or("default".into(), |i| i.to_string())
+                    ));
+                }
+                let material = if pbr.metallic_factor() > 0.5 {
+                    // A conductor whose normal-incidence reflectance is the base colour.
+                    let s = base.clamp(Vec3::ZERO, Vec3::splat(0.999)).map(f32::sqrt);
+                    MaterialDesc::Conductor {
+                        alpha: pbr.roughness_factor() * pbr.roughness_factor(),
+                        eta: (Vec3::ONE + s) / (Vec3::ONE - s),
+                        k: Vec3::ZERO,
+                    }
+                } else {
+                    MaterialDesc::Diffuse {
+                        reflectance: base.clamp(Vec3::ZERO, Vec3::ONE),
+                        two_sided: m.double_sided(),
+                    }
+                };
+                let emission =
+                    Vec3::from_array(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+                desc.materials.push(material);
+                desc.meshes.push(MeshDesc {
+                    name: mesh.name().unwrap_or("mesh").to_string(),
+                    positions,
+                    indices,
+                    material: desc.materials.len() - 1,
+                    emission: (emission.max_element() > 0.0).then_some(Emission {
+                        radiance: emission,
+                        two_sided: false,
+                    }),
+                    normals,
+                    uvs,
+                    visibility: Visibility::ALL,
+                });
+            }
+        }
+        if let (Some(cam), None) = (node.camera(), &camera) {
+            if let gltf::camera::Projection::Perspective(p) = cam.projection() {
+                let origin = world.transform_point3(Vec3::ZERO);
+                let forward = world
+                    .transform_vector3(Vec3::NEG_Z)
+                    .normalize_or(Vec3::NEG_Z);
+                camera = Some((
+                    CameraDesc {
+                        origin,
+                        target: origin + forward,
+                        up: world.transform_vector3(Vec3::Y).normalize_or(Vec3::Y),
+                        fov_degrees: p.yfov().to_degrees(),
+                        fov_axis: FovAxis::Y,
+                        lens_radius: 0.0,
+                        focal_distance: 1.0,
+                        focal_pixels: None,
+                    },
+                    p.aspect_ratio(),
+                ));
+            }
+        }
+        if let Some(light) = node.light() {
+            let color = Vec3::from_array(light.color()) * light.intensity();
+            let position = world.transform_point3(Vec3::ZERO);
+            let direction = world
+                .transform_vector3(Vec3::NEG_Z)
+                .normalize_or(Vec3::NEG_Z);
+            match light.kind() {
+                Kind::Point => desc.point_lights.push(PointLightDesc {
+                    position,
+                    intensity: color,
+                    attenuation: INVERSE_SQUARE,
+                }),
+                Kind::Directional => desc.directional_lights.push(DirectionalLightDesc {
+                    direction,
+                    irradiance: color,
+                }),
+                Kind::Spot {
+                    outer_cone_angle, ..
+                } => desc.spot_lights.push(SpotLightDesc {
+                    position,
+                    direction,
+                    intensity: color,
+                    cutoff_degrees: outer_cone_angle.to_degrees(),
+                    exponent: 0.0,
+                    attenuation: INVERSE_SQUARE,
+                }),
+            }
+        }
+        stack.extend(node.children().map(|c| (c, world)));
+    }
+    if desc
+        .materials
+        .iter()
+        .any(|m| !pathlab_render::bsdf::is_supported(m))
+    {
+        desc.warnings.push(
+            "metallic materials are drawn as diffuse stand-ins until the conductor BSDF exists"
+                .into(),
+        );
+    }
+    match camera {
+        Some((c, aspect)) => {
+            desc.camera = c;
+            if let Some(a) = aspect.filter(|a| *a > 0.0 && a.is_finite()) {
+                desc.resolution = [
+                    (DEFAULT_RESOLUTION[1] as f32 * a).round().max(1.0) as u32,
+                    DEFAULT_RESOLUTION[1],
+                ];
+            }
+        }
+        None => desc.camera = framing_camera(path, &desc)?,
+    }
+    let lit = !desc.point_lights.is_empty()
+        || !desc.spot_lights.is_empty()
+        || !desc.directional_lights.is_empty()
+        || desc.meshes.iter().any(|m| m.emission.is_some());
+    if !lit {
+        add_default_lights(&mut desc);
+        desc.warnings
+            .push("the scene has no lights: lit by a default sky and key light".into());
+    }
+    Ok(desc)
+}
