@@ -5,7 +5,7 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::film::Film;
-use pathlab_render::image_io::{write_exr, write_png, ExtraChannel};
+use pathlab_render::image_io::{write_exr, write_png_with, ExtraChannel, ToneMap};
 use pathlab_render::integrator::{
     DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
 };
@@ -30,6 +30,15 @@ pub enum IntegratorName {
     Depth,
     /// Debug view: BVH nodes visited per camera ray.
     Bvh,
+}
+
+/// PNG tone maps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ToneMapName {
+    /// Exposure, clamp, sRGB transfer function.
+    Srgb,
+    /// The CS184 course's renderer: clamp((√2 c)^(1/2.2)).
+    Cs184,
 }
 
 /// Extra outputs.
@@ -91,6 +100,9 @@ pub struct RenderArgs {
     /// Exposure in stops applied before PNG encoding.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
+    /// PNG encoding: srgb, or cs184 (the course's one stop of exposure and gamma 2.2).
+    #[arg(long, value_enum, default_value_t = ToneMapName::Srgb)]
+    pub tonemap: ToneMapName,
     /// Extra outputs, comma-separated: variance, samples (EXR channels, or files next to a PNG).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub aov: Vec<Aov>,
@@ -317,7 +329,11 @@ fn write_outputs(
             write_exr(output, w, h, &mean, &extra)?;
         }
         OutputFormat::Png => {
-            write_png(output, w, h, &mean, args.exposure)?;
+            let tone = match args.tonemap {
+                ToneMapName::Srgb => ToneMap::Srgb,
+                ToneMapName::Cs184 => ToneMap::Cs184,
+            };
+            write_png_with(output, w, h, &mean, args.exposure, tone)?;
             let stem = output.with_extension("");
             if let Some(v) = &variance {
                 write_exr(

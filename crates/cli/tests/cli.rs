@@ -546,3 +546,63 @@ fn bad_render_flags_are_one_line_errors() {
         "nonexistent-dir",
     );
 }
+
+fn course_scene(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scene/tests/data/cs184")
+        .join(name)
+        .to_str()
+        .unwrap()
+        .to_string()
+}
+
+#[test]
+fn info_and_render_read_scene_files() {
+    let bunny = course_scene("CBbunny.dae");
+    let v = json_of(&pathlab(&["info", &bunny, "--json"]));
+    assert_eq!(v["triangles"], 28_588);
+    assert_eq!(v["camera"]["resolution"], serde_json::json!([800, 600]));
+    assert!(v["lights"]
+        .as_object()
+        .unwrap()
+        .contains_key("area (parallelogram)"));
+    let out = scratch("spheres.png");
+    let stats = json_of(&pathlab(&[
+        "render",
+        &course_scene("CBspheres.dae"),
+        "-s",
+        "2",
+        "-r",
+        "40",
+        "30",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_image_at_least(&out, true, 100);
+    let mean = stats["image_mean_rgb"].as_array().unwrap();
+    assert!(mean.iter().all(|m| m.as_f64().unwrap() > 0.0));
+    let text =
+        String::from_utf8(pathlab(&["info", &course_scene("CBspheres.dae")]).stdout).unwrap();
+    assert!(
+        text.contains("2 spheres") && text.contains("warning"),
+        "{text}"
+    );
+}
+
+#[test]
+fn bad_scene_files_are_short_errors() {
+    let bad = scratch("broken.dae");
+    std::fs::write(
+        &bad,
+        "<COLLADA><library_geometries><geometry id=\"g\"><mesh>",
+    )
+    .unwrap();
+    let out = pathlab(&["render", bad.to_str().unwrap(), "-s", "1"]);
+    assert_one_line_error(&out, "broken.dae:1:");
+    assert_one_line_error(
+        &pathlab(&["info", "/no/such/file.dae"]),
+        "/no/such/file.dae",
+    );
+    assert_one_line_error(&pathlab(&["info", "model.fbx"]), "unknown scene format");
+}

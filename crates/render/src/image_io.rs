@@ -100,7 +100,35 @@ pub fn srgb_encode(v: f32) -> f32 {
     }
 }
 
-/// Writes `rgb` as an 8-bit sRGB PNG after scaling by 2^`exposure` and clamping to [0, 1].
+/// How linear radiance becomes 8-bit PNG values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ToneMap {
+    /// Scale by 2^exposure, clamp to [0, 1], sRGB transfer function.
+    #[default]
+    Srgb,
+    /// The CS184 course's images: clamp((√2 · 2^exposure · c)^(1/2.2), 0, 1), i.e. one stop
+    /// of exposure and gamma 2.2.
+    Cs184,
+}
+
+impl ToneMap {
+    /// The encoded value in [0, 1] of a linear value, after `scale` (2^exposure).
+    #[inline]
+    pub fn encode(self, v: f32, scale: f32) -> f32 {
+        if !v.is_finite() {
+            return 0.0;
+        }
+        match self {
+            ToneMap::Srgb => srgb_encode((v * scale).clamp(0.0, 1.0)),
+            ToneMap::Cs184 => (std::f32::consts::SQRT_2 * scale * v)
+                .max(0.0)
+                .powf(1.0 / 2.2)
+                .min(1.0),
+        }
+    }
+}
+
+/// Writes `rgb` as an 8-bit PNG after scaling by 2^`exposure`, with the sRGB transfer function.
 pub fn write_png(
     path: &Path,
     width: u32,
@@ -108,18 +136,23 @@ pub fn write_png(
     rgb: &[Rgb],
     exposure: f32,
 ) -> std::result::Result<(), ImageError> {
+    write_png_with(path, width, height, rgb, exposure, ToneMap::Srgb)
+}
+
+/// Writes `rgb` as an 8-bit PNG after scaling by 2^`exposure` and the tone map `tone`.
+pub fn write_png_with(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[Rgb],
+    exposure: f32,
+    tone: ToneMap,
+) -> std::result::Result<(), ImageError> {
     let scale = exposure.exp2();
     let bytes: Vec<u8> = rgb
         .iter()
         .flat_map(|c| c.to_array())
-        .map(|v| {
-            let v = if v.is_finite() {
-                (v * scale).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (srgb_encode(v) * 255.0 + 0.5) as u8
-        })
+        .map(|v| (tone.encode(v, scale) * 255.0 + 0.5) as u8)
         .collect();
     image::save_buffer(path, &bytes, width, height, image::ExtendedColorType::Rgb8).map_err(|e| {
         ImageError::Png {
@@ -127,4 +160,53 @@ pub fn write_png(
             message: e.to_string(),
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tone_maps() {
+        // sRGB: linear 0.5 encodes to 0.7354; the curve is continuous at its knee.
+        assert!((ToneMap::Srgb.encode(0.5, 1.0) - 0.735_357).abs() < 1e-5);
+        assert!((srgb_encode(0.003_130_8) - 12.92 * 0.003_130_8).abs() < 1e-6);
+        assert!((srgb_encode(0.003_130_81) - srgb_encode(0.003_130_79)).abs() < 1e-6);
+        // The course's: (√2 · 0.5)^(1/2.2).
+        let expected = (std::f32::consts::SQRT_2 * 0.5).powf(1.0 / 2.2);
+        assert!((ToneMap::Cs184.encode(0.5, 1.0) - expected).abs() < 1e-6);
+        assert_eq!(ToneMap::Cs184.encode(10.0, 1.0), 1.0);
+        assert_eq!(ToneMap::Srgb.encode(f32::NAN, 1.0), 0.0);
+        // One stop of exposure doubles the linear value.
+        assert_eq!(
+            ToneMap::Srgb.encode(0.25, 2.0),
+            ToneMap::Srgb.encode(0.5, 1.0)
+        );
+    }
+
+    #[test]
+    fn exr_round_trip_with_extra_channels() {
+        let dir = std::env::temp_dir().join(format!("pathlab-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.exr");
+        let rgb: Vec<Rgb> = (0..12)
+            .map(|i| Rgb::new(i as f32, 0.5 * i as f32, 1e-3))
+            .collect();
+        let extra = vec![1.0f32; 12];
+        write_exr(
+            &path,
+            4,
+            3,
+            &rgb,
+            &[ExtraChannel {
+                name: "samples.Y".into(),
+                values: &extra,
+            }],
+        )
+        .unwrap();
+        let (w, h, back) = read_exr_rgb(&path).unwrap();
+        assert_eq!((w, h), (4, 3));
+        assert_eq!(back, rgb);
+        let _ = std::fs::remove_dir_all(dir);
+    }
 }
