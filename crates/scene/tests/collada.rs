@@ -212,3 +212,34 @@ fn malformed_files_give_located_errors() {
         matches!(missing, Error::Io { .. }) && missing.to_string().contains("/no/such/scene.dae")
     );
 }
+
+#[test]
+fn polygons_and_transform_elements() {
+    // A unit square as one <polygons> quad, under translate/rotate/scale, Y up (no entry
+    // rotation): scale 2, rotate 90° about z, translate (10, 0, 0).
+    let text = r##"<?xml version="1.0"?>
+<COLLADA version="1.4.1"><asset><up_axis>Y_UP</up_axis></asset>
+<library_geometries><geometry id="g"><mesh>
+<source id="pos"><float_array id="pa" count="12">0 0 0 1 0 0 1 1 0 0 1 0</float_array>
+<technique_common><accessor source="#pa" count="4" stride="3"/></technique_common></source>
+<vertices id="v"><input semantic="POSITION" source="#pos"/></vertices>
+<polygons count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2 3</p></polygons>
+</mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="s"><node id="n">
+<translate>10 0 0</translate><rotate>0 0 1 90</rotate><scale>2 2 2</scale>
+<instance_geometry url="#g"/></node></visual_scene></library_visual_scenes>
+<scene><instance_visual_scene url="#s"/></scene></COLLADA>"##;
+    let desc = collada::parse(text, Path::new("t.dae")).unwrap();
+    let s = info::summarize(&desc);
+    assert_eq!(s.triangles, 2);
+    let (lo, hi) = s.bounds.unwrap();
+    // x' = 10 - 2y, y' = 2x: the square becomes [8, 10] x [0, 2].
+    assert!(
+        (lo - glam::Vec3::new(8.0, 0.0, 0.0)).length() < 1e-5,
+        "{lo}"
+    );
+    assert!(
+        (hi - glam::Vec3::new(10.0, 2.0, 0.0)).length() < 1e-5,
+        "{hi}"
+    );
+}

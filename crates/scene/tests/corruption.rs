@@ -20,15 +20,43 @@ const SAMPLES: [&str; 3] = ["cube.dae", "CBspheres.dae", "plane.dae"];
 
 /// Loads corrupted text; whatever loads must also build and render a tiny image.
 fn exercise(text: &str) {
-    if let Ok(mut desc) = collada::parse(text, Path::new("corrupt.dae")) {
-        desc.resolution = [4, 3];
-        if let Ok(scene) = Scene::build(&desc) {
-            let settings = RenderSettings::new(1, 0, SamplerKind::Independent);
-            let integrator = IntegratorKind::Path(PathIntegrator::default());
-            let (film, _) = render(&scene, &integrator, &settings, &|_| {}, &Default::default());
-            assert!(film.pixels().iter().all(|p| p.mean().is_finite()));
-        }
+    if let Ok(desc) = collada::parse(text, Path::new("corrupt.dae")) {
+        render_tiny(desc);
     }
+}
+
+/// Builds and renders a 4 x 3 image of a scene that loaded; it must be finite.
+fn render_tiny(mut desc: pathlab_render::desc::SceneDesc) {
+    desc.resolution = [4, 3];
+    if let Ok(scene) = Scene::build(&desc) {
+        let settings = RenderSettings::new(1, 0, SamplerKind::Independent);
+        let integrator = IntegratorKind::Path(PathIntegrator::default());
+        let (film, _) = render(&scene, &integrator, &settings, &|_| {}, &Default::default());
+        assert!(film.pixels().iter().all(|p| p.mean().is_finite()));
+    }
+}
+
+/// Writes corrupted bytes to a file named `name` and loads it by extension.
+fn exercise_file(name: &str, bytes: &[u8]) {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    if let Ok(desc) = pathlab_scene::load(path.to_str().unwrap()) {
+        render_tiny(desc);
+    }
+    let _ = std::fs::remove_file(path);
+}
+
+/// Truncates `bytes` at `cut` (as a fraction) after flipping the given bits.
+fn corrupt(mut bytes: Vec<u8>, cut: f64, flips: &[(f64, u8)]) -> Vec<u8> {
+    for &(pos, bit) in flips {
+        let i = ((pos * bytes.len() as f64) as usize).min(bytes.len() - 1);
+        bytes[i] ^= 1 << bit;
+    }
+    let keep = ((cut * 1.2).min(1.0) * bytes.len() as f64) as usize;
+    bytes.truncate(keep);
+    bytes
 }
 
 /// Byte offsets of number tokens in `text`.
@@ -113,35 +141,23 @@ fn ply_square() -> Vec<u8> {
     b
 }
 
-/// Loads corrupted PLY bytes from a file; whatever loads must build and render.
-fn exercise_ply(bytes: &[u8], case: u64) {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption");
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("case{case}.ply"));
-    std::fs::write(&path, bytes).unwrap();
-    if let Ok(mut desc) = pathlab_scene::load(path.to_str().unwrap()) {
-        desc.resolution = [4, 3];
-        if let Ok(scene) = Scene::build(&desc) {
-            let settings = RenderSettings::new(1, 0, SamplerKind::Independent);
-            let integrator = IntegratorKind::Path(PathIntegrator::default());
-            let (film, _) = render(&scene, &integrator, &settings, &|_| {}, &Default::default());
-            assert!(film.pixels().iter().all(|p| p.mean().is_finite()));
-        }
-    }
-    let _ = std::fs::remove_file(path);
-}
-
 proptest! {
     #![proptest_config(ProptestConfig { cases: 100, failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
-    fn ply_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6), case in 0u64..1_000_000) {
-        let mut bytes = ply_square();
-        for (pos, bit) in flips {
-            let i = ((pos * bytes.len() as f64) as usize).min(bytes.len() - 1);
-            bytes[i] ^= 1 << bit;
-        }
-        let keep = ((cut * 1.2).min(1.0) * bytes.len() as f64) as usize;
-        exercise_ply(&bytes[..keep], case);
+    fn ply_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6)) {
+        exercise_file("case.ply", &corrupt(ply_square(), cut, &flips));
+    }
+
+    #[test]
+    fn obj_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6)) {
+        let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n".to_vec();
+        exercise_file("case.obj", &corrupt(obj, cut, &flips));
+    }
+
+    #[test]
+    fn mitsuba_xml_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6)) {
+        let xml = std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-box/scene.xml")).unwrap();
+        exercise_file("case.xml", &corrupt(xml, cut, &flips));
     }
 }
