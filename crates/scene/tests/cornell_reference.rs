@@ -282,6 +282,32 @@ fn direct_strategies_rank_by_variance() {
 }
 
 #[test]
+fn mitsuba_xml_scene_matches_mitsuba_pixel_by_pixel() {
+    // The reference's own scene.xml, read by the Mitsuba loader, at -m 1.
+    let desc = pathlab_scene::mitsuba::load(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-box/scene.xml"),
+    )
+    .unwrap();
+    let scene = Scene::build(&desc).unwrap();
+    let film = render(
+        &scene,
+        &path(1),
+        &RenderSettings::new(512, 31, SamplerKind::Independent),
+        &|_| {},
+        &Default::default(),
+    )
+    .0;
+    let r = reference("2");
+    assert_agrees("scene.xml -m 1", &compare(&film, &r));
+    let (out, blocks) = compare_blocks(&film, &r, 0.0);
+    assert!(
+        out.iter()
+            .all(|&o| (o as f64) < MAX_OUTLIER_FRACTION * blocks as f64 + 1.0),
+        "{out:?}"
+    );
+}
+
+#[test]
 fn path_blocks_match_mitsuba() {
     let film = render_cornell(path(u32::MAX), 64, 21);
     let (out, blocks) = compare_blocks(&film, &reference("inf"), 0.0);

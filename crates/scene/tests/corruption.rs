@@ -1,5 +1,6 @@
 //! Corrupted scene files: truncated, bit-flipped and number-mangled variants of the course's
-//! scenes must load or fail with an error, never panic; what loads must build and render.
+//! scenes must load or fail with an error, never panic, and stay within a memory bound; what
+//! loads must build and render.
 
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
@@ -7,7 +8,63 @@ use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
 use pathlab_scene::collada;
 use proptest::prelude::*;
+use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Counts the bytes this test binary holds, and the most it held, so that a loader that
+/// trusted a huge declared count would be caught even if the allocation happened to succeed.
+struct Counting;
+
+static CURRENT: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: every method forwards to the system allocator with the caller's arguments unchanged,
+// so `Counting` upholds exactly the guarantees `System` does; the counters are plain atomics and
+// never affect what is returned.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: same contract as the caller's, forwarded unchanged.
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            let now = CURRENT.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+            PEAK.fetch_max(now, Ordering::Relaxed);
+        }
+        p
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` was allocated by `alloc` above with this layout.
+        unsafe { System.dealloc(ptr, layout) };
+        CURRENT.fetch_sub(layout.size(), Ordering::Relaxed);
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Most memory the whole test binary may hold at once while loading corrupted files: the
+/// inputs are a few tens of kilobytes, so anything near this means a declared size was trusted.
+const MEMORY_BOUND: usize = 512 << 20;
+
+fn assert_memory_bound() {
+    let peak = PEAK.load(Ordering::Relaxed);
+    assert!(
+        peak < MEMORY_BOUND,
+        "peak allocation {peak} bytes exceeds {MEMORY_BOUND}"
+    );
+}
+
+#[test]
+fn the_allocator_counts() {
+    let before = CURRENT.load(Ordering::Relaxed);
+    let v = vec![0u8; 1 << 20];
+    assert!(
+        CURRENT.load(Ordering::Relaxed) >= before + (1 << 20)
+            || PEAK.load(Ordering::Relaxed) >= 1 << 20
+    );
+    drop(v);
+    assert_memory_bound();
+}
 
 fn sample(name: &str) -> String {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -23,10 +80,12 @@ fn exercise(text: &str) {
     if let Ok(desc) = collada::parse(text, Path::new("corrupt.dae")) {
         render_tiny(desc);
     }
+    assert_memory_bound();
 }
 
 /// Builds and renders a 4 x 3 image of a scene that loaded; it must be finite.
 fn render_tiny(mut desc: pathlab_render::desc::SceneDesc) {
+    assert_memory_bound();
     desc.resolution = [4, 3];
     if let Ok(scene) = Scene::build(&desc) {
         let settings = RenderSettings::new(1, 0, SamplerKind::Independent);
@@ -45,6 +104,7 @@ fn exercise_file(name: &str, bytes: &[u8]) {
     if let Ok(desc) = pathlab_scene::load(path.to_str().unwrap()) {
         render_tiny(desc);
     }
+    assert_memory_bound();
     let _ = std::fs::remove_file(path);
 }
 
