@@ -5,11 +5,11 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::film::Film;
-use pathlab_render::image_io::{write_exr, write_png_with, ExtraChannel, ToneMap};
+use pathlab_render::image_io::{write_exr, write_png_with, write_rgb8, ExtraChannel, ToneMap};
 use pathlab_render::integrator::{
     DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
 };
-use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::render::{render, Adaptive, RenderSettings};
 use pathlab_render::scene::Scene;
 use serde_json::json;
 use std::io::IsTerminal;
@@ -79,6 +79,11 @@ pub struct RenderArgs {
     /// Image size in pixels (default: the scene's).
     #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"])]
     pub resolution: Option<Vec<u32>>,
+    /// Adaptive sampling: batches of BATCH samples; a pixel stops once the 95% interval of its
+    /// mean luminance is within ± TOL relative (at most --spp samples). Defaults 32 0.05. Writes
+    /// the samples-per-pixel heat map to NAME_rate.png.
+    #[arg(short = 'a', long, num_args = 0..=2, value_names = ["BATCH", "TOL"], default_missing_values = ["32", "0.05"])]
+    pub adaptive: Option<Vec<String>>,
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black).
     #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"])]
     pub crop: Option<Vec<u32>>,
@@ -120,6 +125,30 @@ fn parse_max_depth(text: &str) -> Result<u32> {
     }
     text.parse::<u32>().with_context(|| {
         format!("--max-depth {text}: expected a number of bounces (0, 1, 2, ...) or inf")
+    })
+}
+
+fn parse_adaptive(values: &[String]) -> Result<Adaptive> {
+    let batch = match values.first() {
+        Some(b) => b.parse::<u32>().ok().filter(|&b| b > 0).with_context(|| {
+            format!("--adaptive {b}: BATCH must be a positive number of samples")
+        })?,
+        None => Adaptive::DEFAULT.batch,
+    };
+    let tolerance = match values.get(1) {
+        Some(t) => t
+            .parse::<f32>()
+            .ok()
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .with_context(|| {
+                format!("--adaptive {batch} {t}: TOL must be a positive number such as 0.05")
+            })?,
+        None => Adaptive::DEFAULT.tolerance,
+    };
+    Ok(Adaptive {
+        batch,
+        tolerance,
+        min_samples: 4 * batch,
     })
 }
 
@@ -194,6 +223,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         IntegratorName::Bvh => IntegratorKind::Debug(DebugView::BvhHeat),
     };
     let mut settings = RenderSettings::new(spp, args.seed, args.sampler);
+    if let Some(a) = &args.adaptive {
+        settings.adaptive = Some(parse_adaptive(a)?);
+    }
     if let Some(c) = &args.crop {
         let [w, h] = desc.resolution;
         if c[0] >= c[2] || c[1] >= c[3] || c[2] > w || c[3] > h {
@@ -241,6 +273,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     write_outputs(&film, &output, format, args)?;
+    if settings.adaptive.is_some() {
+        let rate = PathBuf::from(format!("{}_rate.png", output.with_extension("").display()));
+        write_rate_image(&film, spp, &rate)?;
+        if !args.quiet {
+            let counts = film.sample_counts();
+            let mean = counts.iter().map(|&c| c as f64).sum::<f64>() / counts.len().max(1) as f64;
+            eprintln!(
+                "adaptive: {mean:.1} samples per pixel on average (at most {spp}); rate image {}",
+                rate.display()
+            );
+        }
+    }
 
     let build = scene.stats();
     let mean = film.image_mean();
@@ -287,6 +331,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             );
         }
     }
+    Ok(())
+}
+
+/// The samples-per-pixel heat map: blue (few) through green to red (`spp`).
+fn write_rate_image(film: &Film, spp: u32, path: &Path) -> Result<()> {
+    let bytes: Vec<u8> = film
+        .sample_counts()
+        .iter()
+        .flat_map(|&n| {
+            let t = (n / spp.max(1) as f32).clamp(0.0, 1.0);
+            let ramp = |c: f32| ((1.5 - (4.0 * t - c).abs()).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+            [ramp(3.0), ramp(2.0), ramp(1.0)]
+        })
+        .collect();
+    write_rgb8(path, film.width(), film.height(), &bytes)?;
     Ok(())
 }
 

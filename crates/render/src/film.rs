@@ -8,6 +8,7 @@ use pathlab_mc::estimator::RunningStats;
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelStats {
     channels: [RunningStats; 3],
+    luminance: RunningStats,
 }
 
 impl PixelStats {
@@ -17,6 +18,13 @@ impl PixelStats {
         for (c, v) in self.channels.iter_mut().zip(l.to_array()) {
             c.push(v as f64);
         }
+        self.luminance.push(crate::light::luminance(l) as f64);
+    }
+
+    /// Statistics of the samples' luminance (the "illuminance" of the course's adaptive
+    /// sampling).
+    pub fn luminance(&self) -> &RunningStats {
+        &self.luminance
     }
 
     /// Combines with another set of samples of the same pixel.
@@ -24,6 +32,7 @@ impl PixelStats {
         for (c, d) in self.channels.iter_mut().zip(&o.channels) {
             c.merge(d);
         }
+        self.luminance.merge(&o.luminance);
     }
 
     /// Number of samples.

@@ -128,6 +128,21 @@ impl ToneMap {
     }
 }
 
+/// Writes 8-bit RGB values (row-major, 3 bytes a pixel) as a PNG.
+pub fn write_rgb8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+) -> std::result::Result<(), ImageError> {
+    image::save_buffer(path, bytes, width, height, image::ExtendedColorType::Rgb8).map_err(|e| {
+        ImageError::Png {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }
+    })
+}
+
 /// Writes `rgb` as an 8-bit PNG after scaling by 2^`exposure`, with the sRGB transfer function.
 pub fn write_png(
     path: &Path,

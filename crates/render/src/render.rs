@@ -24,6 +24,55 @@ pub struct RenderSettings {
     /// Only the pixels `x0 <= x < x1`, `y0 <= y < y1` of `[x0, y0, x1, y1]`; the others get
     /// no samples. `None`: the whole image.
     pub crop: Option<[u32; 4]>,
+    /// Per-pixel adaptive sampling (`spp` is then the most a pixel takes).
+    pub adaptive: Option<Adaptive>,
+}
+
+/// The course's per-pixel adaptive sampling: samples come in batches; after each, a pixel
+/// whose n samples have luminance mean μ and standard deviation σ stops when
+/// 1.96 σ / √n ≤ `tolerance` · μ, i.e. when the 95% confidence interval of its mean is within
+/// ± `tolerance` relative.
+///
+/// Guards: no pixel stops before `min_samples`; a pixel whose samples are all equal (σ = 0, for
+/// instance all zero because none has found a small light yet, or all on the light though the
+/// pixel straddles its edge) never counts as converged, since a zero sample variance says
+/// nothing about the true one; and a single bright sample among dark ones cannot stop a pixel,
+/// since then σ ≈ μ √n and the test would need 1.96 ≤ `tolerance`.
+///
+/// Stopping on a pixel's own samples makes its estimate slightly biased (optional stopping: a
+/// pixel tends to stop after a run of samples that happened to agree), by an amount that shrinks
+/// with `min_samples` and `tolerance`; the tests measure it against the reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    /// Samples per batch between convergence checks.
+    pub batch: u32,
+    /// Relative half-width of the 95% interval at which a pixel stops.
+    pub tolerance: f32,
+    /// Samples every pixel takes before it may stop.
+    pub min_samples: u32,
+}
+
+impl Adaptive {
+    /// The course's defaults: batches of 32, tolerance 0.05; at least four batches.
+    pub const DEFAULT: Adaptive = Adaptive {
+        batch: 32,
+        tolerance: 0.05,
+        min_samples: 128,
+    };
+
+    /// Whether a pixel with these luminance statistics may stop.
+    pub fn converged(&self, luminance: &pathlab_mc::estimator::RunningStats) -> bool {
+        let n = luminance.count();
+        if n < self.min_samples.max(2) as u64 {
+            return false;
+        }
+        let sigma = luminance.std_dev();
+        if sigma <= 0.0 {
+            return false;
+        }
+        let half_width = 1.96 * sigma / (n as f64).sqrt();
+        half_width <= self.tolerance as f64 * luminance.mean()
+    }
 }
 
 impl RenderSettings {
@@ -34,6 +83,7 @@ impl RenderSettings {
             seed,
             sampler,
             crop: None,
+            adaptive: None,
         }
     }
 }
@@ -110,7 +160,16 @@ pub fn render(
                         continue;
                     }
                     let px = &mut out.pixels[((y - y0) * w + (x - x0)) as usize];
+                    let batch = settings.adaptive.map_or(settings.spp, |a| a.batch.max(1));
                     for i in 0..settings.spp {
+                        if i > 0
+                            && i % batch == 0
+                            && settings
+                                .adaptive
+                                .is_some_and(|a| a.converged(px.luminance()))
+                        {
+                            break;
+                        }
                         sampler.start_pixel_sample([x, y], i, 0);
                         let film = Vec2::new(x as f32, y as f32) + sampler.next_pixel_2d();
                         let u_lens = sampler.next_2d();
@@ -125,7 +184,9 @@ pub fn render(
                     }
                 }
             }
-            progress(out.samples + out.nonfinite);
+            // Progress counts the budget of every pixel done, also where adaptive sampling
+            // stopped early, so that the bar ends at 100%.
+            progress(w as u64 * h as u64 * settings.spp as u64);
             out
         })
         .collect();
@@ -144,4 +205,42 @@ pub fn render(
     stats.seconds = start.elapsed().as_secs_f64();
     stats.cancelled = cancel.load(Ordering::Relaxed);
     (film, stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pathlab_mc::estimator::RunningStats;
+
+    fn stats(values: &[f64]) -> RunningStats {
+        let mut s = RunningStats::new();
+        values.iter().for_each(|&v| s.push(v));
+        s
+    }
+
+    #[test]
+    fn adaptive_stopping_rule() {
+        let a = Adaptive {
+            batch: 8,
+            tolerance: 0.05,
+            min_samples: 16,
+        };
+        // Equal samples (all black, or all on a light) never stop a pixel: their variance
+        // estimate of zero is no evidence of a tight interval.
+        assert!(!a.converged(&stats(&[1.0; 100])));
+        assert!(!a.converged(&stats(&[0.0; 100])));
+        // Nearly constant samples stop once the minimum is reached.
+        let near: Vec<f64> = (0..16).map(|i| 1.0 + 1e-3 * (i % 2) as f64).collect();
+        assert!(!a.converged(&stats(&near[..8])));
+        assert!(a.converged(&stats(&near)));
+        // One bright sample among dark ones never stops a pixel.
+        let mut firefly = vec![0.0; 999];
+        firefly.push(100.0);
+        assert!(!a.converged(&stats(&firefly)));
+        // The course's rule: 1.96 σ/√n ≤ tol μ. Values 1 ± 0.5 (σ ≈ 0.5) need n ≥ (1.96·0.5/0.05)² ≈ 384.
+        let alternating =
+            |n: usize| -> Vec<f64> { (0..n).map(|i| if i % 2 == 0 { 0.5 } else { 1.5 }).collect() };
+        assert!(!a.converged(&stats(&alternating(300))));
+        assert!(a.converged(&stats(&alternating(400))));
+    }
 }
