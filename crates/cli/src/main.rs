@@ -1,5 +1,6 @@
 //! `pathlab`: the command-line front end of the pathlab renderer and Monte Carlo toolkit.
 
+mod compare_cmd;
 mod expr;
 mod info_cmd;
 mod integrate;
@@ -22,6 +23,8 @@ struct Cli {
 enum Command {
     /// Render a scene (default: the built-in Cornell box).
     Render(render_cmd::RenderArgs),
+    /// Render a scene with several strategies side by side, with variance, RMSE and efficiency.
+    Compare(compare_cmd::CompareArgs),
     /// Show what a scene contains (shapes, materials, lights, camera, bounds, warnings).
     Info(info_cmd::InfoArgs),
     /// Draw samples from a distribution or warp and compare them with its exact pdf.
@@ -35,6 +38,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Render(args) => render_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
+        Command::Compare(args) => compare_cmd::run(args),
         Command::Sample(args) => sample::run(args),
         Command::Integrate(args) => integrate::run(args),
     };

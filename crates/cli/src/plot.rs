@@ -38,6 +38,11 @@ fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow!("plotting failed: {e:?}")
 }
 
+/// Registers the embedded font for plotters' text (idempotent).
+pub fn register_fonts() {
+    register_font();
+}
+
 fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {

@@ -96,8 +96,10 @@ pub struct RenderArgs {
     /// Direct-lighting strategy for --integrator direct: hemisphere, cosine, light or mis.
     #[arg(long, default_value = "mis")]
     pub direct: DirectStrategy,
-    /// Where the uniform numbers come from: independent, stratified or sobol.
-    #[arg(long, default_value = "independent")]
+    /// Where the uniform numbers come from: sobol (Owen-scrambled, padded per dimension),
+    /// stratified or independent. Per-pixel variances (--aov variance) are exact estimates only
+    /// for independent samples; for the others they overstate the error.
+    #[arg(long, default_value = "sobol")]
     pub sampler: SamplerKind,
     /// Seed of the random numbers.
     #[arg(long, default_value_t = 0)]

@@ -606,3 +606,51 @@ fn bad_scene_files_are_short_errors() {
     );
     assert_one_line_error(&pathlab(&["info", "model.fbx"]), "unknown scene format");
 }
+
+#[test]
+fn compare_ranks_the_strategies() {
+    let out = scratch("compare.png");
+    let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scene/tests/data/cornell-box/mean-maxdepth-2.exr");
+    let v = json_of(&pathlab(&[
+        "compare",
+        "-s",
+        "8",
+        "--ref",
+        reference.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_image(&out, true);
+    let rows = v["strategies"].as_array().unwrap();
+    let get = |name: &str, key: &str| {
+        rows.iter().find(|r| r["name"] == name).unwrap()[key]
+            .as_f64()
+            .unwrap()
+    };
+    // The course's worksheet, in numbers: cosine beats uniform, light sampling beats both.
+    assert!(get("cosine", "mean_pixel_variance") < get("hemisphere", "mean_pixel_variance"));
+    assert!(get("light", "mean_pixel_variance") < get("cosine", "mean_pixel_variance"));
+    assert!(get("light", "rmse") < get("hemisphere", "rmse"));
+    // A course scene works too.
+    let out = scratch("compare_dae.png");
+    let o = pathlab(&[
+        "compare",
+        &course_scene("CBspheres_lambertian.dae"),
+        "-s",
+        "2",
+        "-r",
+        "40",
+        "30",
+        "--strategies",
+        "cosine,mis,path",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_one_line_error(
+        &pathlab(&["compare", "--strategies", "magic"]),
+        "unknown direct-lighting strategy",
+    );
+}

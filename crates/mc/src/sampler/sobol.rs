@@ -4,25 +4,27 @@ use glam::Vec2;
 
 /// Largest sample index the Sobol tables cover in one sequence (2^16).
 const SEQUENCE_LENGTH: u32 = 1 << 16;
-/// Dimensions of the underlying Sobol tables.
-const TABLE_DIMENSIONS: u32 = sobol_burley::NUM_DIMENSIONS;
 
 /// The Sobol sequence with Owen scrambling (Burley, "Practical Hash-based Owen Scrambling",
 /// JCGT 2020; the `sobol_burley` crate, Joe–Kuo direction numbers).
 ///
-/// Every pixel gets its own, independently scrambled and shuffled copy of the sequence (the
-/// scrambling seed is a hash of the pixel and the sampler's seed), so neighbouring pixels are
-/// decorrelated while the samples *within* a pixel keep the sequence's stratification: the first
-/// 2^k samples of any dimension pair form a (0, k, 2)-net in base 2 for the first pairs.
+/// Dimensions are "padded" (Burley 2020, §4; pbrt-v4's padded Sobol): every 1D or 2D request
+/// uses the first one or two dimensions of the Sobol sequence — a (0, 2)-sequence in base 2,
+/// the best-stratified there is — scrambled *and shuffled* with a seed hashed from the pixel,
+/// the sampler's seed and the dimension. So within a pixel each request's samples are as
+/// well stratified as the first two Sobol dimensions (the first 2^k samples of every `next_2d`
+/// form a (0, k, 2)-net), while different requests, pixels and seeds are decorrelated by their
+/// independent shuffles. The light and BSDF samples of the first bounces are thus stratified as
+/// well as the pixel position.
 ///
 /// Owen scrambling makes each sample uniform on [0, 1)^d, so estimators stay unbiased; their
 /// variance falls faster than 1/N on smooth integrands. The sample variance of the estimates no
 /// longer measures that error (the samples are not independent): compare independent
 /// scramblings (different seeds) to estimate it.
 ///
-/// Limits: `sobol_burley` covers 2^16 sample indices and 256 dimensions. Beyond them the sampler
-/// switches to a fresh scramble for each block of 2^16 indices and each block of 256
-/// dimensions; every sample stays uniform, and the blocks are independent randomisations.
+/// Limits: `sobol_burley` covers 2^16 sample indices. Beyond them the sampler switches to a
+/// fresh scramble for each block of 2^16 indices; every sample stays uniform, and the blocks
+/// are independent randomisations. Dimensions are unlimited (padding uses only the first two).
 #[derive(Clone, Debug)]
 pub struct SobolSampler {
     samples_per_pixel: u32,
@@ -45,20 +47,16 @@ impl SobolSampler {
         }
     }
 
+    /// The scramble seed of the request at `dimension`.
     #[inline]
-    fn sample_dimension(&self, dimension: u32) -> f32 {
+    fn seed_for(&self, dimension: u32) -> u32 {
         let index_block = self.sample_index / SEQUENCE_LENGTH;
-        let dim_block = dimension / TABLE_DIMENSIONS;
-        let scramble = if index_block == 0 && dim_block == 0 {
-            self.pixel_seed
-        } else {
-            hash_words(&[self.pixel_seed, index_block as u64, dim_block as u64])
-        };
-        sobol_burley::sample(
-            self.sample_index % SEQUENCE_LENGTH,
-            dimension % TABLE_DIMENSIONS,
-            scramble as u32,
-        )
+        hash_words(&[self.pixel_seed, dimension as u64, index_block as u64]) as u32
+    }
+
+    #[inline]
+    fn index(&self) -> u32 {
+        self.sample_index % SEQUENCE_LENGTH
     }
 }
 
@@ -75,16 +73,17 @@ impl Sampler for SobolSampler {
 
     #[inline]
     fn next_1d(&mut self) -> f32 {
-        let v = self.sample_dimension(self.dimension);
+        let v = sobol_burley::sample(self.index(), 0, self.seed_for(self.dimension));
         self.dimension += 1;
         v
     }
 
     #[inline]
     fn next_2d(&mut self) -> Vec2 {
+        let seed = self.seed_for(self.dimension);
         let v = Vec2::new(
-            self.sample_dimension(self.dimension),
-            self.sample_dimension(self.dimension + 1),
+            sobol_burley::sample(self.index(), 0, seed),
+            sobol_burley::sample(self.index(), 1, seed),
         );
         self.dimension += 2;
         v

@@ -1,0 +1,228 @@
+//! `pathlab compare`: render one scene with several strategies, side by side, with the numbers
+//! that say which converges fastest.
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::film::Film;
+use pathlab_render::image_io::{read_exr_rgb, write_rgb8, ToneMap};
+use pathlab_render::integrator::{
+    DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
+};
+use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::scene::Scene;
+use plotters::prelude::*;
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Raw command-line arguments of `pathlab compare`.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// The scene: a file or a built-in scene's name.
+    #[arg(default_value = "cornell-box")]
+    pub scene: String,
+    /// Strategies to compare, comma-separated: hemisphere, cosine, light, mis (direct lighting)
+    /// and path (path tracing at --max-depth).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "hemisphere,cosine,light,mis"
+    )]
+    pub strategies: Vec<String>,
+    /// Samples per pixel for every strategy.
+    #[arg(short = 's', long, default_value_t = 16)]
+    pub spp: u32,
+    /// Largest bounce for the path strategy.
+    #[arg(short = 'm', long, default_value_t = 1)]
+    pub max_depth: u32,
+    /// A reference image (linear EXR of the same size) for RMSE.
+    #[arg(long = "ref", value_name = "REF.exr")]
+    pub reference: Option<PathBuf>,
+    /// Image size (default: the scene's).
+    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"])]
+    pub resolution: Option<Vec<u32>>,
+    /// Sampler: independent (the default here, so that variances are exact), stratified, sobol.
+    #[arg(long, default_value = "independent")]
+    pub sampler: SamplerKind,
+    /// Seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// The side-by-side image (PNG).
+    #[arg(short = 'o', long, default_value = "compare.png")]
+    pub output: PathBuf,
+    /// Print the table as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+struct Row {
+    name: String,
+    seconds: f64,
+    variance: f64,
+    rmse: Option<f64>,
+    film: Film,
+}
+
+fn integrator(name: &str, max_depth: u32) -> Result<IntegratorKind> {
+    if name == "path" {
+        return Ok(IntegratorKind::Path(PathIntegrator {
+            max_depth,
+            ..Default::default()
+        }));
+    }
+    let strategy: DirectStrategy = name
+        .parse()
+        .map_err(|e: String| anyhow::anyhow!("--strategies: {e}"))?;
+    Ok(IntegratorKind::Direct(DirectIntegrator {
+        strategy,
+        samples: 1,
+    }))
+}
+
+/// Runs `pathlab compare`.
+pub fn run(args: &CompareArgs) -> Result<()> {
+    if args.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
+    if args.strategies.is_empty() {
+        bail!("--strategies: name at least one");
+    }
+    let integrators = args
+        .strategies
+        .iter()
+        .map(|s| integrator(s.trim(), args.max_depth))
+        .collect::<Result<Vec<_>>>()?;
+    let mut desc = pathlab_scene::load(&args.scene)?;
+    if let Some(r) = &args.resolution {
+        if !(1..=16384).contains(&r[0]) || !(1..=16384).contains(&r[1]) {
+            bail!(
+                "--resolution {} {}: width and height must be between 1 and 16384",
+                r[0],
+                r[1]
+            );
+        }
+        desc.resolution = [r[0], r[1]];
+    }
+    let [w, h] = desc.resolution;
+    let reference = match &args.reference {
+        Some(p) => {
+            let (rw, rh, px) = read_exr_rgb(p)?;
+            if (rw, rh) != (w, h) {
+                bail!(
+                    "{}: the reference is {rw}x{rh}, the render {w}x{h}",
+                    p.display()
+                );
+            }
+            Some(px)
+        }
+        None => None,
+    };
+    let scene = Scene::build(&desc).context("cannot build the scene")?;
+    let settings = RenderSettings::new(args.spp, args.seed, args.sampler);
+    let mut rows = Vec::new();
+    for (name, integrator) in args.strategies.iter().zip(&integrators) {
+        let (film, stats) = render(&scene, integrator, &settings, &|_| {}, &Default::default());
+        let n = film.pixels().len() as f64;
+        let variance = film
+            .pixels()
+            .iter()
+            .map(|p| p.variance().element_sum() / 3.0)
+            .sum::<f64>()
+            / n;
+        let rmse = reference.as_ref().map(|r| {
+            (film
+                .pixels()
+                .iter()
+                .zip(r)
+                .map(|(p, q)| (p.mean().as_vec3() - *q).length_squared() as f64 / 3.0)
+                .sum::<f64>()
+                / n)
+                .sqrt()
+        });
+        rows.push(Row {
+            name: name.trim().to_string(),
+            seconds: stats.seconds,
+            variance,
+            rmse,
+            film,
+        });
+    }
+    write_side_by_side(&rows, &args.output)?;
+    let efficiency = |r: &Row| 1.0 / (r.variance * r.seconds).max(f64::MIN_POSITIVE);
+    if args.json {
+        let out = json!({
+            "scene": args.scene,
+            "spp": args.spp,
+            "sampler": args.sampler.name(),
+            "image": args.output,
+            "strategies": rows.iter().map(|r| json!({
+                "name": r.name,
+                "seconds": r.seconds,
+                "mean_pixel_variance": r.variance,
+                "rmse": r.rmse,
+                "efficiency": efficiency(r),
+            })).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!(
+        "{} at {w}x{h}, {} spp, {} sampler",
+        args.scene,
+        args.spp,
+        args.sampler.name()
+    );
+    println!(
+        "  {:<12} {:>9} {:>16} {:>12} {:>14}",
+        "strategy", "seconds", "mean variance", "RMSE", "efficiency"
+    );
+    for r in &rows {
+        let rmse = r.rmse.map_or("-".to_string(), |e| format!("{e:.5}"));
+        println!(
+            "  {:<12} {:>9.3} {:>16.6} {:>12} {:>14.4e}",
+            r.name,
+            r.seconds,
+            r.variance,
+            rmse,
+            efficiency(r)
+        );
+    }
+    println!(
+        "  (variance: per sample, averaged over pixels; efficiency = 1 / (variance x seconds))"
+    );
+    println!("  side-by-side image written to {}", args.output.display());
+    Ok(())
+}
+
+/// The renders next to each other, each labelled with its strategy.
+fn write_side_by_side(rows: &[Row], path: &std::path::Path) -> Result<()> {
+    let (w, h) = (rows[0].film.width(), rows[0].film.height());
+    let label = 28u32;
+    let (tw, th) = (w * rows.len() as u32, h + label);
+    let mut buf = vec![255u8; (tw * th * 3) as usize];
+    for (k, r) in rows.iter().enumerate() {
+        for (i, c) in r.film.mean_image().iter().enumerate() {
+            let (x, y) = (k as u32 * w + i as u32 % w, label + i as u32 / w);
+            let o = ((y * tw + x) * 3) as usize;
+            for ch in 0..3 {
+                buf[o + ch] = (ToneMap::Srgb.encode(c[ch], 1.0) * 255.0 + 0.5) as u8;
+            }
+        }
+    }
+    crate::plot::register_fonts();
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (tw, th)).into_drawing_area();
+        for (k, r) in rows.iter().enumerate() {
+            root.draw(&Text::new(
+                r.name.clone(),
+                (k as i32 * w as i32 + 6, 6),
+                ("sans-serif", 18).into_font().color(&BLACK),
+            ))
+            .map_err(|e| anyhow::anyhow!("labelling the comparison failed: {e:?}"))?;
+        }
+        root.present()
+            .map_err(|e| anyhow::anyhow!("labelling the comparison failed: {e:?}"))?;
+    }
+    write_rgb8(path, tw, th, &buf)?;
+    Ok(())
+}
