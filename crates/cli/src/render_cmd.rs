@@ -9,6 +9,7 @@ use pathlab_render::image_io::{write_exr, write_png_with, write_rgb8, ExtraChann
 use pathlab_render::integrator::{
     DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
 };
+use pathlab_render::progressive::{render_progressive, StopRule};
 use pathlab_render::render::{render, Adaptive, RenderSettings};
 use pathlab_render::scene::Scene;
 use serde_json::json;
@@ -99,8 +100,17 @@ pub struct RenderArgs {
     /// Where the uniform numbers come from: sobol (Owen-scrambled, padded per dimension),
     /// stratified or independent. Per-pixel variances (--aov variance) are exact estimates only
     /// for independent samples; for the others they overstate the error.
-    #[arg(long, default_value = "sobol")]
-    pub sampler: SamplerKind,
+    /// Default: sobol, or independent with --target-error/--time (whose error estimate is
+    /// exact only for independent samples).
+    #[arg(long)]
+    pub sampler: Option<SamplerKind>,
+    /// Render in passes until the estimated relative RMSE of the image is at most E, spending
+    /// each pass where it lowers the error most (-s then caps the average spp; default 65536).
+    #[arg(long, value_name = "E")]
+    pub target_error: Option<f64>,
+    /// Render in passes for this many seconds, spending each pass where it lowers the error most.
+    #[arg(long, value_name = "SECONDS")]
+    pub time: Option<f64>,
     /// Seed of the random numbers.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -224,7 +234,28 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         IntegratorName::Depth => IntegratorKind::Debug(DebugView::Depth),
         IntegratorName::Bvh => IntegratorKind::Debug(DebugView::BvhHeat),
     };
-    let mut settings = RenderSettings::new(spp, args.seed, args.sampler);
+    let progressive = args.target_error.is_some() || args.time.is_some();
+    if let Some(e) = args.target_error {
+        if !(e.is_finite() && e > 0.0) {
+            bail!("--target-error {e}: must be a positive number such as 0.02");
+        }
+    }
+    if let Some(t) = args.time {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--time {t}: must be a positive number of seconds");
+        }
+    }
+    if progressive && args.adaptive.is_some() {
+        bail!(
+            "--adaptive and --target-error/--time are different ways to place samples; choose one"
+        );
+    }
+    let sampler = args.sampler.unwrap_or(if progressive {
+        SamplerKind::Independent
+    } else {
+        SamplerKind::Sobol
+    });
+    let mut settings = RenderSettings::new(spp, args.seed, sampler);
     if let Some(a) = &args.adaptive {
         settings.adaptive = Some(parse_adaptive(a)?);
     }
@@ -247,6 +278,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }) * spp as u64;
     let bar = if args.quiet || !std::io::stderr().is_terminal() {
         ProgressBar::hidden()
+    } else if progressive {
+        let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        b.enable_steady_tick(std::time::Duration::from_millis(200));
+        b
     } else {
         let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
         b.set_style(
@@ -266,7 +305,32 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .build()
         .context("cannot start the worker threads")?;
     let threads = pool.current_num_threads();
-    let (film, stats) = pool.install(|| render(&scene, &integrator, &settings, &progress, &CANCEL));
+    let mut estimated_error = None;
+    let (film, stats) = if progressive {
+        let stop = StopRule {
+            target_error: args.target_error,
+            time_limit: args.time,
+            max_spp: args.spp.unwrap_or(65536),
+        };
+        let bar_pass = Arc::clone(&bar);
+        let report_pass = move |pass: u32, error: f64| {
+            bar_pass.set_message(format!("pass {pass}: estimated relative RMSE {error:.4}"));
+        };
+        let (film, stats, report) = pool.install(|| {
+            render_progressive(&scene, &integrator, &settings, &stop, &report_pass, &CANCEL)
+        });
+        let error = report.error_history.last().copied().unwrap_or(f64::NAN);
+        if !args.quiet {
+            eprintln!(
+                "progressive: {} passes, stopped by {}; estimated relative RMSE {error:.4}",
+                report.passes, report.stopped_by
+            );
+        }
+        estimated_error = Some(error);
+        (film, stats)
+    } else {
+        pool.install(|| render(&scene, &integrator, &settings, &progress, &CANCEL))
+    };
     bar.finish_and_clear();
     if stats.cancelled {
         eprintln!(
@@ -310,6 +374,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "image_mean_rgb": [mean.x, mean.y, mean.z],
             "nonfinite_samples_discarded": stats.nonfinite_samples,
             "cancelled": stats.cancelled,
+            "sampler": sampler.name(),
+            "estimated_relative_rmse": estimated_error,
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else if !args.quiet {

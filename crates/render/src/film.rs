@@ -114,6 +114,11 @@ impl Film {
         &self.pixels
     }
 
+    /// All pixels, row-major, mutable.
+    pub fn pixels_mut(&mut self) -> &mut [PixelStats] {
+        &mut self.pixels
+    }
+
     /// Mean radiance per pixel, row-major.
     pub fn mean_image(&self) -> Vec<Vec3> {
         self.pixels.iter().map(|p| p.mean().as_vec3()).collect()

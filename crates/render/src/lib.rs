@@ -48,6 +48,7 @@ pub mod geometry;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
+pub mod progressive;
 pub mod render;
 pub mod scene;
 pub mod shape;

@@ -115,6 +115,35 @@ struct TileResult {
     nonfinite: u64,
 }
 
+/// Adds the samples with indices `range` of pixel `[x, y]` to `px`; returns how many were
+/// finite (added) and how many were NaN or infinite (discarded).
+#[inline]
+pub fn sample_pixel(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    sampler: &mut pathlab_mc::sampler::AnySampler,
+    [x, y]: [u32; 2],
+    range: std::ops::Range<u32>,
+    px: &mut PixelStats,
+    path: &mut PathStats,
+) -> (u64, u64) {
+    let (mut ok, mut bad) = (0, 0);
+    for i in range {
+        sampler.start_pixel_sample([x, y], i, 0);
+        let film = Vec2::new(x as f32, y as f32) + sampler.next_pixel_2d();
+        let u_lens = sampler.next_2d();
+        let ray = scene.camera().generate_ray(film, u_lens);
+        let l = integrator.li(scene, ray, sampler, path);
+        if l.is_finite() {
+            px.add(l);
+            ok += 1;
+        } else {
+            bad += 1;
+        }
+    }
+    (ok, bad)
+}
+
 /// Renders `scene` with `integrator`.
 ///
 /// Each pixel's samples use the sampler positioned at (pixel, sample index), so the image is
@@ -161,26 +190,28 @@ pub fn render(
                     }
                     let px = &mut out.pixels[((y - y0) * w + (x - x0)) as usize];
                     let batch = settings.adaptive.map_or(settings.spp, |a| a.batch.max(1));
-                    for i in 0..settings.spp {
+                    let mut i = 0;
+                    while i < settings.spp {
                         if i > 0
-                            && i % batch == 0
                             && settings
                                 .adaptive
                                 .is_some_and(|a| a.converged(px.luminance()))
                         {
                             break;
                         }
-                        sampler.start_pixel_sample([x, y], i, 0);
-                        let film = Vec2::new(x as f32, y as f32) + sampler.next_pixel_2d();
-                        let u_lens = sampler.next_2d();
-                        let ray = scene.camera().generate_ray(film, u_lens);
-                        let l = integrator.li(scene, ray, &mut sampler, &mut out.path);
-                        if l.is_finite() {
-                            px.add(l);
-                            out.samples += 1;
-                        } else {
-                            out.nonfinite += 1;
-                        }
+                        let end = (i + batch).min(settings.spp);
+                        let (ok, bad) = sample_pixel(
+                            scene,
+                            integrator,
+                            &mut sampler,
+                            [x, y],
+                            i..end,
+                            px,
+                            &mut out.path,
+                        );
+                        out.samples += ok;
+                        out.nonfinite += bad;
+                        i = end;
                     }
                 }
             }

@@ -458,3 +458,115 @@ fn sobol_beats_independent_at_equal_samples() {
         "Sobol's MSE is not clearly below independent sampling's"
     );
 }
+
+#[test]
+fn target_error_stops_where_the_measured_error_is_close_to_the_estimate() {
+    use pathlab_render::progressive::{render_progressive, StopRule};
+    let desc = pathlab_scene::builtin::cornell_box().unwrap();
+    let scene = Scene::build(&desc).unwrap();
+    let r = reference("2");
+    // A 64 x 64 window over the floor, the short box and its shadow.
+    let crop = [96, 150, 160, 214];
+    let settings = RenderSettings {
+        crop: Some(crop),
+        ..RenderSettings::new(1, 61, SamplerKind::Independent)
+    };
+    let stop = StopRule {
+        target_error: Some(0.02),
+        time_limit: None,
+        max_spp: 1 << 16,
+    };
+    let (film, stats, report) = render_progressive(
+        &scene,
+        &path(1),
+        &settings,
+        &stop,
+        &|_, _| {},
+        &Default::default(),
+    );
+    assert_eq!(report.stopped_by, "target");
+    let estimate = *report.error_history.last().unwrap();
+    assert!(estimate <= 0.02);
+    // Measured: the same relative RMSE of luminance against the reference, over the window.
+    let lum = |c: DVec3| 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+    let (mut se, mut mean, mut n) = (0.0, 0.0, 0.0);
+    for (p, m) in film.pixels().iter().zip(&r.mean) {
+        if p.count() > 0 {
+            se += (lum(p.mean()) - lum(*m)).powi(2);
+            mean += lum(*m);
+            n += 1.0;
+        }
+    }
+    let measured = (se / n).sqrt() / (mean / n);
+    eprintln!(
+        "target 0.02: {} passes, {:.0} spp on average; estimated {estimate:.4}, measured {measured:.4} (ratio {:.2})",
+        report.passes,
+        stats.samples as f64 / n,
+        measured / estimate
+    );
+    assert!(
+        measured <= 1.5 * estimate && measured >= estimate / 1.5,
+        "measured {measured} vs estimate {estimate}"
+    );
+}
+
+#[test]
+fn error_driven_allocation_beats_uniform_at_equal_samples() {
+    use pathlab_render::progressive::{render_progressive, StopRule};
+    let desc = pathlab_scene::builtin::cornell_box().unwrap();
+    let scene = Scene::build(&desc).unwrap();
+    let r = reference("2");
+    let stop = StopRule {
+        target_error: None,
+        time_limit: None,
+        max_spp: 256,
+    };
+    let settings = RenderSettings::new(1, 71, SamplerKind::Independent);
+    let (progressive, stats, _) = render_progressive(
+        &scene,
+        &path(1),
+        &settings,
+        &stop,
+        &|_, _| {},
+        &Default::default(),
+    );
+    let n = progressive.pixels().len() as f64;
+    let spp = (stats.samples as f64 / n).round() as u32;
+    let uniform = render(
+        &scene,
+        &path(1),
+        &RenderSettings::new(spp, 72, SamplerKind::Independent),
+        &|_| {},
+        &Default::default(),
+    )
+    .0;
+    let sq = |f: &Film| -> Vec<f64> {
+        f.pixels()
+            .iter()
+            .zip(&r.mean)
+            .map(|(p, m)| (p.mean() - *m).length_squared() / 3.0)
+            .collect()
+    };
+    let (ep, eu) = (sq(&progressive), sq(&uniform));
+    let d: Vec<f64> = eu.iter().zip(&ep).map(|(u, p)| u - p).collect();
+    let mean = d.iter().sum::<f64>() / n;
+    let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let rmse = |e: &[f64]| (e.iter().sum::<f64>() / n).sqrt();
+    eprintln!(
+        "{spp} spp on average: RMSE error-driven {:.5} vs uniform {:.5}; MSE difference {mean:.2e} ± {se:.1e}",
+        rmse(&ep),
+        rmse(&eu)
+    );
+    assert!(
+        mean > MAX_Z * se,
+        "error-driven allocation is not clearly better than uniform"
+    );
+    // Allocation driven by the samples drawn so far is a form of optional stopping: a pixel
+    // whose early samples missed a rare bright path gets fewer samples and keeps a low mean.
+    // Measured, not asserted (see the progressive module's documentation).
+    let c = compare(&progressive, &r);
+    eprintln!(
+        "error-driven bias: image mean {:.5?} vs reference {:.5?}, z {:.2?}; per-pixel |z| > 4: {:?}",
+        c.ours_mean, c.ref_mean, c.mean_z, c.outliers
+    );
+}
