@@ -1,6 +1,7 @@
 //! `pathlab`: the command-line front end of the pathlab renderer and Monte Carlo toolkit.
 
 mod compare_cmd;
+mod converge_cmd;
 mod expr;
 mod info_cmd;
 mod integrate;
@@ -25,6 +26,8 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Render a scene with several strategies side by side, with variance, RMSE and efficiency.
     Compare(compare_cmd::CompareArgs),
+    /// Plot the error against a reference as samples and time grow, for several samplers.
+    Converge(converge_cmd::ConvergeArgs),
     /// Show what a scene contains (shapes, materials, lights, camera, bounds, warnings).
     Info(info_cmd::InfoArgs),
     /// Draw samples from a distribution or warp and compare them with its exact pdf.
@@ -39,6 +42,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
+        Command::Converge(args) => converge_cmd::run(args),
         Command::Sample(args) => sample::run(args),
         Command::Integrate(args) => integrate::run(args),
     };

@@ -692,3 +692,105 @@ fn draw_convergence<DB: DrawingBackend>(
     legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
     Ok(())
 }
+
+/// One curve of `pathlab converge`: (samples per pixel, seconds, RMSE) points.
+pub struct RmseCurve {
+    /// Legend name.
+    pub name: String,
+    /// Points at increasing sample counts.
+    pub points: Vec<(f64, f64, f64)>,
+    /// Least-squares slope of log RMSE against log samples.
+    pub slope: f64,
+}
+
+/// Writes RMSE against samples per pixel and against seconds, log-log, one curve each.
+pub fn rmse_curves(path: &Path, format: Format, title: &str, curves: &[RmseCurve]) -> Result<()> {
+    with_root!(path, format, (1400, 600), |root| draw_rmse_curves(
+        &root, title, curves
+    ))
+}
+
+fn draw_rmse_curves<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    curves: &[RmseCurve],
+) -> Result<()> {
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    let panels = root.split_evenly((1, 2));
+    let all = || {
+        curves
+            .iter()
+            .flat_map(|c| c.points.iter())
+            .filter(|p| p.2 > 0.0 && p.1 > 0.0)
+    };
+    let range = |f: fn(&(f64, f64, f64)) -> f64| {
+        let lo = all().map(f).fold(f64::INFINITY, f64::min);
+        let hi = all().map(f).fold(0.0, f64::max);
+        if lo.is_finite() && hi > lo {
+            (lo / 1.5, hi * 1.5)
+        } else {
+            (1e-3, 1.0)
+        }
+    };
+    let (e0, e1) = range(|p| p.2);
+    for (panel, (xi, label)) in panels
+        .iter()
+        .zip([(0usize, "samples per pixel"), (1usize, "seconds")])
+    {
+        let (x0, x1) = if xi == 0 {
+            range(|p| p.0)
+        } else {
+            range(|p| p.1)
+        };
+        let mut chart = ChartBuilder::on(panel)
+            .caption(
+                format!("RMSE against the reference vs {label} (log-log)"),
+                ("sans-serif", 18),
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(80)
+            .build_cartesian_2d((x0..x1).log_scale(), (e0..e1).log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(label)
+            .y_desc("root-mean-square error")
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .x_label_formatter(&|v| {
+                if *v >= 1.0 {
+                    format!("{v:.0}")
+                } else {
+                    format!("{v:.2}")
+                }
+            })
+            .draw()
+            .map_err(err)?;
+        for (c, colour) in curves.iter().zip(SERIES_COLOURS.iter().cycle()) {
+            let colour = *colour;
+            let pts: Vec<(f64, f64)> = c
+                .points
+                .iter()
+                .filter(|p| p.2 > 0.0 && p.1 > 0.0)
+                .map(|p| (if xi == 0 { p.0 } else { p.1 }, p.2))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
+                .map_err(err)?
+                .label(if xi == 0 {
+                    format!("{} (slope {:.2})", c.name, c.slope)
+                } else {
+                    c.name.clone()
+                })
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+                });
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                .map_err(err)?;
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    }
+    Ok(())
+}

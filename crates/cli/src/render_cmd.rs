@@ -106,10 +106,10 @@ pub struct RenderArgs {
     pub sampler: Option<SamplerKind>,
     /// Render in passes until the estimated relative RMSE of the image is at most E, spending
     /// each pass where it lowers the error most (-s then caps the average spp; default 65536).
-    #[arg(long, value_name = "E")]
+    #[arg(long, value_name = "E", allow_negative_numbers = true)]
     pub target_error: Option<f64>,
     /// Render in passes for this many seconds, spending each pass where it lowers the error most.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub time: Option<f64>,
     /// Seed of the random numbers.
     #[arg(long, default_value_t = 0)]

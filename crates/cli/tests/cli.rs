@@ -654,3 +654,109 @@ fn compare_ranks_the_strategies() {
         "unknown direct-lighting strategy",
     );
 }
+
+#[test]
+fn converge_plots_error_curves() {
+    let out = scratch("converge.png");
+    let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scene/tests/data/cornell-box/mean-maxdepth-2.exr");
+    let v = json_of(&pathlab(&[
+        "converge",
+        "--ref",
+        reference.to_str().unwrap(),
+        "--max-spp",
+        "32",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_image(&out, true);
+    let curves = v["curves"].as_array().unwrap();
+    let find = |n: &str| curves.iter().find(|c| c["name"] == n).unwrap();
+    let slope = |n: &str| find(n)["fitted_slope"].as_f64().unwrap();
+    // Independent sampling converges as N^-1/2; Sobol faster.
+    assert!(
+        (slope("independent") + 0.5).abs() < 0.15,
+        "{}",
+        slope("independent")
+    );
+    assert!(slope("sobol") < slope("independent"));
+    // A course scene, against a reference pathlab renders itself.
+    let scene = course_scene("CBspheres_lambertian.dae");
+    let reference = scratch("cb_ref.exr");
+    let o = pathlab(&[
+        "render",
+        &scene,
+        "-r",
+        "40",
+        "30",
+        "-s",
+        "256",
+        "-m",
+        "1",
+        "-o",
+        reference.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(o.status.success());
+    let out = scratch("converge_dae.svg");
+    let o = pathlab(&[
+        "converge",
+        &scene,
+        "-r",
+        "40",
+        "30",
+        "--ref",
+        reference.to_str().unwrap(),
+        "--max-spp",
+        "8",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_image(&out, false);
+    assert_one_line_error(
+        &pathlab(&[
+            "converge",
+            &scene,
+            "--ref",
+            reference.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]),
+        "the reference is 40x30",
+    );
+}
+
+#[test]
+fn target_error_and_time_budget() {
+    let v = json_of(&pathlab(&[
+        "render",
+        "-m",
+        "1",
+        "--target-error",
+        "0.1",
+        "-o",
+        scratch("te.exr").to_str().unwrap(),
+        "--json",
+    ]));
+    let e = v["estimated_relative_rmse"].as_f64().unwrap();
+    assert!(e <= 0.1, "{e}");
+    assert_eq!(v["sampler"], "independent");
+    let v = json_of(&pathlab(&[
+        "render",
+        "-m",
+        "1",
+        "--time",
+        "1",
+        "-o",
+        scratch("tb.exr").to_str().unwrap(),
+        "--json",
+    ]));
+    assert!(v["seconds"].as_f64().unwrap() < 5.0);
+    assert_one_line_error(
+        &pathlab(&["render", "--target-error", "-1"]),
+        "--target-error",
+    );
+    assert_one_line_error(&pathlab(&["render", "--time", "1", "-a"]), "choose one");
+}

@@ -1,0 +1,198 @@
+//! `pathlab converge`: how the error against a reference falls with samples and with time, for
+//! independent and Sobol sampling and for uniform and error-driven sample allocation.
+
+use crate::plot::{self, RmseCurve};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::film::Film;
+use pathlab_render::image_io::read_exr_rgb;
+use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
+use pathlab_render::progressive::{render_progressive, StopRule};
+use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::scene::Scene;
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Raw command-line arguments of `pathlab converge`.
+#[derive(Args, Debug)]
+pub struct ConvergeArgs {
+    /// The scene: a file or a built-in scene's name.
+    #[arg(default_value = "cornell-box")]
+    pub scene: String,
+    /// The reference image: a linear EXR of the scene at the render's resolution.
+    #[arg(long = "ref", value_name = "REF.exr")]
+    pub reference: PathBuf,
+    /// Largest bounce (default 1: direct lighting).
+    #[arg(short = 'm', long, default_value_t = 1)]
+    pub max_depth: u32,
+    /// Largest samples per pixel (powers of two from 1 up to this).
+    #[arg(long, default_value_t = 256)]
+    pub max_spp: u32,
+    /// Image size (default: the scene's).
+    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"])]
+    pub resolution: Option<Vec<u32>>,
+    /// Seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// The plot (.png or .svg).
+    #[arg(short = 'o', long, default_value = "converge.png")]
+    pub output: PathBuf,
+    /// Print the data as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `pathlab converge`.
+pub fn run(args: &ConvergeArgs) -> Result<()> {
+    if !(1..=65536).contains(&args.max_spp) {
+        bail!(
+            "--max-spp must be between 1 and 65536, got {}",
+            args.max_spp
+        );
+    }
+    let format = plot::Format::from_path(&args.output)?;
+    let mut desc = pathlab_scene::load(&args.scene)?;
+    if let Some(r) = &args.resolution {
+        if !(1..=16384).contains(&r[0]) || !(1..=16384).contains(&r[1]) {
+            bail!(
+                "--resolution {} {}: width and height must be between 1 and 16384",
+                r[0],
+                r[1]
+            );
+        }
+        desc.resolution = [r[0], r[1]];
+    }
+    let (rw, rh, reference) = read_exr_rgb(&args.reference)?;
+    if [rw, rh] != desc.resolution {
+        bail!(
+            "{}: the reference is {rw}x{rh} but the scene renders at {}x{}",
+            args.reference.display(),
+            desc.resolution[0],
+            desc.resolution[1]
+        );
+    }
+    let scene = Scene::build(&desc).context("cannot build the scene")?;
+    let integrator = IntegratorKind::Path(PathIntegrator {
+        max_depth: args.max_depth,
+        ..Default::default()
+    });
+    let rmse = |film: &Film| -> f64 {
+        let n = film.pixels().len() as f64;
+        (film
+            .pixels()
+            .iter()
+            .zip(&reference)
+            .map(|(p, r)| (p.mean().as_vec3() - *r).length_squared() as f64 / 3.0)
+            .sum::<f64>()
+            / n)
+            .sqrt()
+    };
+    let levels: Vec<u32> = (0..=16)
+        .map(|k| 1u32 << k)
+        .filter(|&s| s <= args.max_spp)
+        .collect();
+    let mut curves = Vec::new();
+    for (name, kind) in [
+        ("independent", SamplerKind::Independent),
+        ("sobol", SamplerKind::Sobol),
+    ] {
+        let points = levels
+            .iter()
+            .map(|&spp| {
+                let (film, stats) = render(
+                    &scene,
+                    &integrator,
+                    &RenderSettings::new(spp, args.seed, kind),
+                    &|_| {},
+                    &Default::default(),
+                );
+                (spp as f64, stats.seconds, rmse(&film))
+            })
+            .collect::<Vec<_>>();
+        curves.push(curve(name, points));
+    }
+    // Error-driven allocation (independent samples): the same average sample counts, placed
+    // where the estimated error falls most.
+    let points = levels
+        .iter()
+        .filter(|&&spp| spp >= 32)
+        .map(|&spp| {
+            let stop = StopRule {
+                target_error: None,
+                time_limit: None,
+                max_spp: spp,
+            };
+            let settings = RenderSettings::new(spp, args.seed, SamplerKind::Independent);
+            let (film, stats, _) = render_progressive(
+                &scene,
+                &integrator,
+                &settings,
+                &stop,
+                &|_, _| {},
+                &Default::default(),
+            );
+            let n = film.pixels().len() as f64;
+            (stats.samples as f64 / n, stats.seconds, rmse(&film))
+        })
+        .collect::<Vec<_>>();
+    if !points.is_empty() {
+        curves.push(curve("error-driven", points));
+    }
+    let name = |p: &std::path::Path| {
+        p.file_name().map_or_else(
+            || p.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        )
+    };
+    let title = format!(
+        "{}: -m {}, error against {}",
+        name(std::path::Path::new(&args.scene)),
+        args.max_depth,
+        name(&args.reference)
+    );
+    plot::rmse_curves(&args.output, format, &title, &curves)?;
+    if args.json {
+        let out = json!({
+            "scene": args.scene,
+            "reference": args.reference,
+            "plot": args.output,
+            "curves": curves.iter().map(|c| json!({
+                "name": c.name,
+                "fitted_slope": c.slope,
+                "spp": c.points.iter().map(|p| p.0).collect::<Vec<_>>(),
+                "seconds": c.points.iter().map(|p| p.1).collect::<Vec<_>>(),
+                "rmse": c.points.iter().map(|p| p.2).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!("{} against {}", args.scene, args.reference.display());
+    for c in &curves {
+        let last = c.points.last().map_or(f64::NAN, |p| p.2);
+        println!(
+            "  {:<13} RMSE ∝ N^{:.2}; at the most samples {last:.5}",
+            c.name, c.slope
+        );
+    }
+    println!("  plot written to {}", args.output.display());
+    Ok(())
+}
+
+fn curve(name: &str, points: Vec<(f64, f64, f64)>) -> RmseCurve {
+    let as_conv: Vec<plot::ConvergencePoint> = points
+        .iter()
+        .map(|p| plot::ConvergencePoint {
+            n: p.0,
+            estimate: 0.0,
+            ci_half: 0.0,
+            rmse: p.2,
+        })
+        .collect();
+    RmseCurve {
+        name: name.to_string(),
+        slope: plot::fitted_slope(&as_conv),
+        points,
+    }
+}
