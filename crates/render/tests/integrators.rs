@@ -439,3 +439,47 @@ fn bad_scenes_are_errors() {
     desc.resolution = [0, 10];
     assert!(Scene::build(&desc).is_err());
 }
+
+#[test]
+fn glass_and_mirror_spheres_in_a_white_furnace() {
+    // Under a uniform sky of radiance 1, a glass sphere without absorption passes or reflects
+    // everything: L = 1 at every depth limit that lets paths escape (unbounded here). A mirror
+    // of reflectance 0.7 shows 0.7 of the sky.
+    for (material, truth) in [
+        (
+            MaterialDesc::Glass {
+                reflectance: Vec3::ONE,
+                transmittance: Vec3::ONE,
+                roughness: 0.0,
+                ior: 1.5,
+            },
+            1.0,
+        ),
+        (
+            MaterialDesc::Mirror {
+                reflectance: Vec3::splat(0.7),
+            },
+            0.7,
+        ),
+    ] {
+        let mut desc = sky_sphere();
+        desc.materials = vec![material.clone()];
+        let film = run(&desc, path(u32::MAX), 256, 8);
+        assert_mean(
+            &format!("{material:?} in a white furnace"),
+            &film,
+            DVec3::splat(truth),
+        );
+        // Every pixel, not just the mean.
+        for p in film.pixels() {
+            let se = p.variance_of_mean().map(f64::sqrt);
+            for c in 0..3 {
+                assert!(
+                    (p.mean()[c] - truth).abs() <= MAX_Z * se[c] + 1e-4,
+                    "{material:?}: pixel {:?}",
+                    p.mean()
+                );
+            }
+        }
+    }
+}

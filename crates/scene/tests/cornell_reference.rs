@@ -99,15 +99,25 @@ const BLOCK: usize = 8;
 /// Only blocks whose reference mean (average of the channels) is at least `min_ref` count.
 /// Returns the number of outlier blocks per channel and the number of blocks compared.
 fn compare_blocks(film: &Film, r: &Reference, min_ref: f64) -> ([usize; 3], usize) {
+    compare_blocks_of(film, r, min_ref, BLOCK)
+}
+
+/// [`compare_blocks`] with blocks of `block` x `block` pixels.
+fn compare_blocks_of(
+    film: &Film,
+    r: &Reference,
+    min_ref: f64,
+    block: usize,
+) -> ([usize; 3], usize) {
     let w = film.width() as usize;
-    let (bw, bh) = (w / BLOCK, film.height() as usize / BLOCK);
+    let (bw, bh) = (w / block, film.height() as usize / block);
     let mut outliers = [0usize; 3];
     let mut compared = 0;
     for by in 0..bh {
         for bx in 0..bw {
             let (mut diff, mut var, mut reference) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
-            for y in by * BLOCK..(by + 1) * BLOCK {
-                for x in bx * BLOCK..(bx + 1) * BLOCK {
+            for y in by * block..(by + 1) * block {
+                for x in bx * block..(bx + 1) * block {
                     let i = y * w + x;
                     let p = film.pixels()[i];
                     let rounding = r.mean[i].abs() * REFERENCE_ROUNDING;
@@ -116,7 +126,7 @@ fn compare_blocks(film: &Film, r: &Reference, min_ref: f64) -> ([usize; 3], usiz
                     var += p.variance_of_mean() + r.stderr[i] * r.stderr[i] + rounding * rounding;
                 }
             }
-            if reference.element_sum() / ((3 * BLOCK * BLOCK) as f64) < min_ref {
+            if reference.element_sum() / ((3 * block * block) as f64) < min_ref {
                 continue;
             }
             compared += 1;
@@ -569,4 +579,47 @@ fn error_driven_allocation_beats_uniform_at_equal_samples() {
         "error-driven bias: image mean {:.5?} vs reference {:.5?}, z {:.2?}; per-pixel |z| > 4: {:?}",
         c.ours_mean, c.ref_mean, c.mean_z, c.outliers
     );
+}
+
+#[test]
+fn mirror_and_glass_spheres_match_mitsuba() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-spheres");
+    let desc = pathlab_scene::mitsuba::load(&dir.join("scene.xml")).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let scene = Scene::build(&desc).unwrap();
+    let film = render(
+        &scene,
+        &path(u32::MAX),
+        &RenderSettings::new(256, 81, SamplerKind::Independent),
+        &|_| {},
+        &Default::default(),
+    )
+    .0;
+    let read = |name: &str| -> Vec<DVec3> {
+        read_exr_rgb(&dir.join(name))
+            .unwrap()
+            .2
+            .iter()
+            .map(|p| p.as_dvec3())
+            .collect()
+    };
+    let r = Reference {
+        mean: read("mean-maxdepth-inf.exr"),
+        stderr: read("stderr-maxdepth-inf.exr"),
+    };
+    let c = compare(&film, &r);
+    let (out, blocks) = compare_blocks(&film, &r, 0.0);
+    eprintln!(
+        "cornell-spheres -m inf: per-pixel outliers {:?}; blocks {out:?} of {blocks}; image mean {:.5?} vs {:.5?}, z {:.2?}",
+        c.outliers, c.ours_mean, c.ref_mean, c.mean_z
+    );
+    // Caustics through the glass sphere (light reaching the walls only through it) are rare,
+    // bright paths: at 256 spp even 8 x 8 blocks often miss them and then underestimate both
+    // their mean and their variance (all the outlier blocks above are low). Means over 64 x 64
+    // regions (16 384 pixels' samples each) are close to normal: none of the 48 region-channel
+    // z values may exceed 4, and the image mean must agree within 3 combined standard errors.
+    let (regions, count) = compare_blocks_of(&film, &r, 0.0, 64);
+    eprintln!("64 x 64 regions beyond 4 sigma: {regions:?} of {count}");
+    assert_eq!(regions, [0, 0, 0]);
+    assert!(c.mean_z.abs().max_element() <= MAX_MEAN_Z, "{:?}", c.mean_z);
 }

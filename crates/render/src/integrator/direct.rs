@@ -64,18 +64,18 @@ pub struct DirectIntegrator {
 }
 
 impl DirectIntegrator {
-    /// Emission found along a sampled direction, weighted by f |cos| / pdf.
+    /// Emission found along a sampled direction `wi`, weighted by `f_cos / pdf` (f_cos being
+    /// f(wo, wi) |cos θi|, or the sampled value of a delta lobe); also returns the density with
+    /// which light sampling would have found it.
     fn gather(
         scene: &Scene,
         si: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        wo: Vec3,
         wi: Vec3,
+        f_cos: Rgb,
         pdf: f32,
         stats: &mut PathStats,
     ) -> (Rgb, Option<f32>) {
-        let f = bsdf.f(wo, wi) * wi.dot(si.ns).abs();
-        if f.max_element() <= 0.0 || pdf <= 0.0 {
+        if f_cos.max_element() <= 0.0 || pdf <= 0.0 {
             return (Rgb::ZERO, None);
         }
         let ray = spawn_ray(si.p, si.ng, wi);
@@ -84,7 +84,7 @@ impl DirectIntegrator {
             None => escaped(scene, &ray),
         };
         match found {
-            Some((le, pdf_light)) => (f * le / pdf, Some(pdf_light)),
+            Some((le, pdf_light)) => (f_cos * le / pdf, Some(pdf_light)),
             None => (Rgb::ZERO, None),
         }
     }
@@ -112,7 +112,8 @@ impl Integrator for DirectIntegrator {
                         (w, cosine_hemisphere_pdf(w.z))
                     };
                     let wi = frame.to_world(w);
-                    sum += Self::gather(scene, &si, &bsdf, wo, wi, pdf, stats).0;
+                    let f_cos = bsdf.f(wo, wi) * wi.dot(si.ns).abs();
+                    sum += Self::gather(scene, &si, wi, f_cos, pdf, stats).0;
                 }
                 DirectStrategy::Light => {
                     let u_select = sampler.next_1d();
@@ -124,10 +125,15 @@ impl Integrator for DirectIntegrator {
                     let u_light = sampler.next_2d();
                     sum += sample_light(scene, &si, &bsdf, wo, u_select, u_light, n, n, stats);
                     if let Some(bs) = bsdf.sample_f(wo, sampler.next_2d()) {
-                        let (c, pdf_light) =
-                            Self::gather(scene, &si, &bsdf, wo, bs.wi, bs.pdf, stats);
+                        let f_cos = bs.f * bs.wi.dot(si.ns).abs();
+                        let (c, pdf_light) = Self::gather(scene, &si, bs.wi, f_cos, bs.pdf, stats);
                         if let Some(pdf_light) = pdf_light {
-                            sum += c * power_heuristic(n, bs.pdf, n, pdf_light);
+                            let w = if bs.delta {
+                                1.0
+                            } else {
+                                power_heuristic(n, bs.pdf, n, pdf_light)
+                            };
+                            sum += c * w;
                         }
                     }
                 }

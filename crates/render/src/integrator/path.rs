@@ -51,7 +51,8 @@ impl Integrator for PathIntegrator {
         let mut beta = Rgb::ONE;
         let wants = |bounce: u32| self.only_bounce.is_none_or(|k| k == bounce);
         let n_light = self.light_samples.max(1);
-        // The previous vertex and the BSDF density of the direction that left it.
+        // The previous vertex and the BSDF density of the direction that left it (infinite
+        // for a delta lobe, which gives emission found through it MIS weight one).
         let mut prev: Option<(glam::Vec3, f32)> = None;
         let mut depth = 0u32;
         loop {
@@ -80,7 +81,7 @@ impl Integrator for PathIntegrator {
                 break;
             }
             let bsdf = Bsdf::new(scene.material(si.material), si.ns, wo);
-            if wants(depth + 1) {
+            if wants(depth + 1) && !bsdf.is_delta() {
                 let mut ld = Rgb::ZERO;
                 for _ in 0..n_light {
                     let u_select = sampler.next_1d();
@@ -101,7 +102,7 @@ impl Integrator for PathIntegrator {
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
-            prev = Some((si.p, bs.pdf));
+            prev = Some((si.p, if bs.delta { f32::INFINITY } else { bs.pdf }));
             depth += 1;
             let u_rr = sampler.next_1d();
             if depth >= self.rr_depth {
