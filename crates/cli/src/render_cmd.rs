@@ -85,6 +85,17 @@ pub struct RenderArgs {
     /// the samples-per-pixel heat map to NAME_rate.png.
     #[arg(short = 'a', long, num_args = 0..=2, value_names = ["BATCH", "TOL"], default_missing_values = ["32", "0.05"])]
     pub adaptive: Option<Vec<String>>,
+    /// Thin lens: aperture radius (0: pinhole). Overrides the scene's.
+    #[arg(
+        short = 'b',
+        long,
+        value_name = "RADIUS",
+        allow_negative_numbers = true
+    )]
+    pub lens_radius: Option<f32>,
+    /// Thin lens: distance to the plane in focus. Overrides the scene's.
+    #[arg(short = 'd', long, value_name = "DISTANCE")]
+    pub focal_distance: Option<f32>,
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black).
     #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"])]
     pub crop: Option<Vec<u32>>,
@@ -208,6 +219,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         for w in &desc.warnings {
             eprintln!("warning: {w}");
         }
+    }
+    if let Some(b) = args.lens_radius {
+        if !(b.is_finite() && b >= 0.0) {
+            bail!("--lens-radius {b}: must be a finite number >= 0");
+        }
+        desc.camera.lens_radius = b;
+    }
+    if let Some(d) = args.focal_distance {
+        if !(d.is_finite() && d > 0.0) {
+            bail!("--focal-distance {d}: must be a positive distance");
+        }
+        desc.camera.focal_distance = d;
     }
     let spp = args.spp.or(desc.hints.spp).unwrap_or(64);
     let max_depth = cli_depth.or(desc.hints.max_depth).unwrap_or(u32::MAX);

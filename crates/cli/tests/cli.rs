@@ -541,6 +541,8 @@ fn bad_render_flags_are_one_line_errors() {
         &pathlab(&["render", "--crop", "10", "10", "5", "20"]),
         "--crop",
     );
+    assert_one_line_error(&pathlab(&["render", "-b", "-1"]), "--lens-radius");
+    assert_one_line_error(&pathlab(&["render", "-d", "0"]), "--focal-distance");
     assert_one_line_error(
         &pathlab(&["render", "-s", "1", "-o", "/nonexistent-dir/x.png"]),
         "nonexistent-dir",
@@ -585,7 +587,16 @@ fn info_and_render_read_scene_files() {
     let text =
         String::from_utf8(pathlab(&["info", &course_scene("CBspheres.dae")]).stdout).unwrap();
     assert!(
-        text.contains("2 spheres") && text.contains("warning"),
+        text.contains("2 spheres") && text.contains("1 mirror") && !text.contains("warning"),
+        "{text}"
+    );
+    // Microfacet conductors are still drawn by a stand-in, and info says so.
+    let text = String::from_utf8(
+        pathlab(&["info", &course_scene("CBspheres_microfacet_al_ag.dae")]).stdout,
+    )
+    .unwrap();
+    assert!(
+        text.contains("warning") && text.contains("conductor"),
         "{text}"
     );
 }
