@@ -581,16 +581,19 @@ fn error_driven_allocation_beats_uniform_at_equal_samples() {
     );
 }
 
-#[test]
-fn mirror_and_glass_spheres_match_mitsuba() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-spheres");
+/// Renders a reference folder's scene.xml at -m inf and loads its reference.
+fn render_reference_scene(folder: &str, spp: u32, seed: u64) -> (Film, Reference) {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(folder);
     let desc = pathlab_scene::mitsuba::load(&dir.join("scene.xml")).unwrap();
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
     let scene = Scene::build(&desc).unwrap();
+    let settings = RenderSettings::new(spp, seed, SamplerKind::Independent);
     let film = render(
         &scene,
         &path(u32::MAX),
-        &RenderSettings::new(256, 81, SamplerKind::Independent),
+        &settings,
         &|_| {},
         &Default::default(),
     )
@@ -607,6 +610,29 @@ fn mirror_and_glass_spheres_match_mitsuba() {
         mean: read("mean-maxdepth-inf.exr"),
         stderr: read("stderr-maxdepth-inf.exr"),
     };
+    (film, r)
+}
+
+#[test]
+fn thin_lens_matches_mitsuba() {
+    let (film, r) = render_reference_scene("cornell-thinlens", 128, 91);
+    let c = compare(&film, &r);
+    let (out, blocks) = compare_blocks(&film, &r, 0.0);
+    eprintln!(
+        "cornell-thinlens -m inf, 128 spp: per-pixel outliers {:?}; blocks {out:?} of {blocks}; image mean z {:.2?}",
+        c.outliers, c.mean_z
+    );
+    assert!(
+        out.iter()
+            .all(|&o| (o as f64) < MAX_OUTLIER_FRACTION * blocks as f64 + 1.0),
+        "{out:?}"
+    );
+    assert!(c.mean_z.abs().max_element() <= MAX_MEAN_Z, "{:?}", c.mean_z);
+}
+
+#[test]
+fn mirror_and_glass_spheres_match_mitsuba() {
+    let (film, r) = render_reference_scene("cornell-spheres", 256, 81);
     let c = compare(&film, &r);
     let (out, blocks) = compare_blocks(&film, &r, 0.0);
     eprintln!(
