@@ -93,16 +93,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         .map(|s| integrator(s.trim(), args.max_depth))
         .collect::<Result<Vec<_>>>()?;
     let mut desc = pathlab_scene::load(&args.scene)?;
-    if let Some(r) = &args.resolution {
-        if !(1..=16384).contains(&r[0]) || !(1..=16384).contains(&r[1]) {
-            bail!(
-                "--resolution {} {}: width and height must be between 1 and 16384",
-                r[0],
-                r[1]
-            );
-        }
-        desc.resolution = [r[0], r[1]];
-    }
+    crate::render_cmd::apply_resolution(&mut desc, args.resolution.as_deref())?;
     let [w, h] = desc.resolution;
     let reference = match &args.reference {
         Some(p) => {

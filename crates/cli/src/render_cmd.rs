@@ -4,6 +4,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::desc::SceneDesc;
 use pathlab_render::film::Film;
 use pathlab_render::image_io::{write_exr, write_png_with, write_rgb8, ExtraChannel, ToneMap};
 use pathlab_render::integrator::{
@@ -194,6 +195,17 @@ fn output_format(path: &Path) -> Result<OutputFormat> {
     }
 }
 
+/// Applies a `-r W H` override to a scene, checking the size.
+pub fn apply_resolution(desc: &mut SceneDesc, resolution: Option<&[u32]>) -> Result<()> {
+    if let Some(&[w, h]) = resolution {
+        if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+            bail!("--resolution {w} {h}: width and height must be between 1 and 16384");
+        }
+        desc.resolution = [w, h];
+    }
+    Ok(())
+}
+
 /// Set by Ctrl-C: the render stops and writes what it has.
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
@@ -234,13 +246,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let spp = args.spp.or(desc.hints.spp).unwrap_or(64);
     let max_depth = cli_depth.or(desc.hints.max_depth).unwrap_or(u32::MAX);
-    if let Some(r) = &args.resolution {
-        let (w, h) = (r[0], r[1]);
-        if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
-            bail!("--resolution {w} {h}: width and height must be between 1 and 16384");
-        }
-        desc.resolution = [w, h];
-    }
+    apply_resolution(&mut desc, args.resolution.as_deref())?;
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let integrator = match args.integrator {
         IntegratorName::Path => IntegratorKind::Path(PathIntegrator {

@@ -32,6 +32,22 @@ pub struct SceneDesc {
     pub hints: RenderHints,
 }
 
+impl SceneDesc {
+    /// The bounding box (min, max) of every mesh vertex and sphere, or `None` without shapes.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for &p in self.meshes.iter().flat_map(|m| &m.positions) {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        for s in &self.spheres {
+            lo = lo.min(s.center - Vec3::splat(s.radius));
+            hi = hi.max(s.center + Vec3::splat(s.radius));
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+}
+
 /// Render settings a scene file can suggest.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RenderHints {

@@ -68,18 +68,6 @@ pub fn summarize(desc: &SceneDesc) -> SceneInfo {
     add("spot", desc.spot_lights.len());
     add("directional", desc.directional_lights.len());
     add("environment", desc.environment.is_some() as usize);
-    let mut lo = Vec3::splat(f32::INFINITY);
-    let mut hi = Vec3::splat(f32::NEG_INFINITY);
-    for m in &desc.meshes {
-        for &p in &m.positions {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-    }
-    for s in &desc.spheres {
-        lo = lo.min(s.center - Vec3::splat(s.radius));
-        hi = hi.max(s.center + Vec3::splat(s.radius));
-    }
     let cam = pathlab_render::camera::Camera::new(&desc.camera, desc.resolution);
     let shapes = || desc.meshes.iter().filter(|m| !is_area_light(m));
     SceneInfo {
@@ -94,7 +82,7 @@ pub fn summarize(desc: &SceneDesc) -> SceneInfo {
             cam.vertical_fov_degrees(),
             desc.resolution,
         ),
-        bounds: (lo.x <= hi.x).then_some((lo, hi)),
+        bounds: desc.bounds(),
         warnings: desc.warnings.clone(),
     }
 }

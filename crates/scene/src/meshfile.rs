@@ -284,25 +284,14 @@ pub(crate) fn add_default_lights(desc: &mut SceneDesc) {
 /// A camera that frames the bounding box of all shapes from the front, slightly above and to
 /// the right, with a 40° vertical field of view.
 pub(crate) fn framing_camera(path: &Path, desc: &SceneDesc) -> Result<CameraDesc, Error> {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for m in &desc.meshes {
-        for &p in &m.positions {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-    }
-    for s in &desc.spheres {
-        lo = lo.min(s.center - Vec3::splat(s.radius));
-        hi = hi.max(s.center + Vec3::splat(s.radius));
-    }
-    if lo.x > hi.x {
+    let Some((lo, hi)) = desc.bounds() else {
         return Err(Error::Parse {
             path: path.display().to_string(),
             line: 0,
             column: 0,
             message: "the file holds no geometry".into(),
         });
-    }
+    };
     let center = 0.5 * (lo + hi);
     let radius = (0.5 * (hi - lo).length()).max(1e-6);
     let fov: f32 = 40.0;
