@@ -11,7 +11,7 @@ use pathlab_render::integrator::{
     DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
 };
 use pathlab_render::progressive::{render_progressive, StopRule};
-use pathlab_render::render::{render, Adaptive, RenderSettings};
+use pathlab_render::render::{render, Adaptive, AdaptiveRule, RenderSettings};
 use pathlab_render::scene::Scene;
 use serde_json::json;
 use std::io::IsTerminal;
@@ -32,6 +32,15 @@ pub enum IntegratorName {
     Depth,
     /// Debug view: BVH nodes visited per camera ray.
     Bvh,
+}
+
+/// Adaptive stopping rules.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum RuleName {
+    /// The course's relative-precision rule.
+    Course,
+    /// Samples in proportion to each pixel's standard deviation.
+    Neyman,
 }
 
 /// PNG tone maps.
@@ -97,6 +106,10 @@ pub struct RenderArgs {
     /// Thin lens: distance to the plane in focus. Overrides the scene's.
     #[arg(short = 'd', long, value_name = "DISTANCE")]
     pub focal_distance: Option<f32>,
+    /// Adaptive stopping rule: course (1.96σ/√n ≤ TOL·μ), or neyman (n ≥ (1.96/TOL)² σ/L̄
+    /// with L̄ from a 4-spp pilot: samples in proportion to σ, which minimises the image's MSE).
+    #[arg(long, value_enum, default_value_t = RuleName::Course)]
+    pub adaptive_rule: RuleName,
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black).
     #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"])]
     pub crop: Option<Vec<u32>>,
@@ -173,6 +186,7 @@ fn parse_adaptive(values: &[String]) -> Result<Adaptive> {
         batch,
         tolerance,
         min_samples: 4 * batch,
+        rule: AdaptiveRule::Course,
     })
 }
 
@@ -300,6 +314,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             );
         }
         settings.crop = Some([c[0], c[1], c[2], c[3]]);
+    }
+    if args.adaptive_rule == RuleName::Neyman {
+        if let Some(a) = settings.adaptive.as_mut() {
+            // A short pilot for the image's mean luminance (its samples are not reused).
+            let pilot = RenderSettings::new(4, args.seed.wrapping_add(1), sampler);
+            let (film, _) = render(&scene, &integrator, &pilot, &|_| {}, &CANCEL);
+            let m = film.image_mean();
+            let image_luminance = 0.2126 * m.x + 0.7152 * m.y + 0.0722 * m.z;
+            if image_luminance > 0.0 {
+                a.rule = AdaptiveRule::Neyman { image_luminance };
+            }
+        }
     }
     let [w, h] = desc.resolution;
     let total = settings.crop.map_or(w as u64 * h as u64, |c| {

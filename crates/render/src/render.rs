@@ -50,6 +50,23 @@ pub struct Adaptive {
     pub tolerance: f32,
     /// Samples every pixel takes before it may stop.
     pub min_samples: u32,
+    /// Which stopping rule.
+    pub rule: AdaptiveRule,
+}
+
+/// When an adaptive pixel stops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AdaptiveRule {
+    /// The course's: the 95% interval of the pixel's mean is within ± tolerance of that mean,
+    /// 1.96 σ/√n ≤ tolerance · μ. It gives n ∝ (σ/μ)², spending most on dark, noisy pixels.
+    Course,
+    /// n ≥ (1.96/tolerance)² · σ / L̄, with L̄ the image's mean luminance (from a short pilot
+    /// render): the course's test with μ replaced by √(σ L̄). It gives n ∝ σ, the allocation
+    /// that minimises the image's mean squared error for a given total (Neyman allocation).
+    Neyman {
+        /// The image's mean luminance.
+        image_luminance: f64,
+    },
 }
 
 impl Adaptive {
@@ -58,6 +75,7 @@ impl Adaptive {
         batch: 32,
         tolerance: 0.05,
         min_samples: 128,
+        rule: AdaptiveRule::Course,
     };
 
     /// Whether a pixel with these luminance statistics may stop.
@@ -70,8 +88,11 @@ impl Adaptive {
         if sigma <= 0.0 {
             return false;
         }
-        let half_width = 1.96 * sigma / (n as f64).sqrt();
-        half_width <= self.tolerance as f64 * luminance.mean()
+        let z = 1.96 / self.tolerance as f64;
+        match self.rule {
+            AdaptiveRule::Course => z * sigma / (n as f64).sqrt() <= luminance.mean(),
+            AdaptiveRule::Neyman { image_luminance } => n as f64 * image_luminance >= z * z * sigma,
+        }
     }
 }
 

@@ -649,3 +649,75 @@ fn mirror_and_glass_spheres_match_mitsuba() {
     assert_eq!(regions, [0, 0, 0]);
     assert!(c.mean_z.abs().max_element() <= MAX_MEAN_Z, "{:?}", c.mean_z);
 }
+
+#[test]
+fn neyman_adaptive_sampling_matches_mitsuba_and_lowers_the_expected_error() {
+    use pathlab_render::render::{Adaptive, AdaptiveRule};
+    let desc = pathlab_scene::builtin::cornell_box().unwrap();
+    let scene = Scene::build(&desc).unwrap();
+    let r = reference("2");
+    // A short pilot (4 spp) gives the image's mean luminance; its samples count in the total.
+    let pilot = render(
+        &scene,
+        &path(1),
+        &RenderSettings::new(4, 90, SamplerKind::Independent),
+        &|_| {},
+        &Default::default(),
+    );
+    let m = pilot.0.image_mean();
+    let image_luminance = 0.2126 * m.x + 0.7152 * m.y + 0.0722 * m.z;
+    let mut settings = RenderSettings::new(1024, 91, SamplerKind::Independent);
+    settings.adaptive = Some(Adaptive {
+        rule: AdaptiveRule::Neyman { image_luminance },
+        ..Adaptive::DEFAULT
+    });
+    let (adaptive, stats) = render(&scene, &path(1), &settings, &|_| {}, &Default::default());
+    let n = adaptive.pixels().len() as f64;
+    let total = stats.samples + pilot.1.samples;
+    let spp = (total as f64 / n).round() as u32;
+    let uniform = render(
+        &scene,
+        &path(1),
+        &RenderSettings::new(spp, 92, SamplerKind::Independent),
+        &|_| {},
+        &Default::default(),
+    )
+    .0;
+    let sq = |f: &Film| -> Vec<f64> {
+        f.pixels()
+            .iter()
+            .zip(&r.mean)
+            .map(|(p, m)| (p.mean() - *m).length_squared() / 3.0)
+            .collect()
+    };
+    let (ea, eu) = (sq(&adaptive), sq(&uniform));
+    let d: Vec<f64> = eu.iter().zip(&ea).map(|(u, a)| u - a).collect();
+    let mean = d.iter().sum::<f64>() / n;
+    let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let rmse = |e: &[f64]| (e.iter().sum::<f64>() / n).sqrt();
+    eprintln!(
+        "Neyman adaptive: {spp} spp on average incl. pilot; RMSE {:.5} vs uniform {:.5}; MSE difference {mean:.2e} ± {se:.1e}",
+        rmse(&ea),
+        rmse(&eu)
+    );
+    let c = compare(&adaptive, &r);
+    eprintln!(
+        "Neyman adaptive vs reference: outliers {:?}, image mean z {:.2?}",
+        c.outliers, c.mean_z
+    );
+    assert_agrees("Neyman adaptive -m 1", &c);
+    // The expected MSE of each allocation, from the per-pixel variances the adaptive render
+    // measured (every pixel has at least 128 samples): Σ σ²/n against Σ σ²/n̄ for uniform.
+    let (mut adaptive_mse, mut uniform_mse) = (0.0, 0.0);
+    for p in adaptive.pixels() {
+        let var = p.variance().element_sum() / 3.0;
+        adaptive_mse += var / p.count() as f64;
+        uniform_mse += var / spp as f64;
+    }
+    eprintln!(
+        "expected RMSE from the variances: Neyman {:.5}, uniform {:.5}",
+        (adaptive_mse / n).sqrt(),
+        (uniform_mse / n).sqrt()
+    );
+    assert!(adaptive_mse < uniform_mse);
+}
