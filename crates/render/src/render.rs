@@ -276,6 +276,7 @@ mod tests {
             batch: 8,
             tolerance: 0.05,
             min_samples: 16,
+            rule: AdaptiveRule::Course,
         };
         // Equal samples (all black, or all on a light) never stop a pixel: their variance
         // estimate of zero is no evidence of a tight interval.
@@ -294,5 +295,14 @@ mod tests {
             |n: usize| -> Vec<f64> { (0..n).map(|i| if i % 2 == 0 { 0.5 } else { 1.5 }).collect() };
         assert!(!a.converged(&stats(&alternating(300))));
         assert!(a.converged(&stats(&alternating(400))));
+        // Neyman: n ≥ (1.96/tol)² σ / L̄; with σ = 0.5 and L̄ = 1 that is n ≥ 768.4.
+        let neyman = Adaptive {
+            rule: AdaptiveRule::Neyman {
+                image_luminance: 1.0,
+            },
+            ..a
+        };
+        assert!(!neyman.converged(&stats(&alternating(760))));
+        assert!(neyman.converged(&stats(&alternating(780))));
     }
 }
