@@ -138,6 +138,29 @@ fn compare_blocks_of(
     (outliers, compared)
 }
 
+/// Per-pixel squared error against the reference mean, averaged over the channels.
+fn squared_errors(film: &Film, r: &Reference) -> Vec<f64> {
+    film.pixels()
+        .iter()
+        .zip(&r.mean)
+        .map(|(p, m)| (p.mean() - *m).length_squared() / 3.0)
+        .collect()
+}
+
+/// Mean and standard error of the paired differences `worse[i] - better[i]`.
+fn paired_difference(worse: &[f64], better: &[f64]) -> (f64, f64) {
+    let n = worse.len() as f64;
+    let d: Vec<f64> = worse.iter().zip(better).map(|(w, b)| w - b).collect();
+    let mean = d.iter().sum::<f64>() / n;
+    let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    (mean, se)
+}
+
+/// Root of the mean of squared errors.
+fn rms(e: &[f64]) -> f64 {
+    (e.iter().sum::<f64>() / e.len() as f64).sqrt()
+}
+
 fn assert_agrees(name: &str, c: &Comparison) {
     eprintln!(
         "{name}: outliers per channel {:?} of {} pixels; image mean {:.5?} vs reference {:.5?}, z {:.2?}",
@@ -375,17 +398,9 @@ fn adaptive_sampling_matches_mitsuba() {
             })
             .collect()
     };
-    let paired = |a: &[f64], u: &[f64]| -> (f64, f64) {
-        let d: Vec<f64> = u.iter().zip(a).map(|(u, a)| u - a).collect();
-        let mean = d.iter().sum::<f64>() / n;
-        (
-            mean,
-            (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt(),
-        )
-    };
+    let paired = |better: &[f64], worse: &[f64]| paired_difference(worse, better);
     let (abs_a, abs_u) = (errors(&adaptive, false), errors(&uniform, false));
     let (rel_a, rel_u) = (errors(&adaptive, true), errors(&uniform, true));
-    let rms = |e: &[f64]| (e.iter().sum::<f64>() / n).sqrt();
     eprintln!(
         "adaptive: {:.1} spp on average (max 1024) vs uniform {spp}: RMSE {:.5} vs {:.5}; relative RMSE {:.5} vs {:.5}",
         stats.samples as f64 / n,
@@ -442,26 +457,18 @@ fn sobol_beats_independent_at_equal_samples() {
             &Default::default(),
         )
         .0;
-        film.pixels()
-            .iter()
-            .zip(&r.mean)
-            .map(|(p, m)| (p.mean() - *m).length_squared() / 3.0)
-            .collect()
+        squared_errors(&film, &r)
     };
     let (ind, sob) = (
         err(SamplerKind::Independent, 51),
         err(SamplerKind::Sobol, 52),
     );
-    let n = ind.len() as f64;
-    let d: Vec<f64> = ind.iter().zip(&sob).map(|(i, s)| i - s).collect();
-    let mean = d.iter().sum::<f64>() / n;
-    let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
-    let rmse = |e: &[f64]| (e.iter().sum::<f64>() / n).sqrt();
+    let (mean, se) = paired_difference(&ind, &sob);
     eprintln!(
         "-m 1, 64 spp: RMSE independent {:.5}, Sobol {:.5} (factor {:.2}); MSE difference {mean:.2e} ± {se:.1e}",
-        rmse(&ind),
-        rmse(&sob),
-        rmse(&ind) / rmse(&sob)
+        rms(&ind),
+        rms(&sob),
+        rms(&ind) / rms(&sob)
     );
     assert!(
         mean > MAX_Z * se,
@@ -550,22 +557,13 @@ fn error_driven_allocation_beats_uniform_at_equal_samples() {
         &Default::default(),
     )
     .0;
-    let sq = |f: &Film| -> Vec<f64> {
-        f.pixels()
-            .iter()
-            .zip(&r.mean)
-            .map(|(p, m)| (p.mean() - *m).length_squared() / 3.0)
-            .collect()
-    };
+    let sq = |f: &Film| squared_errors(f, &r);
     let (ep, eu) = (sq(&progressive), sq(&uniform));
-    let d: Vec<f64> = eu.iter().zip(&ep).map(|(u, p)| u - p).collect();
-    let mean = d.iter().sum::<f64>() / n;
-    let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
-    let rmse = |e: &[f64]| (e.iter().sum::<f64>() / n).sqrt();
+    let (mean, se) = paired_difference(&eu, &ep);
     eprintln!(
         "{spp} spp on average: RMSE error-driven {:.5} vs uniform {:.5}; MSE difference {mean:.2e} ± {se:.1e}",
-        rmse(&ep),
-        rmse(&eu)
+        rms(&ep),
+        rms(&eu)
     );
     assert!(
         mean > MAX_Z * se,
@@ -683,22 +681,13 @@ fn neyman_adaptive_sampling_matches_mitsuba_and_lowers_the_expected_error() {
         &Default::default(),
     )
     .0;
-    let sq = |f: &Film| -> Vec<f64> {
-        f.pixels()
-            .iter()
-            .zip(&r.mean)
-            .map(|(p, m)| (p.mean() - *m).length_squared() / 3.0)
-            .collect()
-    };
+    let sq = |f: &Film| squared_errors(f, &r);
     let (ea, eu) = (sq(&adaptive), sq(&uniform));
-    let d: Vec<f64> = eu.iter().zip(&ea).map(|(u, a)| u - a).collect();
-    let mean = d.iter().sum::<f64>() / n;
-    let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
-    let rmse = |e: &[f64]| (e.iter().sum::<f64>() / n).sqrt();
+    let (mean, se) = paired_difference(&eu, &ea);
     eprintln!(
         "Neyman adaptive: {spp} spp on average incl. pilot; RMSE {:.5} vs uniform {:.5}; MSE difference {mean:.2e} ± {se:.1e}",
-        rmse(&ea),
-        rmse(&eu)
+        rms(&ea),
+        rms(&eu)
     );
     let c = compare(&adaptive, &r);
     eprintln!(
