@@ -200,7 +200,7 @@ fn write_side_by_side(rows: &[Row], path: &std::path::Path) -> Result<()> {
             }
         }
     }
-    crate::plot::register_fonts();
+    crate::plot::register_font();
     {
         let root = BitMapBackend::with_buffer(&mut buf, (tw, th)).into_drawing_area();
         for (k, r) in rows.iter().enumerate() {

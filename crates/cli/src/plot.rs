@@ -39,11 +39,7 @@ fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
 }
 
 /// Registers the embedded font for plotters' text (idempotent).
-pub fn register_fonts() {
-    register_font();
-}
-
-fn register_font() {
+pub fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The font is a valid TrueType file shipped by the `dejavu` crate; if it were rejected,

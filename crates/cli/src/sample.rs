@@ -8,7 +8,9 @@ use glam::{Vec2, Vec3};
 use pathlab_mc::distribution::{AliasTable, Exponential, PiecewiseConstant1D, PiecewiseConstant2D};
 use pathlab_mc::estimator::RunningStats;
 use pathlab_mc::sampler::{AnySampler, Sampler, SamplerKind};
-use pathlab_mc::stats::{chi2_test_1d, chi2_test_2d, chi2_test_discrete, z_test, ChiSquareTest};
+use pathlab_mc::stats::{
+    azimuth, chi2_test_1d, chi2_test_2d, chi2_test_discrete, cos_theta_phi, z_test, ChiSquareTest,
+};
 use pathlab_mc::warp::*;
 use serde_json::json;
 use std::f64::consts::TAU;
@@ -300,14 +302,6 @@ fn samples(
     })
 }
 
-fn cos_theta_phi(p: [f64; 3]) -> [f64; 2] {
-    let mut phi = p[1].atan2(p[0]);
-    if phi < 0.0 {
-        phi += TAU;
-    }
-    [p[2], phi]
-}
-
 fn fit(dist: &Dist, kind: SamplerKind, n: u32, seed: u64, want_plot: bool) -> Fit {
     const RES: [usize; 2] = [32, 32];
     let draw = || samples(dist, kind, n, seed);
@@ -365,13 +359,7 @@ fn fit(dist: &Dist, kind: SamplerKind, n: u32, seed: u64, want_plot: bool) -> Fi
         }
         Dist::Disk => {
             // In polar coordinates (r, φ) the area density 1/π becomes r/π.
-            let to_polar = |p: [f64; 3]| {
-                let mut phi = p[1].atan2(p[0]);
-                if phi < 0.0 {
-                    phi += TAU;
-                }
-                [(p[0] * p[0] + p[1] * p[1]).sqrt(), phi]
-            };
+            let to_polar = |p: [f64; 3]| [(p[0] * p[0] + p[1] * p[1]).sqrt(), azimuth(p[1], p[0])];
             let pdf = |r: f64, _: f64| r * uniform_disk_pdf(Vec2::ZERO) as f64;
             let dom = [[0.0, 1.0], [0.0, TAU]];
             let test = chi2_test_2d(draw().map(to_polar), pdf, dom, RES);

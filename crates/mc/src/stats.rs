@@ -235,6 +235,25 @@ fn quadrature_2d(f: &impl Fn(f64, f64) -> f64, xr: [f64; 2], yr: [f64; 2]) -> f6
     sum * 0.25 * hx * hy
 }
 
+/// The azimuth atan2(y, x), in [0, 2π).
+#[inline]
+pub fn azimuth(y: f64, x: f64) -> f64 {
+    let phi = y.atan2(x);
+    if phi < 0.0 {
+        phi + std::f64::consts::TAU
+    } else {
+        phi
+    }
+}
+
+/// (cos θ, φ) of a unit direction `[x, y, z]`: the parameterisation in which a density per unit
+/// solid angle is a density per unit area (dω = d(cos θ) dφ), for chi-square tests of
+/// directions.
+#[inline]
+pub fn cos_theta_phi(d: [f64; 3]) -> [f64; 2] {
+    [d[2], azimuth(d[1], d[0])]
+}
+
 /// The outcome of a z-test.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ZTest {

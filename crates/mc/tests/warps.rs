@@ -87,11 +87,10 @@ fn concentric_disk_fits_its_pdf() {
     // Tested in polar coordinates (r, φ), where the area density becomes r · pdf(p).
     let samples = draws(N, 5, |s| {
         let p = sample_uniform_disk_concentric(s.next_2d());
-        let mut phi = (p.y as f64).atan2(p.x as f64);
-        if phi < 0.0 {
-            phi += TAU;
-        }
-        [p.length() as f64, phi]
+        [
+            p.length() as f64,
+            pathlab_mc::stats::azimuth(p.y as f64, p.x as f64),
+        ]
     });
     let t = chi2_test_2d(
         samples,

@@ -77,7 +77,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneDesc, Error> {
     for node in children(scene, "node") {
         loader.node(node, entry)?;
     }
-    loader.finish(path)
+    loader.finish()
 }
 
 /// A CGL area light: a parallelogram emitting `radiance` towards `direction`.
@@ -390,7 +390,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 continue;
             }
             let (material, emission) = self.bound_material(inst, prim.attribute("material"))?;
-            let tri = self.primitive(mesh, prim)?;
+            let tri = self.primitive(prim)?;
             let positions: Vec<Vec3> = tri
                 .positions
                 .iter()
@@ -463,11 +463,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             .collect())
     }
 
-    fn primitive(
-        &self,
-        mesh: Node<'a, 'input>,
-        prim: Node<'a, 'input>,
-    ) -> Result<Triangles, Error> {
+    fn primitive(&self, prim: Node<'a, 'input>) -> Result<Triangles, Error> {
         // Inputs: semantic, source, offset.
         let mut stride = 0usize;
         let mut pos: Option<(Vec<Vec3>, usize)> = None;
@@ -616,7 +612,6 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 }
             }
         }
-        let _ = mesh;
         Ok(out)
     }
 
@@ -710,7 +705,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         Ok(())
     }
 
-    fn finish(mut self, path: &Path) -> Result<SceneDesc, Error> {
+    fn finish(mut self) -> Result<SceneDesc, Error> {
         // CGL lights: emissive meshes are seen by camera rays only, and the area lights light
         // the scene as one-sided parallelograms hidden from the camera.
         if self.has_cgl_lights {
@@ -771,7 +766,6 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 .push("the scene has no lights: lit by a uniform white environment".into());
         }
         self.desc.camera = self.course_camera()?;
-        let _ = path;
         Ok(self.desc)
     }
 
@@ -812,19 +806,18 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         let aspect = aspect
             .filter(|a| *a > 0.0 && a.is_finite())
             .unwrap_or(4.0 / 3.0);
-        let (mut tx, mut ty) = match (xfov, yfov) {
+        let (tx, mut ty) = match (xfov, yfov) {
             (Some(x), Some(y)) => (half_tan(x), half_tan(y)),
             (Some(x), None) => (half_tan(x), half_tan(x) / aspect),
             (None, Some(y)) => (half_tan(y) * aspect, half_tan(y)),
             (None, None) => (half_tan(50.0), half_tan(50.0) * 0.75),
         };
-        // Configure for 800 x 600: widen whichever field of view is too small for 4:3.
-        if tx / ty < 4.0 / 3.0 {
-            tx = ty * 4.0 / 3.0;
-        } else {
+        // Configure for 800 x 600: widen whichever field of view is too small for 4:3. Only the
+        // vertical one matters from here on (it fixes the image-plane distance), and it changes
+        // only when the horizontal one is the wider.
+        if tx / ty >= 4.0 / 3.0 {
             ty = tx * 0.75;
         }
-        let _ = tx;
         let d = 600.0 / (2.0 * ty);
         let phi = dir.y.clamp(-1.0, 1.0).acos();
         let theta = dir.x.atan2(dir.z);

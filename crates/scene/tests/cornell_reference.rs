@@ -9,7 +9,7 @@ use pathlab_render::image_io::read_exr_rgb;
 use pathlab_render::integrator::{
     DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
 };
-use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::render::{render, RenderSettings, RenderStats};
 use pathlab_render::scene::Scene;
 use std::path::PathBuf;
 
@@ -198,6 +198,18 @@ fn render_cornell_window(
     render(&scene, &integrator, &settings, &|_| {}, &Default::default()).0
 }
 
+/// Renders `scene` by path tracing to `max_depth` with `spp` independent samples per pixel.
+fn render_independent(scene: &Scene, max_depth: u32, spp: u32, seed: u64) -> (Film, RenderStats) {
+    let settings = RenderSettings::new(spp, seed, SamplerKind::Independent);
+    render(
+        scene,
+        &path(max_depth),
+        &settings,
+        &|_| {},
+        &Default::default(),
+    )
+}
+
 fn path(max_depth: u32) -> IntegratorKind {
     IntegratorKind::Path(PathIntegrator {
         max_depth,
@@ -322,14 +334,7 @@ fn mitsuba_xml_scene_matches_mitsuba_pixel_by_pixel() {
     )
     .unwrap();
     let scene = Scene::build(&desc).unwrap();
-    let film = render(
-        &scene,
-        &path(1),
-        &RenderSettings::new(512, 31, SamplerKind::Independent),
-        &|_| {},
-        &Default::default(),
-    )
-    .0;
+    let film = render_independent(&scene, 1, 512, 31).0;
     let r = reference("2");
     assert_agrees("scene.xml -m 1", &compare(&film, &r));
     let (out, blocks) = compare_blocks(&film, &r, 0.0);
@@ -376,14 +381,7 @@ fn adaptive_sampling_matches_mitsuba() {
     // relative one.
     let n = adaptive.pixels().len() as f64;
     let spp = (stats.samples as f64 / n).round() as u32;
-    let uniform = render(
-        &scene,
-        &path(1),
-        &RenderSettings::new(spp, 42, SamplerKind::Independent),
-        &|_| {},
-        &Default::default(),
-    )
-    .0;
+    let uniform = render_independent(&scene, 1, spp, 42).0;
     let errors = |f: &Film, relative: bool| -> Vec<f64> {
         f.pixels()
             .iter()
@@ -549,14 +547,7 @@ fn error_driven_allocation_beats_uniform_at_equal_samples() {
     );
     let n = progressive.pixels().len() as f64;
     let spp = (stats.samples as f64 / n).round() as u32;
-    let uniform = render(
-        &scene,
-        &path(1),
-        &RenderSettings::new(spp, 72, SamplerKind::Independent),
-        &|_| {},
-        &Default::default(),
-    )
-    .0;
+    let uniform = render_independent(&scene, 1, spp, 72).0;
     let sq = |f: &Film| squared_errors(f, &r);
     let (ep, eu) = (sq(&progressive), sq(&uniform));
     let (mean, se) = paired_difference(&eu, &ep);
@@ -655,13 +646,7 @@ fn neyman_adaptive_sampling_matches_mitsuba_and_lowers_the_expected_error() {
     let scene = Scene::build(&desc).unwrap();
     let r = reference("2");
     // A short pilot (4 spp) gives the image's mean luminance; its samples count in the total.
-    let pilot = render(
-        &scene,
-        &path(1),
-        &RenderSettings::new(4, 90, SamplerKind::Independent),
-        &|_| {},
-        &Default::default(),
-    );
+    let pilot = render_independent(&scene, 1, 4, 90);
     let m = pilot.0.image_mean();
     let image_luminance = 0.2126 * m.x + 0.7152 * m.y + 0.0722 * m.z;
     let mut settings = RenderSettings::new(1024, 91, SamplerKind::Independent);
@@ -673,14 +658,7 @@ fn neyman_adaptive_sampling_matches_mitsuba_and_lowers_the_expected_error() {
     let n = adaptive.pixels().len() as f64;
     let total = stats.samples + pilot.1.samples;
     let spp = (total as f64 / n).round() as u32;
-    let uniform = render(
-        &scene,
-        &path(1),
-        &RenderSettings::new(spp, 92, SamplerKind::Independent),
-        &|_| {},
-        &Default::default(),
-    )
-    .0;
+    let uniform = render_independent(&scene, 1, spp, 92).0;
     let sq = |f: &Film| squared_errors(f, &r);
     let (ea, eu) = (sq(&adaptive), sq(&uniform));
     let (mean, se) = paired_difference(&eu, &ea);

@@ -64,9 +64,5 @@ pub fn draws<T>(n: u32, seed: u64, mut f: impl FnMut(&mut IndependentSampler) ->
 /// (cos θ, φ) of a direction, φ in [0, 2π): the parameterisation in which a solid-angle density
 /// is a density per unit area.
 pub fn cos_theta_phi(w: glam::Vec3) -> [f64; 2] {
-    let mut phi = (w.y as f64).atan2(w.x as f64);
-    if phi < 0.0 {
-        phi += std::f64::consts::TAU;
-    }
-    [w.z as f64, phi]
+    pathlab_mc::stats::cos_theta_phi(w.as_dvec3().to_array())
 }
