@@ -2,6 +2,8 @@
 
 use glam::{Vec2, Vec3};
 
+pub use crate::bsdf::{FresnelModel, NormalDistribution};
+
 /// Linear RGB.
 pub type Rgb = Vec3;
 
@@ -154,12 +156,16 @@ pub enum MaterialDesc {
         reflectance: Rgb,
         /// Transmittance scale.
         transmittance: Rgb,
-        /// Roughness (0: smooth).
+        /// Roughness α of the microfacet distribution (0: smooth).
         roughness: f32,
-        /// Index of refraction inside.
+        /// Index of refraction inside relative to outside.
         ior: f32,
+        /// Microfacet distribution when rough.
+        distribution: NormalDistribution,
+        /// Fresnel reflectance of the smooth interface.
+        fresnel: FresnelModel,
     },
-    /// A rough conductor (microfacet model).
+    /// A conductor: smooth (α = 0) or rough (microfacet model).
     Conductor {
         /// Roughness α of the normal distribution.
         alpha: f32,
@@ -167,6 +173,17 @@ pub enum MaterialDesc {
         eta: Rgb,
         /// Imaginary part (absorption), per channel.
         k: Rgb,
+        /// Microfacet distribution.
+        distribution: NormalDistribution,
+    },
+    /// A diffuse base under a smooth dielectric coat.
+    Plastic {
+        /// Diffuse reflectance of the base.
+        diffuse: Rgb,
+        /// Index of refraction of the coat relative to outside.
+        ior: f32,
+        /// Whether internal reflections are tinted by the base.
+        nonlinear: bool,
     },
 }
 
@@ -178,6 +195,7 @@ impl MaterialDesc {
             MaterialDesc::Mirror { .. } => "mirror",
             MaterialDesc::Glass { .. } => "glass",
             MaterialDesc::Conductor { .. } => "conductor",
+            MaterialDesc::Plastic { .. } => "plastic",
         }
     }
 }

@@ -452,6 +452,20 @@ fn glass_and_mirror_spheres_in_a_white_furnace() {
                 transmittance: Vec3::ONE,
                 roughness: 0.0,
                 ior: 1.5,
+                distribution: NormalDistribution::Ggx,
+                fresnel: FresnelModel::Exact,
+            },
+            1.0,
+        ),
+        (
+            // Schlick's reflectance splits energy as R and 1 - R too.
+            MaterialDesc::Glass {
+                reflectance: Vec3::ONE,
+                transmittance: Vec3::ONE,
+                roughness: 0.0,
+                ior: 1.5,
+                distribution: NormalDistribution::Ggx,
+                fresnel: FresnelModel::Schlick,
             },
             1.0,
         ),

@@ -300,6 +300,8 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                         transmittance: rgb(m, "transmittance", Vec3::ONE)?,
                         roughness: scalar(m, "roughness", 0.0)?,
                         ior: scalar(m, "ior", 1.5)?,
+                        distribution: NormalDistribution::Beckmann,
+                        fresnel: FresnelModel::Exact,
                     }
                 }
                 "microfacet" => {
@@ -307,17 +309,12 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                         alpha: scalar(m, "alpha", 0.5)?,
                         eta: rgb(m, "eta", Vec3::ONE)?,
                         k: rgb(m, "k", Vec3::ZERO)?,
+                        // The course's microfacet model.
+                        distribution: NormalDistribution::Beckmann,
                     }
                 }
                 _ => {}
             }
-        }
-        if !pathlab_render::bsdf::is_supported(&out.material) {
-            let id = material.attribute("id").unwrap_or("?");
-            self.desc.warnings.push(format!(
-                "material '{id}' is {}: rendered as diffuse until that BSDF exists",
-                out.material.kind()
-            ));
         }
         Ok(out)
     }

@@ -115,6 +115,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
                         alpha: pbr.roughness_factor() * pbr.roughness_factor(),
                         eta: (Vec3::ONE + s) / (Vec3::ONE - s),
                         k: Vec3::ZERO,
+                        distribution: NormalDistribution::Ggx,
                     }
                 } else {
                     MaterialDesc::Diffuse {
@@ -190,16 +191,6 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
             }
         }
         stack.extend(node.children().map(|c| (c, world)));
-    }
-    if desc
-        .materials
-        .iter()
-        .any(|m| !pathlab_render::bsdf::is_supported(m))
-    {
-        desc.warnings.push(
-            "metallic materials are drawn as diffuse stand-ins until the conductor BSDF exists"
-                .into(),
-        );
     }
     match camera {
         Some((c, aspect)) => {

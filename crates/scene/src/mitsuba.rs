@@ -174,6 +174,34 @@ impl Loader {
         }
     }
 
+    /// A `distribution` property: `beckmann` (Mitsuba's default) or `ggx`.
+    fn distribution(&self, f: &XmlFile, node: Node) -> Result<NormalDistribution, Error> {
+        match self.property(f, node, "distribution")?.as_deref() {
+            None | Some("beckmann") => Ok(NormalDistribution::Beckmann),
+            Some("ggx") => Ok(NormalDistribution::Ggx),
+            Some(other) => Err(f.error(
+                node,
+                format!("unknown microfacet distribution '{other}' (expected beckmann or ggx)"),
+            )),
+        }
+    }
+
+    /// An index of refraction: a number or one of Mitsuba's named media.
+    fn ior(&self, f: &XmlFile, node: Node, name: &str, default: f32) -> Result<f32, Error> {
+        let Some(v) = self.property(f, node, name)? else {
+            return Ok(default);
+        };
+        if let Some(&(_, n)) = NAMED_IORS.iter().find(|(k, _)| k.eq_ignore_ascii_case(&v)) {
+            return Ok(n);
+        }
+        let n = parse_f32(f, node, &v)?;
+        if n > 0.0 && n.is_finite() {
+            Ok(n)
+        } else {
+            Err(f.error(node, format!("{name} must be positive, got {v}")))
+        }
+    }
+
     fn bsdf(&mut self, f: &XmlFile, node: Node) -> Result<usize, Error> {
         let material = self.bsdf_desc(f, node)?;
         self.desc.materials.push(material);
@@ -198,30 +226,68 @@ impl Loader {
                     other => other,
                 }
             }
-            "conductor" | "roughconductor" => MaterialDesc::Conductor {
-                alpha: if kind == "conductor" {
-                    0.0
-                } else {
-                    self.float(f, node, "alpha", 0.1)?
-                },
-                eta: self.color(f, node, "eta", Vec3::ZERO)?,
-                k: self.color(f, node, "k", Vec3::ONE)?,
+            "conductor" | "roughconductor" => {
+                let (eta, k) = match self.property(f, node, "material")? {
+                    Some(name) => named_conductor(&name).ok_or_else(|| {
+                        f.error(
+                            node,
+                            format!(
+                                "unknown conductor material '{name}' (known: {}; or give eta and k)",
+                                CONDUCTORS.iter().map(|c| c.0).collect::<Vec<_>>().join(", ")
+                            ),
+                        )
+                    })?,
+                    // Mitsuba's default: a perfect mirror.
+                    None => (Vec3::ZERO, Vec3::ONE),
+                };
+                MaterialDesc::Conductor {
+                    alpha: if kind == "conductor" {
+                        0.0
+                    } else {
+                        self.float(f, node, "alpha", 0.1)?
+                    },
+                    eta: self.color(f, node, "eta", eta)?,
+                    k: self.color(f, node, "k", k)?,
+                    distribution: self.distribution(f, node)?,
+                }
+            }
+            "dielectric" | "roughdielectric" | "thindielectric" => {
+                if kind == "thindielectric" {
+                    self.desc.warnings.push(format!(
+                        "{}: 'thindielectric' is drawn as a solid dielectric",
+                        f.path.display()
+                    ));
+                }
+                MaterialDesc::Glass {
+                    reflectance: self.color(f, node, "specular_reflectance", Vec3::ONE)?,
+                    transmittance: self.color(f, node, "specular_transmittance", Vec3::ONE)?,
+                    roughness: if kind == "roughdielectric" {
+                        self.float(f, node, "alpha", 0.1)?
+                    } else {
+                        0.0
+                    },
+                    ior: self.ior(f, node, "int_ior", 1.5046)?
+                        / self.ior(f, node, "ext_ior", 1.000277)?,
+                    distribution: self.distribution(f, node)?,
+                    fresnel: FresnelModel::Exact,
+                }
+            }
+            "plastic" => MaterialDesc::Plastic {
+                diffuse: self.color(f, node, "diffuse_reflectance", Vec3::splat(0.5))?,
+                ior: self.ior(f, node, "int_ior", 1.49)?
+                    / self.ior(f, node, "ext_ior", 1.000277)?,
+                nonlinear: self.property(f, node, "nonlinear")?.as_deref() == Some("true"),
             },
-            "dielectric" | "roughdielectric" | "thindielectric" => MaterialDesc::Glass {
-                reflectance: self.color(f, node, "specular_reflectance", Vec3::ONE)?,
-                transmittance: self.color(f, node, "specular_transmittance", Vec3::ONE)?,
-                roughness: if kind == "roughdielectric" {
-                    self.float(f, node, "alpha", 0.1)?
-                } else {
-                    0.0
-                },
-                ior: self.float(f, node, "int_ior", 1.5049)?
-                    / self.float(f, node, "ext_ior", 1.0)?,
-            },
-            "plastic" | "roughplastic" | "principled" => MaterialDesc::Diffuse {
-                reflectance: self.color(f, node, "diffuse_reflectance", Vec3::splat(0.5))?,
-                two_sided: false,
-            },
+            "roughplastic" | "principled" => {
+                self.desc.warnings.push(format!(
+                    "{}: BSDF '{kind}' is drawn as a diffuse surface of its base colour",
+                    f.path.display()
+                ));
+                MaterialDesc::Diffuse {
+                    reflectance: self.color(f, node, "diffuse_reflectance", Vec3::splat(0.5))?,
+                    two_sided: false,
+                }
+            }
             other => {
                 self.desc.warnings.push(format!(
                     "{}: BSDF '{other}' is not supported; using grey diffuse",
@@ -230,15 +296,6 @@ impl Loader {
                 default_bsdf()
             }
         };
-        if !pathlab_render::bsdf::is_supported(&desc)
-            || kind.contains("plastic")
-            || kind == "principled"
-        {
-            self.desc.warnings.push(format!(
-                "{}: BSDF '{kind}' is drawn as a diffuse stand-in until it is implemented",
-                f.path.display()
-            ));
-        }
         Ok(desc)
     }
 
@@ -625,4 +682,48 @@ fn disk(n: u32) -> (Vec<Vec3>, Vec<u32>) {
     }
     let indices = (0..n).flat_map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
     (positions, indices)
+}
+
+/// Named indices of refraction Mitsuba accepts for `int_ior` / `ext_ior`.
+const NAMED_IORS: &[(&str, f32)] = &[
+    ("vacuum", 1.0),
+    ("helium", 1.000036),
+    ("hydrogen", 1.000132),
+    ("air", 1.000277),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.333),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.47),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.575),
+    ("diamond", 2.419),
+];
+
+/// RGB complex indices (η, k) of common metals for `conductor`'s `material` (values at the
+/// centres of the red, green and blue bands; `none` is the perfect mirror).
+const CONDUCTORS: &[(&str, [f32; 3], [f32; 3])] = &[
+    ("none", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+    ("Au", [0.143, 0.374, 1.442], [3.983, 2.385, 1.603]),
+    ("Ag", [0.155, 0.117, 0.138], [4.828, 3.122, 2.147]),
+    ("Cu", [0.200, 0.924, 1.102], [3.912, 2.452, 2.142]),
+    ("Al", [1.657, 0.880, 0.521], [9.224, 6.270, 4.837]),
+];
+
+fn named_conductor(name: &str) -> Option<(Vec3, Vec3)> {
+    CONDUCTORS
+        .iter()
+        .find(|c| c.0.eq_ignore_ascii_case(name))
+        .map(|c| (Vec3::from_array(c.1), Vec3::from_array(c.2)))
 }

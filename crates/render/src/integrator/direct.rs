@@ -124,7 +124,7 @@ impl Integrator for DirectIntegrator {
                     let u_select = sampler.next_1d();
                     let u_light = sampler.next_2d();
                     sum += sample_light(scene, &si, &bsdf, wo, u_select, u_light, n, n, stats);
-                    if let Some(bs) = bsdf.sample_f(wo, sampler.next_2d()) {
+                    if let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) {
                         let f_cos = bs.f * bs.wi.dot(si.ns).abs();
                         let (c, pdf_light) = Self::gather(scene, &si, bs.wi, f_cos, bs.pdf, stats);
                         if let Some(pdf_light) = pdf_light {

@@ -95,7 +95,7 @@ impl Integrator for PathIntegrator {
                     sampler.next_2d();
                 }
             }
-            let Some(bs) = bsdf.sample_f(wo, sampler.next_2d()) else {
+            let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) else {
                 break;
             };
             beta *= bs.f * (bs.wi.dot(si.ns).abs() / bs.pdf);

@@ -1,0 +1,83 @@
+//! A smooth dielectric interface (glass).
+
+use super::fresnel::{fresnel_dielectric, fresnel_schlick};
+use super::mirror::specular_reflection;
+use super::LocalSample;
+use crate::desc::Rgb;
+use glam::Vec3;
+
+/// Which Fresnel reflectance a dielectric uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FresnelModel {
+    /// The exact dielectric Fresnel equations (unpolarised light).
+    #[default]
+    Exact,
+    /// Schlick's approximation, as the course's renderer uses.
+    Schlick,
+}
+
+impl FresnelModel {
+    /// Reflectance at cos θi (positive: from outside) for relative index `eta`.
+    #[inline]
+    pub fn reflectance(self, cos_theta_i: f32, eta: f32) -> f32 {
+        match self {
+            FresnelModel::Exact => fresnel_dielectric(cos_theta_i, eta),
+            FresnelModel::Schlick => fresnel_schlick(cos_theta_i, eta),
+        }
+    }
+}
+
+/// Glass: Fresnel reflectance F chooses reflection with probability F and refraction (Snell's
+/// law) otherwise; total internal reflection beyond the critical angle. Radiance crossing the
+/// interface is scaled by 1/η'² (η' the relative index along the path), as radiance transport
+/// requires. Both lobes are deltas.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SmoothDielectric {
+    /// Index of refraction inside (below the normal) relative to outside.
+    pub eta: f32,
+    /// Scale of the reflected part.
+    pub reflectance: Rgb,
+    /// Scale of the transmitted part.
+    pub transmittance: Rgb,
+    /// Exact Fresnel or Schlick's approximation.
+    pub fresnel: FresnelModel,
+}
+
+impl SmoothDielectric {
+    /// Reflection with probability F, refraction otherwise (`uc` chooses).
+    pub fn sample(&self, wo: Vec3, uc: f32) -> Option<LocalSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let f = self.fresnel.reflectance(wo.z, self.eta);
+        if uc < f {
+            return specular_reflection(wo, self.reflectance * f, f);
+        }
+        let (wi, etap) = refract(wo, self.eta)?;
+        let t = 1.0 - f;
+        Some(LocalSample {
+            f: self.transmittance * (t / (wi.z.abs() * etap * etap)),
+            wi,
+            pdf: t,
+            delta: true,
+        })
+    }
+}
+
+/// Refracts `wo` (local frame, z = normal) through an interface of relative index `eta`
+/// (inside / outside); `None` under total internal reflection. Returns wi and the relative
+/// index η' along the path (η for entering, 1/η for leaving).
+pub fn refract(wo: Vec3, eta: f32) -> Option<(Vec3, f32)> {
+    let (cos_o, etap, sign) = if wo.z > 0.0 {
+        (wo.z, eta, 1.0)
+    } else {
+        (-wo.z, 1.0 / eta, -1.0)
+    };
+    let sin2_t = (1.0 - cos_o * cos_o).max(0.0) / (etap * etap);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let wi = Vec3::new(-wo.x / etap, -wo.y / etap, -sign * cos_t);
+    Some((wi.normalize(), etap))
+}

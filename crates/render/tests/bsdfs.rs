@@ -1,0 +1,459 @@
+//! Statistical tests of every BSDF: chi-square goodness of fit of `sample` against `pdf`,
+//! agreement of the sampled weight f |cos| / pdf with an independent estimate of the same
+//! integral, directional albedo ≤ 1, exact energy conservation where the model has it, and
+//! reciprocity.
+
+use glam::{Vec2, Vec3};
+use pathlab_mc::estimator::RunningStats;
+use pathlab_mc::rng::Pcg32;
+use pathlab_mc::stats::{
+    bonferroni, chi2_test_2d, chi2_test_2d_with_quadrature, cos_theta_phi, z_test_two_sample,
+};
+use pathlab_render::bsdf::*;
+use pathlab_render::desc::Rgb;
+use std::f64::consts::TAU;
+
+/// Samples in each goodness-of-fit test.
+const N: usize = 1_000_000;
+/// Bins in (cos θ, φ).
+const RES: [usize; 2] = [40, 40];
+/// Quadrature pieces per bin axis: microfacet pdfs have narrow peaks and, where the half
+/// vector crosses the horizon, jumps inside bins.
+const QUADRATURE: usize = 12;
+
+fn gold() -> (Rgb, Rgb) {
+    (
+        Vec3::new(0.143, 0.374, 1.442),
+        Vec3::new(3.983, 2.385, 1.603),
+    )
+}
+
+fn conductor(kind: NormalDistribution, alpha: f32) -> Bxdf {
+    let (eta, k) = gold();
+    Bxdf::Conductor(Conductor {
+        eta,
+        k,
+        distribution: Some(Microfacet::new(kind, alpha)),
+    })
+}
+
+fn rough_glass(kind: NormalDistribution, alpha: f32) -> Bxdf {
+    Bxdf::RoughDielectric(RoughDielectric {
+        eta: 1.5,
+        distribution: Microfacet::new(kind, alpha),
+        reflectance: Vec3::ONE,
+        transmittance: Vec3::ONE,
+    })
+}
+
+fn plastic(diffuse: f32, nonlinear: bool) -> Bxdf {
+    Bxdf::Plastic(Plastic::new(Vec3::splat(diffuse), 1.5, nonlinear))
+}
+
+fn diffuse() -> Bxdf {
+    Bxdf::Diffuse(Diffuse {
+        reflectance: Vec3::splat(0.7),
+    })
+}
+
+/// A direction at polar angle `theta_deg` in the xz-plane (φ = 0), above or below.
+fn wo_at(theta_deg: f32, below: bool) -> Vec3 {
+    let t = theta_deg.to_radians();
+    let z = if below { -t.cos() } else { t.cos() };
+    Vec3::new(t.sin(), 0.0, z)
+}
+
+fn uniform(rng: &mut Pcg32) -> (f32, Vec2) {
+    (
+        rng.uniform_f32(),
+        Vec2::new(rng.uniform_f32(), rng.uniform_f32()),
+    )
+}
+
+fn direction(z: f64, phi: f64) -> Vec3 {
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32)
+}
+
+/// The non-delta samples of `bxdf` from `wo` as (cos θ, φ); delta and failed samples map
+/// outside every test domain.
+fn draws(bxdf: &Bxdf, wo: Vec3, n: usize, seed: u64) -> Vec<[f64; 2]> {
+    let mut rng = Pcg32::new(seed, 7);
+    (0..n)
+        .map(|_| {
+            let (uc, u) = uniform(&mut rng);
+            match bxdf.sample(wo, uc, u) {
+                Some(s) if !s.delta => cos_theta_phi(s.wi.as_dvec3().to_array()),
+                _ => [9.0, 9.0],
+            }
+        })
+        .collect()
+}
+
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    sorted[((sorted.len() - 1) as f64 * q).round() as usize]
+}
+
+/// The domain of a test: the box in (cos θ, φ) holding the central 99% of a pilot run's
+/// samples on one side of the surface (`upper`), widened by a tenth, so that the bins sit
+/// where the lobe is however narrow it is. `None` when that side receives under 1% of the
+/// samples.
+fn pilot_domain(bxdf: &Bxdf, wo: Vec3, upper: bool, seed: u64) -> Option<[[f64; 2]; 2]> {
+    let pilot: Vec<[f64; 2]> = draws(bxdf, wo, 40_000, seed ^ 0x5eed)
+        .into_iter()
+        .filter(|s| s[0] <= 1.0 && (s[0] > 0.0) == upper)
+        .collect();
+    if pilot.len() < 400 {
+        return None;
+    }
+    let range = |axis: usize, lo: f64, hi: f64| {
+        let mut v: Vec<f64> = pilot.iter().map(|s| s[axis]).collect();
+        v.sort_by(f64::total_cmp);
+        let (a, b) = (quantile(&v, 0.005), quantile(&v, 0.995));
+        let pad = 0.1 * (b - a).max(1e-3);
+        [(a - pad).max(lo), (b + pad).min(hi)]
+    };
+    let z = if upper {
+        range(0, 0.0, 1.0)
+    } else {
+        range(0, -1.0, 0.0)
+    };
+    let mut phi = range(1, 0.0, TAU);
+    if phi[1] - phi[0] > std::f64::consts::PI {
+        phi = [0.0, TAU];
+    }
+    Some([z, phi])
+}
+
+struct Case {
+    name: String,
+    bxdf: Bxdf,
+    wo: Vec3,
+}
+
+fn cases() -> Vec<Case> {
+    let mut v = Vec::new();
+    let mut add = |name: String, bxdf: Bxdf, wo: Vec3| v.push(Case { name, bxdf, wo });
+    for theta in [0.0, 60.0] {
+        add(
+            format!("diffuse θo {theta}"),
+            diffuse(),
+            wo_at(theta, false),
+        );
+    }
+    for (kind, label) in [
+        (NormalDistribution::Ggx, "GGX"),
+        (NormalDistribution::Beckmann, "Beckmann"),
+    ] {
+        for alpha in [0.05, 0.3, 0.8] {
+            for theta in [5.0, 45.0, 85.0] {
+                add(
+                    format!("{label} conductor α {alpha} θo {theta}"),
+                    conductor(kind, alpha),
+                    wo_at(theta, false),
+                );
+                add(
+                    format!("{label} rough glass α {alpha} θo {theta} outside"),
+                    rough_glass(kind, alpha),
+                    wo_at(theta, false),
+                );
+            }
+            // From inside the glass, below and beyond the critical angle (41.8°).
+            for theta in [20.0, 60.0] {
+                add(
+                    format!("{label} rough glass α {alpha} θo {theta} inside"),
+                    rough_glass(kind, alpha),
+                    wo_at(theta, true),
+                );
+            }
+        }
+    }
+    for theta in [30.0, 80.0] {
+        add(
+            format!("plastic θo {theta}"),
+            plastic(0.6, false),
+            wo_at(theta, false),
+        );
+    }
+    v
+}
+
+#[test]
+fn every_bsdf_sample_fits_its_pdf() {
+    let cases = cases();
+    // Each case is tested on each side of the surface that receives samples.
+    let tests: Vec<(usize, bool, [[f64; 2]; 2])> = cases
+        .iter()
+        .enumerate()
+        .flat_map(|(i, c)| {
+            [true, false].into_iter().filter_map(move |upper| {
+                pilot_domain(&c.bxdf, c.wo, upper, i as u64).map(|d| (i, upper, d))
+            })
+        })
+        .collect();
+    let alpha = bonferroni(0.01, tests.len());
+    let mut failures = Vec::new();
+    for &(i, upper, domain) in &tests {
+        let c = &cases[i];
+        let samples = draws(&c.bxdf, c.wo, N, 1000 + i as u64);
+        let t = chi2_test_2d_with_quadrature(
+            samples,
+            |z, phi| c.bxdf.pdf(c.wo, direction(z, phi)) as f64,
+            domain,
+            RES,
+            QUADRATURE,
+        );
+        let side = if upper { "upper" } else { "lower" };
+        eprintln!(
+            "{} ({side}): chi2 {:.0} / {} dof, p = {:.3}",
+            c.name, t.statistic, t.dof, t.p_value
+        );
+        if !t.passes(alpha) {
+            failures.push(format!("{} ({side}): p = {:.2e}", c.name, t.p_value));
+        }
+    }
+    assert!(
+        tests.len() >= cases.len(),
+        "only {} tests for {} cases",
+        tests.len(),
+        cases.len()
+    );
+    assert!(
+        failures.is_empty(),
+        "rejected at α = {alpha:.1e}: {failures:?}"
+    );
+}
+
+#[test]
+fn chi_square_harness_rejects_a_wrong_microfacet_pdf() {
+    // GGX samples against a Beckmann pdf of the same roughness: must be rejected.
+    let wo = wo_at(45.0, false);
+    let ggx = conductor(NormalDistribution::Ggx, 0.3);
+    let beckmann = conductor(NormalDistribution::Beckmann, 0.3);
+    let domain = pilot_domain(&ggx, wo, true, 3).unwrap();
+    let t = chi2_test_2d(
+        draws(&ggx, wo, N, 3),
+        |z, phi| beckmann.pdf(wo, direction(z, phi)) as f64,
+        domain,
+        RES,
+    );
+    eprintln!("GGX vs Beckmann pdf: p = {:.3e}", t.p_value);
+    assert!(t.p_value < 1e-6);
+}
+
+/// (mean, standard error) of f |cos θi| / pdf over BSDF samples (delta lobes included).
+fn sampled_albedo(bxdf: &Bxdf, wo: Vec3, n: usize, seed: u64) -> (f64, f64) {
+    let mut rng = Pcg32::new(seed, 11);
+    let mut stats = RunningStats::new();
+    for _ in 0..n {
+        let (uc, u) = uniform(&mut rng);
+        let w = bxdf
+            .sample(wo, uc, u)
+            .map_or(0.0, |s| (s.f.y * s.wi.z.abs() / s.pdf) as f64);
+        stats.push(w);
+    }
+    (stats.mean(), stats.std_error())
+}
+
+/// (mean, standard error) of ∫ f |cos θi| dωi over the sphere by uniform direction sampling:
+/// an estimator that shares nothing with the BSDF's own sampling.
+fn uniform_albedo(bxdf: &Bxdf, wo: Vec3, n: usize, seed: u64) -> (f64, f64) {
+    let mut rng = Pcg32::new(seed, 13);
+    let mut stats = RunningStats::new();
+    for _ in 0..n {
+        let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+        let wi = pathlab_mc::warp::sample_uniform_sphere(u);
+        let pdf = pathlab_mc::warp::uniform_sphere_pdf();
+        stats.push((bxdf.f(wo, wi).y * wi.z.abs() / pdf) as f64);
+    }
+    (stats.mean(), stats.std_error())
+}
+
+#[test]
+fn sampled_weights_agree_with_uniform_integration_and_albedo_is_at_most_one() {
+    // For non-delta BSDFs wide enough for uniform sampling to resolve: E[f cos / pdf] under
+    // the BSDF's sampling must equal ∫ f cos dω, which uniform sampling estimates
+    // independently (this checks f and pdf against each other, the chi-square test checks
+    // sample against pdf). And the directional albedo never exceeds one.
+    let cases: Vec<(String, Bxdf, Vec3)> = [
+        ("diffuse", diffuse()),
+        (
+            "GGX conductor α 0.3",
+            conductor(NormalDistribution::Ggx, 0.3),
+        ),
+        (
+            "GGX conductor α 0.8",
+            conductor(NormalDistribution::Ggx, 0.8),
+        ),
+        (
+            "Beckmann conductor α 0.3",
+            conductor(NormalDistribution::Beckmann, 0.3),
+        ),
+        (
+            "Beckmann conductor α 0.8",
+            conductor(NormalDistribution::Beckmann, 0.8),
+        ),
+        (
+            "GGX rough glass α 0.3",
+            rough_glass(NormalDistribution::Ggx, 0.3),
+        ),
+        (
+            "GGX rough glass α 0.8",
+            rough_glass(NormalDistribution::Ggx, 0.8),
+        ),
+        (
+            "Beckmann rough glass α 0.5",
+            rough_glass(NormalDistribution::Beckmann, 0.5),
+        ),
+    ]
+    .into_iter()
+    .flat_map(|(name, b)| {
+        [(10.0, false), (70.0, false), (30.0, true)]
+            .into_iter()
+            .filter(move |&(_, below)| !below || matches!(b, Bxdf::RoughDielectric(_)))
+            .map(move |(theta, below)| {
+                (
+                    format!("{name} θo {theta} below {below}"),
+                    b,
+                    wo_at(theta, below),
+                )
+            })
+    })
+    .collect();
+    let n = 400_000;
+    for (i, (name, bxdf, wo)) in cases.iter().enumerate() {
+        let (a, se_a) = sampled_albedo(bxdf, *wo, n, 100 + i as u64);
+        let (b, se_b) = uniform_albedo(bxdf, *wo, n, 200 + i as u64);
+        let z = z_test_two_sample(a, se_a, b, se_b);
+        eprintln!(
+            "{name}: sampled {a:.5} ± {se_a:.5}, uniform {b:.5} ± {se_b:.5}, z {:.2}",
+            z.z
+        );
+        assert!(
+            z.within(4.0),
+            "{name}: sampled {a} vs uniform {b} (z = {:.2})",
+            z.z
+        );
+        // Radiance scaling by 1/η² makes transmission from outside carry less than one;
+        // from inside it can exceed one (1/η'² > 1): that is radiance, not energy.
+        if !(matches!(bxdf, Bxdf::RoughDielectric(_)) && wo.z < 0.0) {
+            assert!(a <= 1.0 + 4.0 * se_a, "{name}: albedo {a} > 1");
+        }
+    }
+}
+
+#[test]
+fn narrow_lobes_and_grazing_angles_keep_albedo_at_most_one() {
+    for (name, bxdf) in [
+        (
+            "GGX conductor α 0.05",
+            conductor(NormalDistribution::Ggx, 0.05),
+        ),
+        (
+            "Beckmann conductor α 0.05",
+            conductor(NormalDistribution::Beckmann, 0.05),
+        ),
+        (
+            "GGX rough glass α 0.05",
+            rough_glass(NormalDistribution::Ggx, 0.05),
+        ),
+        ("plastic", plastic(0.8, false)),
+    ] {
+        for theta in [0.0, 45.0, 85.0, 89.0] {
+            let (a, se) = sampled_albedo(&bxdf, wo_at(theta, false), 200_000, 7);
+            eprintln!("{name} θo {theta}: albedo {a:.5} ± {se:.5}");
+            assert!(a <= 1.0 + 4.0 * se, "{name} θo {theta}: albedo {a} > 1");
+        }
+    }
+}
+
+#[test]
+fn white_plastic_reflects_everything_and_coloured_plastic_has_the_stated_albedo() {
+    // Linear model: albedo = F(θo) + (1 - F(θo)) ρ exactly; nonlinear with ρ = 1 too.
+    for (rho, nonlinear) in [(1.0f32, false), (0.5, false), (1.0, true)] {
+        for theta in [0.0f32, 50.0, 80.0] {
+            let wo = wo_at(theta, false);
+            let f = fresnel_dielectric(wo.z, 1.5) as f64;
+            let truth = f + (1.0 - f) * rho as f64;
+            let (a, se) = sampled_albedo(&plastic(rho, nonlinear), wo, 400_000, 9);
+            let z = (a - truth) / se;
+            eprintln!(
+                "plastic ρ {rho} nonlinear {nonlinear} θo {theta}: {a:.5} ± {se:.5} vs {truth:.5}"
+            );
+            assert!(
+                z.abs() <= 4.0,
+                "ρ {rho} θo {theta}: {a} vs {truth} (z {z:.2})"
+            );
+        }
+    }
+}
+
+#[test]
+fn smooth_glass_conserves_energy_exactly() {
+    // Without absorption, reflection + transmission carries all the energy: the throughput
+    // of a transmitted sample times η'² (undoing radiance scaling) is one, as is a
+    // reflected one, for every angle and side (Schlick's reflectance too).
+    for fresnel in [FresnelModel::Exact, FresnelModel::Schlick] {
+        let glass = Bxdf::Dielectric(SmoothDielectric {
+            eta: 1.5,
+            reflectance: Vec3::ONE,
+            transmittance: Vec3::ONE,
+            fresnel,
+        });
+        for (theta, below) in [
+            (0.0, false),
+            (60.0, false),
+            (89.0, false),
+            (30.0, true),
+            (60.0, true),
+        ] {
+            let wo = wo_at(theta, below);
+            for i in 0..1000 {
+                let uc = (i as f32 + 0.5) / 1000.0;
+                let s = glass.sample(wo, uc, Vec2::ZERO).unwrap();
+                let mut w = s.f.y * s.wi.z.abs() / s.pdf;
+                if s.wi.z * wo.z < 0.0 {
+                    let etap: f32 = if wo.z > 0.0 { 1.5 } else { 1.0 / 1.5 };
+                    w *= etap * etap;
+                }
+                assert!((w - 1.0).abs() < 1e-4, "{fresnel:?} θo {theta}: weight {w}");
+            }
+        }
+    }
+}
+
+#[test]
+fn reflection_is_reciprocal() {
+    let mut rng = Pcg32::new(5, 5);
+    let bxdfs = [
+        diffuse(),
+        conductor(NormalDistribution::Ggx, 0.2),
+        conductor(NormalDistribution::Beckmann, 0.3),
+        rough_glass(NormalDistribution::Ggx, 0.3),
+        plastic(0.6, false),
+        plastic(0.6, true),
+    ];
+    for bxdf in &bxdfs {
+        let mut checked = 0;
+        for _ in 0..2000 {
+            let a = pathlab_mc::warp::sample_uniform_hemisphere(Vec2::new(
+                rng.uniform_f32(),
+                rng.uniform_f32(),
+            ));
+            let b = pathlab_mc::warp::sample_uniform_hemisphere(Vec2::new(
+                rng.uniform_f32(),
+                rng.uniform_f32(),
+            ));
+            let (fab, fba) = (bxdf.f(a, b), bxdf.f(b, a));
+            let scale = fab.max_element().max(fba.max_element());
+            if scale > 0.0 {
+                checked += 1;
+                assert!(
+                    (fab - fba).abs().max_element() <= 1e-4 * scale,
+                    "{bxdf:?}: f({a}, {b}) = {fab} but f({b}, {a}) = {fba}"
+                );
+            }
+        }
+        assert!(checked > 100, "{bxdf:?}: only {checked} nonzero pairs");
+    }
+}
