@@ -7,7 +7,7 @@ use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::film::Film;
 use pathlab_render::image_io::{read_exr_rgb, write_rgb8, ToneMap};
 use pathlab_render::integrator::{
-    DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
+    DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator, PathLighting,
 };
 use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
@@ -22,7 +22,8 @@ pub struct CompareArgs {
     #[arg(default_value = "cornell-box")]
     pub scene: String,
     /// Strategies to compare, comma-separated: hemisphere, cosine, light, mis (direct lighting)
-    /// and path (path tracing at --max-depth).
+    /// and path, path-bsdf, path-light (path tracing at --max-depth with MIS, BSDF sampling
+    /// only, light sampling only).
     #[arg(
         long,
         value_delimiter = ',',
@@ -64,9 +65,16 @@ struct Row {
 }
 
 fn integrator(name: &str, max_depth: u32) -> Result<IntegratorKind> {
-    if name == "path" {
+    let lighting = match name {
+        "path" => Some(PathLighting::Mis),
+        "path-bsdf" => Some(PathLighting::Bsdf),
+        "path-light" => Some(PathLighting::Light),
+        _ => None,
+    };
+    if let Some(lighting) = lighting {
         return Ok(IntegratorKind::Path(PathIntegrator {
             max_depth,
+            lighting,
             ..Default::default()
         }));
     }

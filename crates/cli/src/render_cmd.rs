@@ -4,11 +4,11 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::desc::SceneDesc;
+use pathlab_render::desc::{FresnelModel, MaterialDesc, SceneDesc};
 use pathlab_render::film::Film;
 use pathlab_render::image_io::{write_exr, write_png_with, write_rgb8, ExtraChannel, ToneMap};
 use pathlab_render::integrator::{
-    DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
+    DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator, PathLighting,
 };
 use pathlab_render::progressive::{render_progressive, StopRule};
 use pathlab_render::render::{render, Adaptive, AdaptiveRule, RenderSettings};
@@ -59,6 +59,26 @@ pub enum Aov {
     Variance,
     /// Samples per pixel.
     Samples,
+}
+
+/// `--lighting` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LightingName {
+    /// Light sampling and BSDF sampling with MIS.
+    Mis,
+    /// BSDF sampling only.
+    Bsdf,
+    /// Light sampling only.
+    Light,
+}
+
+/// `--fresnel` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FresnelName {
+    /// The exact dielectric Fresnel equations.
+    Exact,
+    /// Schlick's approximation.
+    Schlick,
 }
 
 /// Raw command-line arguments of `pathlab render`.
@@ -119,6 +139,20 @@ pub struct RenderArgs {
     /// The integrator.
     #[arg(long, value_enum, default_value_t = IntegratorName::Path)]
     pub integrator: IntegratorName,
+    /// How the path tracer finds light at each vertex: mis (light and BSDF sampling combined),
+    /// bsdf (BSDF sampling only) or light (light sampling only).
+    #[arg(long, value_enum, default_value_t = LightingName::Mis)]
+    pub lighting: LightingName,
+    /// Light the scene with this environment map (equirectangular .exr, .hdr, .png or .jpg, in
+    /// Mitsuba's convention), in place of the scene's own environment.
+    #[arg(short = 'e', long, value_name = "FILE")]
+    pub envmap: Option<PathBuf>,
+    /// Scale of the --envmap radiance.
+    #[arg(long, default_value_t = 1.0, value_name = "SCALE")]
+    pub envmap_scale: f32,
+    /// Fresnel reflectance of smooth glass: exact, or schlick (the course's approximation).
+    #[arg(long, value_enum, default_value_t = FresnelName::Exact)]
+    pub fresnel: FresnelName,
     /// Direct-lighting strategy for --integrator direct: hemisphere, cosine, light or mis.
     #[arg(long, default_value = "mis")]
     pub direct: DirectStrategy,
@@ -258,6 +292,27 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         desc.camera.focal_distance = d;
     }
+    if let Some(file) = &args.envmap {
+        if !(args.envmap_scale.is_finite() && args.envmap_scale >= 0.0) {
+            bail!(
+                "--envmap-scale {}: must be a number >= 0",
+                args.envmap_scale
+            );
+        }
+        desc.environment_map = Some(pathlab_scene::envmap::load(
+            file,
+            glam::Mat3::IDENTITY,
+            args.envmap_scale,
+        )?);
+        desc.environment = None;
+    }
+    if args.fresnel == FresnelName::Schlick {
+        for m in &mut desc.materials {
+            if let MaterialDesc::Glass { fresnel, .. } = m {
+                *fresnel = FresnelModel::Schlick;
+            }
+        }
+    }
     let spp = args.spp.or(desc.hints.spp).unwrap_or(64);
     let max_depth = cli_depth.or(desc.hints.max_depth).unwrap_or(u32::MAX);
     apply_resolution(&mut desc, args.resolution.as_deref())?;
@@ -268,6 +323,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             rr_depth: args.rr_depth,
             only_bounce: args.only_bounce,
             light_samples: args.light_samples,
+            lighting: match args.lighting {
+                LightingName::Mis => PathLighting::Mis,
+                LightingName::Bsdf => PathLighting::Bsdf,
+                LightingName::Light => PathLighting::Light,
+            },
         }),
         IntegratorName::Direct => IntegratorKind::Direct(DirectIntegrator {
             strategy: args.direct,

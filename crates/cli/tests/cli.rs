@@ -771,3 +771,46 @@ fn target_error_and_time_budget() {
     );
     assert_one_line_error(&pathlab(&["render", "--time", "1", "-a"]), "choose one");
 }
+
+#[test]
+fn envmap_lighting_and_fresnel_flags() {
+    let sky = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scene/tests/data/sky-spheres/sky.exr")
+        .display()
+        .to_string();
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scene/tests/data/cornell-spheres/scene.xml")
+        .display()
+        .to_string();
+    let mean = |extra: &[&str]| -> Vec<f64> {
+        let out = scratch("flags.png");
+        let mut args = vec![
+            "render", &scene, "-s", "4", "-r", "24", "24", "-q", "--json", "-o",
+        ];
+        let out_s = out.to_str().unwrap().to_string();
+        args.push(&out_s);
+        args.extend_from_slice(extra);
+        let v = json_of(&pathlab(&args));
+        v["image_mean_rgb"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m.as_f64().unwrap())
+            .collect()
+    };
+    // Emission seen directly (-m 0): camera rays that pass beside the box see the sky.
+    let plain = mean(&["-m", "0"]);
+    let lit = mean(&["-m", "0", "-e", &sky, "--envmap-scale", "2"]);
+    assert!(
+        lit.iter().zip(&plain).all(|(l, p)| l > p),
+        "{lit:?} {plain:?}"
+    );
+    for lighting in ["bsdf", "light", "mis"] {
+        assert!(mean(&["--lighting", lighting]).iter().all(|m| *m > 0.0));
+    }
+    assert!(mean(&["--fresnel", "schlick"]).iter().all(|m| *m > 0.0));
+    assert_one_line_error(
+        &pathlab(&["render", &scene, "-e", "no-such-sky.exr", "-q"]),
+        "no-such-sky.exr",
+    );
+}

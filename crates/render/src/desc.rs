@@ -1,6 +1,7 @@
 //! The plain scene description that loaders produce and [`crate::scene::Scene::build`] consumes.
 
-use glam::{Vec2, Vec3};
+use glam::{Mat3, Vec2, Vec3};
+use std::sync::Arc;
 
 pub use crate::bsdf::{FresnelModel, NormalDistribution};
 
@@ -24,6 +25,8 @@ pub struct SceneDesc {
     pub directional_lights: Vec<DirectionalLightDesc>,
     /// Uniform environment radiance seen by rays that leave the scene (none: black).
     pub environment: Option<Rgb>,
+    /// An environment map (takes the place of `environment` when both are set).
+    pub environment_map: Option<EnvironmentMapDesc>,
     /// The camera.
     pub camera: CameraDesc,
     /// Image size in pixels `[width, height]`.
@@ -48,6 +51,23 @@ impl SceneDesc {
         }
         (lo.x <= hi.x).then_some((lo, hi))
     }
+}
+
+/// An equirectangular environment map (see [`crate::envmap`] for the convention).
+#[derive(Clone, Debug)]
+pub struct EnvironmentMapDesc {
+    /// Where it was read from, for messages.
+    pub source: String,
+    /// Width in texels.
+    pub width: usize,
+    /// Height in texels.
+    pub height: usize,
+    /// Linear RGB texels, row 0 at the top.
+    pub texels: Arc<Vec<Rgb>>,
+    /// Rotation from the map's frame (y up) to the world.
+    pub to_world: Mat3,
+    /// Radiance scale.
+    pub scale: f32,
 }
 
 /// Render settings a scene file can suggest.

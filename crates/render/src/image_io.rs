@@ -17,6 +17,14 @@ pub enum ImageError {
         /// What failed.
         message: String,
     },
+    /// An image could not be decoded.
+    #[error("{path}: {message}")]
+    Decode {
+        /// The file.
+        path: String,
+        /// What failed.
+        message: String,
+    },
     /// The PNG encoder failed.
     #[error("{path}: {message}")]
     Png {
@@ -88,6 +96,51 @@ pub fn read_exr_rgb(path: &Path) -> std::result::Result<(u32, u32, Vec<Rgb>), Im
     })?;
     let (w, h, px) = image.layer_data.channel_data.pixels;
     Ok((w as u32, h as u32, px))
+}
+
+/// Reads an image as linear RGB: (width, height, pixels row-major from the top). OpenEXR and
+/// Radiance HDR are linear already; 8- and 16-bit formats (PNG, JPEG) are sRGB-encoded colour
+/// and are decoded to linear.
+pub fn read_linear_rgb(path: &Path) -> std::result::Result<(u32, u32, Vec<Rgb>), ImageError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    if ext.as_deref() == Some("exr") {
+        return read_exr_rgb(path);
+    }
+    let err = |message: String| ImageError::Decode {
+        path: path.display().to_string(),
+        message,
+    };
+    let img = image::ImageReader::open(path)
+        .map_err(|e| err(e.to_string()))?
+        .with_guessed_format()
+        .map_err(|e| err(e.to_string()))?
+        .decode()
+        .map_err(|e| err(e.to_string()))?;
+    let (w, h) = (img.width(), img.height());
+    let linear = matches!(
+        img,
+        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+    );
+    let px = img.to_rgb32f();
+    let decode = |v: f32| if linear { v } else { srgb_decode(v) };
+    let pixels = px
+        .pixels()
+        .map(|p| Rgb::new(decode(p[0]), decode(p[1]), decode(p[2])))
+        .collect();
+    Ok((w, h, pixels))
+}
+
+/// The inverse sRGB transfer function: an encoded value in [0, 1] to linear.
+#[inline]
+pub fn srgb_decode(v: f32) -> f32 {
+    if v <= 0.040_45 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// The sRGB transfer function of a linear value in [0, 1].

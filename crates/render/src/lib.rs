@@ -43,6 +43,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod desc;
+pub mod envmap;
 pub mod film;
 pub mod geometry;
 pub mod image_io;

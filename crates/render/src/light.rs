@@ -2,12 +2,14 @@
 //! environment; and the choice of a light in proportion to its power.
 
 use crate::desc::Rgb;
+use crate::envmap::EnvironmentMap;
 use crate::geometry::Aabb;
 use crate::shape::{Sphere, Triangle};
 use glam::{Vec2, Vec3};
 use pathlab_mc::distribution::AliasTable;
 use pathlab_mc::warp::{sample_uniform_sphere, uniform_sphere_pdf};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 /// The shape an area light emits from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -19,7 +21,7 @@ pub enum AreaShape {
 }
 
 /// A light source.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum Light {
     /// Uniform radiance from a surface.
     Area {
@@ -70,6 +72,13 @@ pub enum Light {
         /// Radius of a sphere bounding the scene (for the power estimate).
         scene_radius: f32,
     },
+    /// Radiance at infinity from an image (sampled by luminance).
+    EnvironmentMap {
+        /// The map.
+        map: Arc<EnvironmentMap>,
+        /// Radius of a sphere bounding the scene (for the power estimate).
+        scene_radius: f32,
+    },
 }
 
 /// Incident radiance sampled from a light.
@@ -110,7 +119,21 @@ pub fn luminance(c: Rgb) -> f32 {
 impl Light {
     /// Whether the light is at infinity (shadow rays towards it have no end).
     pub fn is_infinite(&self) -> bool {
-        matches!(self, Light::Environment { .. } | Light::Directional { .. })
+        matches!(
+            self,
+            Light::Environment { .. } | Light::EnvironmentMap { .. } | Light::Directional { .. }
+        )
+    }
+
+    /// Radiance from an environment light arriving along world direction `-w` (`w` points
+    /// from the scene into the environment); zero for other lights.
+    #[inline]
+    pub fn le_environment(&self, w: Vec3) -> Rgb {
+        match self {
+            Light::Environment { radiance, .. } => *radiance,
+            Light::EnvironmentMap { map, .. } => map.eval(w),
+            _ => Rgb::ZERO,
+        }
     }
 
     /// Radiance leaving an area light at a point with normal `n` in direction `w` (away from
@@ -131,6 +154,7 @@ impl Light {
                 }
             }
             Light::Environment { radiance, .. } => radiance,
+            Light::EnvironmentMap { ref map, .. } => map.eval(w),
             Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => Rgb::ZERO,
         }
     }
@@ -232,6 +256,20 @@ impl Light {
                     is_delta: false,
                 })
             }
+            Light::EnvironmentMap {
+                ref map,
+                scene_radius,
+            } => {
+                let (wi, pdf, li) = map.sample(u)?;
+                Some(LightLiSample {
+                    li,
+                    wi,
+                    pdf,
+                    p_light: p + wi * (4.0 * scene_radius.max(1.0)),
+                    n_light: None,
+                    is_delta: false,
+                })
+            }
         }
     }
 
@@ -253,6 +291,7 @@ impl Light {
                 }
             }
             Light::Environment { .. } => uniform_sphere_pdf(),
+            Light::EnvironmentMap { ref map, .. } => map.pdf(wi),
             Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
         }
     }
@@ -287,6 +326,11 @@ impl Light {
                 radiance,
                 scene_radius,
             } => 4.0 * PI * PI * scene_radius * scene_radius * luminance(radiance),
+            // Power through a disk of the scene's radius: π R² ∫ L dω.
+            Light::EnvironmentMap {
+                ref map,
+                scene_radius,
+            } => PI * scene_radius * scene_radius * map.luminance_integral(),
         }
     }
 }

@@ -4,10 +4,12 @@ use crate::accel::{Bvh, BvhParams};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc, Visibility};
+use crate::envmap::EnvironmentMap;
 use crate::geometry::{Aabb, Ray};
 use crate::light::{bounding_radius, AreaShape, Light, LightSampler};
 use crate::shape::{Sphere, Triangle};
 use glam::Vec3;
+use std::sync::Arc;
 use std::time::Instant;
 use thiserror::Error;
 
@@ -233,17 +235,27 @@ impl Scene {
             });
             sampleable.push(true);
         }
-        let environment = desc
-            .environment
-            .filter(|e| e.max_element() > 0.0)
-            .map(|radiance| {
-                lights.push(Light::Environment {
+        let environment_light = match &desc.environment_map {
+            Some(m) => Some(Light::EnvironmentMap {
+                map: Arc::new(
+                    EnvironmentMap::new(m.texels.to_vec(), m.width, m.height, m.to_world, m.scale)
+                        .map_err(|e| SceneError::Invalid(format!("{}: {e}", m.source)))?,
+                ),
+                scene_radius,
+            }),
+            None => desc
+                .environment
+                .filter(|e| e.max_element() > 0.0)
+                .map(|radiance| Light::Environment {
                     radiance,
                     scene_radius,
-                });
-                sampleable.push(true);
-                (lights.len() - 1) as u32
-            });
+                }),
+        };
+        let environment = environment_light.map(|light| {
+            lights.push(light);
+            sampleable.push(true);
+            (lights.len() - 1) as u32
+        });
         let light_sampler = LightSampler::new(&lights, &sampleable);
         let prim_visibility: Vec<Visibility> = prims
             .iter()
@@ -320,7 +332,7 @@ impl Scene {
     #[inline]
     pub fn environment_le(&self, w: Vec3) -> Rgb {
         self.environment
-            .map_or(Rgb::ZERO, |i| self.lights[i as usize].le(Vec3::ZERO, w))
+            .map_or(Rgb::ZERO, |i| self.lights[i as usize].le_environment(w))
     }
 
     /// Whether primitive `i` is seen by a camera ray (`camera`) or another ray.

@@ -67,7 +67,10 @@ pub fn summarize(desc: &SceneDesc) -> SceneInfo {
     add("point", desc.point_lights.len());
     add("spot", desc.spot_lights.len());
     add("directional", desc.directional_lights.len());
-    add("environment", desc.environment.is_some() as usize);
+    match &desc.environment_map {
+        Some(m) => add(&format!("environment map ({} x {})", m.width, m.height), 1),
+        None => add("environment", desc.environment.is_some() as usize),
+    }
     let cam = pathlab_render::camera::Camera::new(&desc.camera, desc.resolution);
     let shapes = || desc.meshes.iter().filter(|m| !is_area_light(m));
     SceneInfo {

@@ -15,6 +15,7 @@
 
 pub mod builtin;
 pub mod collada;
+pub mod envmap;
 pub mod gltf_scene;
 pub mod info;
 pub mod meshfile;

@@ -13,7 +13,7 @@
 use crate::meshfile;
 use crate::xml::{child, parse_document, read_text, XmlFile};
 use crate::Error;
-use glam::{Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec3};
 use pathlab_render::desc::*;
 use roxmltree::Node;
 use std::collections::HashMap;
@@ -548,6 +548,24 @@ impl Loader {
             "constant" => {
                 let r = self.color(f, node, "radiance", Vec3::ONE)?;
                 self.desc.environment = Some(self.desc.environment.unwrap_or(Vec3::ZERO) + r);
+            }
+            "envmap" => {
+                let name = self
+                    .property(f, node, "filename")?
+                    .ok_or_else(|| f.error(node, "envmap needs a 'filename' string"))?;
+                let rotation = Mat3::from_mat4(m);
+                let map = crate::envmap::load(
+                    &relative(f.path, &name),
+                    rotation,
+                    self.float(f, node, "scale", 1.0)?,
+                )?;
+                if self.desc.environment_map.is_some() {
+                    self.desc.warnings.push(format!(
+                        "{}: more than one envmap; using the last",
+                        f.path.display()
+                    ));
+                }
+                self.desc.environment_map = Some(map);
             }
             other => self.desc.warnings.push(format!(
                 "{}: emitter '{other}' is not supported yet; skipped",

@@ -663,6 +663,20 @@ fn microfacet_spheres_match_mitsuba() {
 }
 
 #[test]
+fn environment_map_scene_matches_mitsuba() {
+    let (film, r) = render_reference_scene("sky-spheres", 256, 85);
+    let c = compare(&film, &r);
+    let (out, blocks) = compare_blocks(&film, &r, 0.0);
+    let (regions, count) = compare_blocks_of(&film, &r, 0.0, 64);
+    eprintln!(
+        "sky-spheres -m inf, 256 spp: per-pixel outliers {:?}; blocks {out:?} of {blocks}; \
+         64 x 64 regions {regions:?} of {count}; image mean {:.5?} vs {:.5?}, z {:.2?}",
+        c.outliers, c.ours_mean, c.ref_mean, c.mean_z
+    );
+    assert_agrees("sky-spheres", &c);
+}
+
+#[test]
 fn neyman_adaptive_sampling_matches_mitsuba_and_lowers_the_expected_error() {
     use pathlab_render::render::{Adaptive, AdaptiveRule};
     let desc = pathlab_scene::builtin::cornell_box().unwrap();

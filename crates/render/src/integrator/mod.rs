@@ -13,7 +13,7 @@ mod path;
 
 pub use debug::DebugView;
 pub use direct::{DirectIntegrator, DirectStrategy};
-pub use path::PathIntegrator;
+pub use path::{PathIntegrator, PathLighting};
 
 use crate::bsdf::Bsdf;
 use crate::desc::Rgb;

@@ -13,6 +13,11 @@ use pathlab_mc::sampler::{AnySampler, Sampler};
 /// overall. Bounces are counted as the course does: the radiance a camera ray sees directly
 /// has bounce 0, direct lighting bounce 1, and so on; `max_depth` caps them.
 ///
+/// `lighting` picks how light is found at each vertex: both strategies combined by MIS (the
+/// default), BSDF sampling alone (emission counts only when a sampled direction hits it), or
+/// light sampling alone (emission found by BSDF sampling counts only after a delta bounce,
+/// which light sampling cannot produce). All three are unbiased; they differ in variance.
+///
 /// Russian roulette from `rr_depth` on: the path continues with probability
 /// q = min(max component of the throughput, 0.95) and its throughput is divided by q, which
 /// keeps the estimator unbiased.
@@ -26,6 +31,21 @@ pub struct PathIntegrator {
     pub only_bounce: Option<u32>,
     /// Light samples per surface point.
     pub light_samples: u32,
+    /// How light is found at each vertex.
+    pub lighting: PathLighting,
+}
+
+/// The strategies a path tracer uses to find light at each vertex.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PathLighting {
+    /// Light sampling and BSDF sampling, weighted by the power heuristic.
+    #[default]
+    Mis,
+    /// BSDF sampling only.
+    Bsdf,
+    /// Light sampling only (BSDF sampling still continues the path and finds emission after
+    /// delta bounces).
+    Light,
 }
 
 impl Default for PathIntegrator {
@@ -35,6 +55,7 @@ impl Default for PathIntegrator {
             rr_depth: 5,
             only_bounce: None,
             light_samples: 1,
+            lighting: PathLighting::Mis,
         }
     }
 }
@@ -49,6 +70,20 @@ impl Integrator for PathIntegrator {
     ) -> Rgb {
         let mut l = Rgb::ZERO;
         let mut beta = Rgb::ONE;
+        // MIS weight of emission found by a BSDF-sampled direction of density `pdf_bsdf`
+        // (infinite after a delta bounce) that light sampling would find with `pdf_light`.
+        let bsdf_weight = |pdf_bsdf: f32, pdf_light: f32| match self.lighting {
+            PathLighting::Mis => power_heuristic(1, pdf_bsdf, self.light_samples.max(1), pdf_light),
+            PathLighting::Bsdf => 1.0,
+            PathLighting::Light => {
+                if pdf_bsdf.is_infinite() {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+        };
+        let bsdf_samples = u32::from(self.lighting == PathLighting::Mis);
         let wants = |bounce: u32| self.only_bounce.is_none_or(|k| k == bounce);
         let n_light = self.light_samples.max(1);
         // The previous vertex and the BSDF density of the direction that left it (infinite
@@ -58,9 +93,7 @@ impl Integrator for PathIntegrator {
         loop {
             let Some(si) = trace(scene, &ray, depth == 0, stats) else {
                 if let Some((le, pdf_light)) = escaped(scene, &ray) {
-                    let w = prev.map_or(1.0, |(_, pdf_bsdf)| {
-                        power_heuristic(1, pdf_bsdf, n_light, pdf_light)
-                    });
+                    let w = prev.map_or(1.0, |(_, pdf_bsdf)| bsdf_weight(pdf_bsdf, pdf_light));
                     if wants(depth) {
                         l += beta * w * le;
                     }
@@ -70,9 +103,7 @@ impl Integrator for PathIntegrator {
             let wo = -ray.d;
             let p_prev = prev.map_or(ray.o, |(p, _)| p);
             if let Some((le, pdf_light)) = emitted(scene, p_prev, &ray, &si) {
-                let w = prev.map_or(1.0, |(_, pdf_bsdf)| {
-                    power_heuristic(1, pdf_bsdf, n_light, pdf_light)
-                });
+                let w = prev.map_or(1.0, |(_, pdf_bsdf)| bsdf_weight(pdf_bsdf, pdf_light));
                 if wants(depth) {
                     l += beta * w * le;
                 }
@@ -81,12 +112,22 @@ impl Integrator for PathIntegrator {
                 break;
             }
             let bsdf = Bsdf::new(scene.material(si.material), si.ns, wo);
-            if wants(depth + 1) && !bsdf.is_delta() {
+            if wants(depth + 1) && !bsdf.is_delta() && self.lighting != PathLighting::Bsdf {
                 let mut ld = Rgb::ZERO;
                 for _ in 0..n_light {
                     let u_select = sampler.next_1d();
                     let u_light = sampler.next_2d();
-                    ld += sample_light(scene, &si, &bsdf, wo, u_select, u_light, n_light, 1, stats);
+                    ld += sample_light(
+                        scene,
+                        &si,
+                        &bsdf,
+                        wo,
+                        u_select,
+                        u_light,
+                        n_light,
+                        bsdf_samples,
+                        stats,
+                    );
                 }
                 l += beta * ld / n_light as f32;
             } else {
