@@ -4,6 +4,7 @@ use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;
 
 pub use crate::bsdf::{FresnelModel, NormalDistribution};
+pub use crate::texture::Texture;
 
 /// Linear RGB.
 pub type Rgb = Vec3;
@@ -165,6 +166,15 @@ pub enum MaterialDesc {
         /// Whether the back side reflects too (otherwise it is black, as Mitsuba's `diffuse`).
         two_sided: bool,
     },
+    /// Lambertian reflection whose albedo comes from an image texture (times `scale`).
+    TexturedDiffuse {
+        /// The albedo texture (linear RGB).
+        texture: Arc<Texture>,
+        /// Factor applied to the texture.
+        scale: Rgb,
+        /// Whether the back side reflects too.
+        two_sided: bool,
+    },
     /// Perfect specular reflection.
     Mirror {
         /// Reflectance per channel.
@@ -212,6 +222,7 @@ impl MaterialDesc {
     pub fn kind(&self) -> &'static str {
         match self {
             MaterialDesc::Diffuse { .. } => "diffuse",
+            MaterialDesc::TexturedDiffuse { .. } => "textured diffuse",
             MaterialDesc::Mirror { .. } => "mirror",
             MaterialDesc::Glass { .. } => "glass",
             MaterialDesc::Conductor { .. } => "conductor",

@@ -102,6 +102,15 @@ pub fn read_exr_rgb(path: &Path) -> std::result::Result<(u32, u32, Vec<Rgb>), Im
 /// Radiance HDR are linear already; 8- and 16-bit formats (PNG, JPEG) are sRGB-encoded colour
 /// and are decoded to linear.
 pub fn read_linear_rgb(path: &Path) -> std::result::Result<(u32, u32, Vec<Rgb>), ImageError> {
+    read_rgb(path, true)
+}
+
+/// Reads an image's RGB values: as [`read_linear_rgb`], but 8- and 16-bit values are decoded
+/// from sRGB only when `decode_srgb` (otherwise they are taken as they are, scaled to [0, 1]).
+pub fn read_rgb(
+    path: &Path,
+    decode_srgb: bool,
+) -> std::result::Result<(u32, u32, Vec<Rgb>), ImageError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -120,10 +129,11 @@ pub fn read_linear_rgb(path: &Path) -> std::result::Result<(u32, u32, Vec<Rgb>),
         .decode()
         .map_err(|e| err(e.to_string()))?;
     let (w, h) = (img.width(), img.height());
-    let linear = matches!(
-        img,
-        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-    );
+    let linear = !decode_srgb
+        || matches!(
+            img,
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+        );
     let px = img.to_rgb32f();
     let decode = |v: f32| if linear { v } else { srgb_decode(v) };
     let pixels = px

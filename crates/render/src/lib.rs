@@ -53,5 +53,6 @@ pub mod progressive;
 pub mod render;
 pub mod scene;
 pub mod shape;
+pub mod texture;
 
 pub use pathlab_mc as mc;

@@ -8,7 +8,7 @@ use crate::envmap::EnvironmentMap;
 use crate::geometry::{Aabb, Ray};
 use crate::light::{bounding_radius, AreaShape, Light, LightSampler};
 use crate::shape::{Sphere, Triangle};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::sync::Arc;
 use std::time::Instant;
 use thiserror::Error;
@@ -65,6 +65,8 @@ pub struct SurfaceInteraction {
     pub material: u32,
     /// Index of the light the surface belongs to, if it emits.
     pub light: Option<u32>,
+    /// Texture coordinates (the mesh's, else barycentric; spherical on spheres).
+    pub uv: Vec2,
 }
 
 /// Build statistics.
@@ -88,6 +90,8 @@ pub struct Scene {
     triangles: Vec<Triangle>,
     tri_material: Vec<u32>,
     tri_light: Vec<u32>,
+    /// Per-triangle vertex texture coordinates (empty when no mesh has any).
+    tri_uv: Vec<[Vec2; 3]>,
     spheres: Vec<Sphere>,
     sphere_material: Vec<u32>,
     sphere_light: Vec<u32>,
@@ -128,6 +132,8 @@ impl Scene {
         let mut tri_material = Vec::new();
         let mut tri_light = Vec::new();
         let mut tri_visibility = Vec::new();
+        let mut tri_uv = Vec::new();
+        let any_uvs = desc.meshes.iter().any(|m| !m.uvs.is_empty());
         let mut lights = Vec::new();
         let mut sampleable = Vec::new();
         for mesh in &desc.meshes {
@@ -157,6 +163,15 @@ impl Scene {
                     continue; // degenerate: invisible and unsampleable
                 }
                 triangles.push(t);
+                if any_uvs {
+                    let uv = |k: usize| {
+                        mesh.uvs
+                            .get(tri[k] as usize)
+                            .copied()
+                            .unwrap_or([Vec2::ZERO, Vec2::X, Vec2::Y][k])
+                    };
+                    tri_uv.push([uv(0), uv(1), uv(2)]);
+                }
                 tri_material.push(material);
                 tri_visibility.push(mesh.visibility);
                 tri_light.push(add_area_light(
@@ -276,6 +291,7 @@ impl Scene {
             triangles,
             tri_material,
             tri_light,
+            tri_uv,
             spheres,
             sphere_material,
             sphere_light,
@@ -305,6 +321,12 @@ impl Scene {
     /// Bounds of all shapes.
     pub fn bounds(&self) -> Aabb {
         self.bvh.bounds()
+    }
+
+    /// The BSDF at a surface point seen from `wo`.
+    #[inline]
+    pub fn bsdf(&self, si: &SurfaceInteraction, wo: Vec3) -> crate::bsdf::Bsdf {
+        self.materials[si.material as usize].bsdf(si.ns, wo, si.uv)
     }
 
     /// Material `i`.
@@ -393,6 +415,10 @@ impl Scene {
                     let p = (1.0 - b1 - b2) * tri.p[0] + b1 * tri.p[1] + b2 * tri.p[2];
                     let ng = tri.normal();
                     let light = self.tri_light[i as usize];
+                    let uv = match self.tri_uv.get(i as usize) {
+                        Some(uv) => (1.0 - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2],
+                        None => Vec2::new(b1, b2),
+                    };
                     SurfaceInteraction {
                         p,
                         t,
@@ -400,6 +426,7 @@ impl Scene {
                         ns: ng,
                         material: self.tri_material[i as usize],
                         light: (light != NO_LIGHT).then_some(light),
+                        uv,
                     }
                 }
                 Prim::Sphere(i) => {
@@ -409,6 +436,12 @@ impl Scene {
                     // Project onto the surface to remove the rounding of the ray parameter.
                     let p = s.center + ng * s.radius;
                     let light = self.sphere_light[i as usize];
+                    // Spherical coordinates about z: u = φ / 2π, v = θ / π.
+                    let phi = ng.y.atan2(ng.x);
+                    let uv = Vec2::new(
+                        phi / std::f32::consts::TAU + if phi < 0.0 { 1.0 } else { 0.0 },
+                        ng.z.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
+                    );
                     SurfaceInteraction {
                         p,
                         t,
@@ -416,6 +449,7 @@ impl Scene {
                         ns: ng,
                         material: self.sphere_material[i as usize],
                         light: (light != NO_LIGHT).then_some(light),
+                        uv,
                     }
                 }
             }

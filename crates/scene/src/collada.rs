@@ -23,6 +23,7 @@ use pathlab_render::desc::*;
 use roxmltree::Node;
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Default image size of the course's renderer.
 pub const DEFAULT_RESOLUTION: [u32; 2] = [800, 600];
@@ -239,6 +240,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             .ok_or_else(|| self.file.error(material, "expected an <instance_effect>"))?;
         let effect = self.lookup(inst, inst.attribute("url").unwrap_or(""))?;
         let mut diffuse = Vec3::splat(0.5);
+        let mut texture = None;
         if let Some(shading) = xpath(effect, &["profile_COMMON", "technique"]).and_then(|t| {
             ["phong", "lambert", "blinn", "constant"]
                 .iter()
@@ -248,7 +250,8 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 if let Some(c) = child(d, "color") {
                     diffuse = Vec3::from_slice(&self.file.floats_n(c, 3)?);
                 } else if let Some(t) = child(d, "texture") {
-                    self.texture_warning(t);
+                    texture = self.texture(effect, t);
+                    diffuse = Vec3::ONE;
                 }
             }
         }
@@ -258,9 +261,16 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 && n.attribute("profile") == Some("CGL")
         });
         let mut out = Effect {
-            material: MaterialDesc::Diffuse {
-                reflectance: diffuse.clamp(Vec3::ZERO, Vec3::ONE),
-                two_sided: true,
+            material: match texture {
+                Some(texture) => MaterialDesc::TexturedDiffuse {
+                    texture,
+                    scale: Vec3::ONE,
+                    two_sided: true,
+                },
+                None => MaterialDesc::Diffuse {
+                    reflectance: diffuse.clamp(Vec3::ZERO, Vec3::ONE),
+                    two_sided: true,
+                },
             },
             emission: None,
         };
@@ -319,25 +329,54 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         Ok(out)
     }
 
-    fn texture_warning(&mut self, texture: Node) {
+    /// The image a `<texture texture="...">` names, loaded; `None` (with a warning) when it
+    /// cannot be found or read. The name is a sampler's sid in the effect, whose surface names
+    /// the `<image>`; a direct image id works too.
+    fn texture(&mut self, effect: Node, texture: Node) -> Option<Arc<Texture>> {
         let name = texture.attribute("texture").unwrap_or("?");
-        let image = self.ids.get(name).copied().or_else(|| {
-            // Textures usually name a sampler or surface param whose source is the image.
-            self.ids
-                .values()
-                .copied()
-                .find(|n| n.tag_name().name() == "image")
-        });
-        let file = image
-            .and_then(|i| xpath(i, &["init_from"]))
-            .and_then(|n| n.text())
-            .map(str::trim)
-            .unwrap_or(name);
-        let full = self.file.path.parent().unwrap_or(Path::new(".")).join(file);
-        let note = if full.exists() { "found" } else { "missing" };
-        self.desc.warnings.push(format!(
-            "texture '{file}' ({note}): image textures are not rendered yet; using grey"
-        ));
+        let param = |sid: &str| {
+            effect
+                .descendants()
+                .find(|n| n.tag_name().name() == "newparam" && n.attribute("sid") == Some(sid))
+        };
+        let text_of = |n: Option<Node>, path: &[&str]| {
+            n.and_then(|n| xpath(n, path))
+                .and_then(|n| n.text())
+                .map(|t| t.trim().to_string())
+        };
+        let surface = text_of(param(name), &["sampler2D", "source"]);
+        let image_id = text_of(
+            surface.as_deref().and_then(param),
+            &["surface", "init_from"],
+        )
+        .unwrap_or_else(|| name.to_string());
+        let image = self
+            .ids
+            .get(image_id.as_str())
+            .copied()
+            .filter(|n| n.tag_name().name() == "image");
+        let Some(file) = text_of(image, &["init_from"]) else {
+            self.desc.warnings.push(format!(
+                "texture '{name}' names no <image>; using a white diffuse surface"
+            ));
+            return None;
+        };
+        let file = file.strip_prefix("file://").unwrap_or(&file).to_string();
+        let full = self
+            .file
+            .path
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join(&file);
+        match crate::texture::load(&full, false) {
+            Ok(t) => Some(t),
+            Err(e) => {
+                self.desc.warnings.push(format!(
+                    "texture '{file}': {e}; using a white diffuse surface"
+                ));
+                None
+            }
+        }
     }
 
     fn instance_geometry(&mut self, inst: Node<'a, 'input>, world: Mat4) -> Result<(), Error> {

@@ -3,7 +3,7 @@
 use crate::Error;
 use glam::Mat3;
 use pathlab_render::desc::EnvironmentMapDesc;
-use pathlab_render::image_io::read_linear_rgb;
+use pathlab_render::image_io::{read_linear_rgb, ImageError};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -13,8 +13,7 @@ pub fn load(path: &Path, to_world: Mat3, scale: f32) -> Result<EnvironmentMapDes
     let (w, h, texels) = read_linear_rgb(path).map_err(|e| Error::Io {
         path: path.display().to_string(),
         message: match e {
-            pathlab_render::image_io::ImageError::Exr { message, .. }
-            | pathlab_render::image_io::ImageError::Decode { message, .. } => message,
+            ImageError::Exr { message, .. } | ImageError::Decode { message, .. } => message,
             other => other.to_string(),
         },
     })?;

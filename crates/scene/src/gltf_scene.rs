@@ -10,6 +10,7 @@ use glam::{Mat4, Vec2, Vec3};
 use gltf::khr_lights_punctual::Kind;
 use pathlab_render::desc::*;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Loads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<SceneDesc, Error> {
@@ -19,7 +20,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
         column: 0,
         message,
     };
-    let (doc, buffers, _images) = gltf::import(path).map_err(|e| match e {
+    let (doc, buffers, images) = gltf::import(path).map_err(|e| match e {
         gltf::Error::Io(io) => Error::io(path, io),
         other => err(format!("not a valid glTF file: {other}")),
     })?;
@@ -97,17 +98,25 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
                     .unwrap_or_default();
                 let uvs = reader
                     .read_tex_coords(0)
-                    .map(|t| t.into_f32().map(Vec2::from_array).collect())
+                    // glTF's v grows downwards; pathlab's upwards.
+                    .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect())
                     .unwrap_or_default();
                 let m = prim.material();
                 let pbr = m.pbr_metallic_roughness();
                 let base = Vec3::from_slice(&pbr.base_color_factor()[..3]);
-                if pbr.base_color_texture().is_some() {
-                    desc.warnings.push(format!(
-                        "material {}: base-colour textures are not rendered yet; using the base colour factor",
-                        m.index().map_or("default".into(), |i| i.to_string())
-                    ));
-                }
+                let texture = pbr.base_color_texture().and_then(|info| {
+                    let index = info.texture().source().index();
+                    let texture = images.get(index).and_then(|img| {
+                        base_color_texture(img, format!("{} image {index}", path.display()))
+                    });
+                    if texture.is_none() {
+                        desc.warnings.push(format!(
+                            "material {}: base-colour image {index} has an unsupported pixel format; using the base colour factor",
+                            m.index().map_or("default".into(), |i| i.to_string())
+                        ));
+                    }
+                    texture
+                });
                 let material = if pbr.metallic_factor() > 0.5 {
                     // A conductor whose normal-incidence reflectance is the base colour.
                     let s = base.clamp(Vec3::ZERO, Vec3::splat(0.999)).map(f32::sqrt);
@@ -116,6 +125,12 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
                         eta: (Vec3::ONE + s) / (Vec3::ONE - s),
                         k: Vec3::ZERO,
                         distribution: NormalDistribution::Ggx,
+                    }
+                } else if let Some(texture) = texture {
+                    MaterialDesc::TexturedDiffuse {
+                        texture,
+                        scale: base.clamp(Vec3::ZERO, Vec3::ONE),
+                        two_sided: m.double_sided(),
                     }
                 } else {
                     MaterialDesc::Diffuse {
@@ -214,4 +229,30 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
             .push("the scene has no lights: lit by a default sky and key light".into());
     }
     Ok(desc)
+}
+
+/// A glTF base-colour image as a linear texture (8-bit channels are sRGB-encoded).
+fn base_color_texture(img: &gltf::image::Data, source: String) -> Option<Arc<Texture>> {
+    use gltf::image::Format;
+    let channels = match img.format {
+        Format::R8 => 1,
+        Format::R8G8 => 2,
+        Format::R8G8B8 => 3,
+        Format::R8G8B8A8 => 4,
+        _ => return None,
+    };
+    let decode = pathlab_render::image_io::srgb_decode;
+    let texels = img
+        .pixels
+        .chunks_exact(channels)
+        .map(|p| {
+            let c = |i: usize| decode(p[i.min(channels - 1)] as f32 / 255.0);
+            if channels < 3 {
+                Vec3::splat(c(0))
+            } else {
+                Vec3::new(c(0), c(1), c(2))
+            }
+        })
+        .collect();
+    Texture::new(source, img.width as usize, img.height as usize, texels).map(Arc::new)
 }

@@ -20,6 +20,7 @@ pub mod gltf_scene;
 pub mod info;
 pub mod meshfile;
 pub mod mitsuba;
+pub mod texture;
 mod xml;
 
 pub use pathlab_render::desc::SceneDesc;

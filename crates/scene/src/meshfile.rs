@@ -37,9 +37,28 @@ pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
     let mut emissions = Vec::new();
     for m in &mtl {
         let kd = m.diffuse.map_or(Vec3::splat(0.8), Vec3::from_array);
-        desc.materials.push(MaterialDesc::Diffuse {
-            reflectance: kd.clamp(Vec3::ZERO, Vec3::ONE),
-            two_sided: true,
+        let texture = m.diffuse_texture.as_ref().and_then(|name| {
+            let file = path.parent().unwrap_or(Path::new(".")).join(name);
+            crate::texture::load(&file, false)
+                .map_err(|e| {
+                    desc.warnings.push(format!(
+                        "material '{}': map_Kd {e}; using Kd instead",
+                        m.name
+                    ))
+                })
+                .ok()
+        });
+        desc.materials.push(match texture {
+            // The map replaces Kd, as most OBJ readers do.
+            Some(texture) => MaterialDesc::TexturedDiffuse {
+                texture,
+                scale: Vec3::ONE,
+                two_sided: true,
+            },
+            None => MaterialDesc::Diffuse {
+                reflectance: kd.clamp(Vec3::ZERO, Vec3::ONE),
+                two_sided: true,
+            },
         });
         let ke = m
             .emissive

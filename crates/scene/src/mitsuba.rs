@@ -18,6 +18,7 @@ use pathlab_render::desc::*;
 use roxmltree::Node;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// How deep `<include>` may nest (a loop of includes stops here).
 const MAX_INCLUDE_DEPTH: usize = 16;
@@ -174,6 +175,35 @@ impl Loader {
         }
     }
 
+    /// A `<texture type="bitmap" name="NAME">` child, loaded (8-bit images are decoded from
+    /// sRGB unless `raw` is true); other texture types are warned about and skipped.
+    fn bitmap(
+        &mut self,
+        f: &XmlFile,
+        node: Node,
+        name: &str,
+    ) -> Result<Option<Arc<Texture>>, Error> {
+        let Some(t) = node.children().find(|c| {
+            c.is_element() && c.tag_name().name() == "texture" && c.attribute("name") == Some(name)
+        }) else {
+            return Ok(None);
+        };
+        let kind = self.attr(f, t, "type")?;
+        if kind != "bitmap" {
+            self.desc.warnings.push(format!(
+                "{}: texture '{kind}' is not supported; using a constant colour",
+                f.path.display()
+            ));
+            return Ok(None);
+        }
+        let file = self
+            .property(f, t, "filename")?
+            .ok_or_else(|| f.error(t, "bitmap needs a 'filename' string"))?;
+        let raw = self.property(f, t, "raw")?.as_deref() == Some("true");
+        let texture = crate::texture::load(&relative(f.path, &file), raw)?;
+        Ok(Some(texture))
+    }
+
     /// A `distribution` property: `beckmann` (Mitsuba's default) or `ggx`.
     fn distribution(&self, f: &XmlFile, node: Node) -> Result<NormalDistribution, Error> {
         match self.property(f, node, "distribution")?.as_deref() {
@@ -211,9 +241,16 @@ impl Loader {
     fn bsdf_desc(&mut self, f: &XmlFile, node: Node) -> Result<MaterialDesc, Error> {
         let kind = self.attr(f, node, "type")?;
         let desc = match kind.as_str() {
-            "diffuse" => MaterialDesc::Diffuse {
-                reflectance: self.color(f, node, "reflectance", Vec3::splat(0.5))?,
-                two_sided: false,
+            "diffuse" => match self.bitmap(f, node, "reflectance")? {
+                Some(texture) => MaterialDesc::TexturedDiffuse {
+                    texture,
+                    scale: Vec3::ONE,
+                    two_sided: false,
+                },
+                None => MaterialDesc::Diffuse {
+                    reflectance: self.color(f, node, "reflectance", Vec3::splat(0.5))?,
+                    two_sided: false,
+                },
             },
             "twosided" => {
                 let inner = child(node, "bsdf")
@@ -223,6 +260,13 @@ impl Loader {
                         reflectance,
                         two_sided: true,
                     },
+                    MaterialDesc::TexturedDiffuse { texture, scale, .. } => {
+                        MaterialDesc::TexturedDiffuse {
+                            texture,
+                            scale,
+                            two_sided: true,
+                        }
+                    }
                     other => other,
                 }
             }
@@ -487,6 +531,15 @@ impl Loader {
         if m.determinant() < 0.0 {
             flip_winding(&mut indices);
         }
+        // Mitsuba's rectangle maps its corners (±1, ±1) to the unit square of (u, v).
+        let uvs = if kind == "rectangle" {
+            positions
+                .iter()
+                .map(|p| glam::Vec2::new(0.5 * (p.x + 1.0), 0.5 * (p.y + 1.0)))
+                .collect()
+        } else {
+            Vec::new()
+        };
         self.desc.meshes.push(MeshDesc {
             name,
             positions: positions.iter().map(|&p| m.transform_point3(p)).collect(),
@@ -494,7 +547,7 @@ impl Loader {
             material,
             emission,
             normals: Vec::new(),
-            uvs: Vec::new(),
+            uvs,
             visibility: Visibility::ALL,
         });
         Ok(())

@@ -26,7 +26,9 @@ pub use rough_dielectric::RoughDielectric;
 
 use crate::desc::{MaterialDesc, Rgb};
 use crate::geometry::Frame;
+use crate::texture::Texture;
 use glam::{Vec2, Vec3};
+use std::sync::Arc;
 
 /// A sampled direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -117,13 +119,39 @@ impl Bxdf {
     }
 }
 
-/// A material: its BxDF and whether its back side reflects.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A material: its BxDF, whether its back side reflects, and a texture that varies the
+/// diffuse albedo over the surface.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// Reflectance model.
     pub bxdf: Bxdf,
     /// Whether the back side of the surface reflects too.
     pub two_sided: bool,
+    /// Albedo texture of a diffuse BxDF (its reflectance then scales the texture).
+    pub texture: Option<Arc<Texture>>,
+}
+
+impl Material {
+    /// A material without texture.
+    pub fn new(bxdf: Bxdf, two_sided: bool) -> Self {
+        Material {
+            bxdf,
+            two_sided,
+            texture: None,
+        }
+    }
+
+    /// The BSDF at a point with shading normal `n` and texture coordinates `uv`, seen from `wo`.
+    #[inline]
+    pub fn bsdf(&self, n: Vec3, wo: Vec3, uv: Vec2) -> Bsdf {
+        let bxdf = match (&self.texture, self.bxdf) {
+            (Some(t), Bxdf::Diffuse(d)) => Bxdf::Diffuse(Diffuse {
+                reflectance: (d.reflectance * t.eval(uv)).clamp(Vec3::ZERO, Vec3::ONE),
+            }),
+            _ => self.bxdf,
+        };
+        Bsdf::from_bxdf(bxdf, self.two_sided, n, wo)
+    }
 }
 
 /// Roughness below which a microfacet model is drawn as its smooth (delta) limit.
@@ -136,16 +164,26 @@ impl From<&MaterialDesc> for Material {
             MaterialDesc::Diffuse {
                 reflectance,
                 two_sided,
-            } => Material {
-                bxdf: Bxdf::Diffuse(Diffuse {
+            } => Material::new(
+                Bxdf::Diffuse(Diffuse {
                     reflectance: reflectance.clamp(Vec3::ZERO, Vec3::ONE),
                 }),
                 two_sided,
+            ),
+            MaterialDesc::TexturedDiffuse {
+                ref texture,
+                scale,
+                two_sided,
+            } => Material {
+                bxdf: Bxdf::Diffuse(Diffuse {
+                    reflectance: scale.max(Vec3::ZERO),
+                }),
+                two_sided,
+                texture: Some(texture.clone()),
             },
-            MaterialDesc::Mirror { reflectance } => Material {
-                bxdf: Bxdf::Mirror(Mirror { reflectance }),
-                two_sided: true,
-            },
+            MaterialDesc::Mirror { reflectance } => {
+                Material::new(Bxdf::Mirror(Mirror { reflectance }), true)
+            }
             MaterialDesc::Glass {
                 reflectance,
                 transmittance,
@@ -175,31 +213,28 @@ impl From<&MaterialDesc> for Material {
                     })
                 };
                 // The side matters: inside and outside differ.
-                Material {
-                    bxdf,
-                    two_sided: false,
-                }
+                Material::new(bxdf, false)
             }
             MaterialDesc::Conductor {
                 alpha,
                 eta,
                 k,
                 distribution,
-            } => Material {
-                bxdf: Bxdf::Conductor(Conductor {
+            } => Material::new(
+                Bxdf::Conductor(Conductor {
                     eta,
                     k,
                     distribution: (alpha > SMOOTH_ALPHA)
                         .then(|| Microfacet::new(distribution, alpha)),
                 }),
-                two_sided: true,
-            },
+                true,
+            ),
             MaterialDesc::Plastic {
                 diffuse,
                 ior,
                 nonlinear,
-            } => Material {
-                bxdf: Bxdf::Plastic(Plastic::new(
+            } => Material::new(
+                Bxdf::Plastic(Plastic::new(
                     diffuse.clamp(Vec3::ZERO, Vec3::ONE),
                     if ior > 0.0 && ior.is_finite() {
                         ior
@@ -208,8 +243,8 @@ impl From<&MaterialDesc> for Material {
                     },
                     nonlinear,
                 )),
-                two_sided: false,
-            },
+                false,
+            ),
         }
     }
 }
@@ -308,15 +343,15 @@ mod tests {
     fn glass_sampling_conserves_energy() {
         // Without absorption, the expected throughput f |cos| / pdf of one sample is one on
         // both sides (radiance scaling aside): reflection F/F and transmission (1-F)/(1-F).
-        let m = Material {
-            bxdf: Bxdf::Dielectric(SmoothDielectric {
+        let m = Material::new(
+            Bxdf::Dielectric(SmoothDielectric {
                 eta: 1.5,
                 reflectance: Vec3::ONE,
                 transmittance: Vec3::ONE,
                 fresnel: FresnelModel::Exact,
             }),
-            two_sided: false,
-        };
+            false,
+        );
         let bsdf = Bsdf::new(&m, Vec3::Z, Vec3::Z);
         let wo = Vec3::new(0.6, 0.0, 0.8);
         let (mut reflected, n) = (0, 10_000);
@@ -336,12 +371,12 @@ mod tests {
         let f = fresnel_dielectric(0.8, 1.5);
         assert!((reflected as f32 / n as f32 - f).abs() <= 1.0 / n as f32 + 1e-6);
         let mirror = Bsdf::new(
-            &Material {
-                bxdf: Bxdf::Mirror(Mirror {
+            &Material::new(
+                Bxdf::Mirror(Mirror {
                     reflectance: Vec3::splat(0.7),
                 }),
-                two_sided: true,
-            },
+                true,
+            ),
             Vec3::Z,
             wo,
         );

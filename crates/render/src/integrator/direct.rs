@@ -1,5 +1,4 @@
 use super::{emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats};
-use crate::bsdf::Bsdf;
 use crate::desc::Rgb;
 use crate::geometry::{spawn_ray, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
@@ -97,7 +96,7 @@ impl Integrator for DirectIntegrator {
         };
         let wo = -ray.d;
         let mut l = emitted(scene, ray.o, &ray, &si).map_or(Rgb::ZERO, |(le, _)| le);
-        let bsdf = Bsdf::new(scene.material(si.material), si.ns, wo);
+        let bsdf = scene.bsdf(&si, wo);
         let n = self.samples.max(1);
         let frame = *bsdf.frame();
         let mut sum = Rgb::ZERO;

@@ -1,5 +1,4 @@
 use super::{emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats};
-use crate::bsdf::Bsdf;
 use crate::desc::Rgb;
 use crate::geometry::{spawn_ray, Ray};
 use crate::scene::Scene;
@@ -111,7 +110,7 @@ impl Integrator for PathIntegrator {
             if depth >= self.max_depth {
                 break;
             }
-            let bsdf = Bsdf::new(scene.material(si.material), si.ns, wo);
+            let bsdf = scene.bsdf(&si, wo);
             if wants(depth + 1) && !bsdf.is_delta() && self.lighting != PathLighting::Bsdf {
                 let mut ld = Rgb::ZERO;
                 for _ in 0..n_light {
