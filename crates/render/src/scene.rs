@@ -92,6 +92,9 @@ pub struct Scene {
     tri_light: Vec<u32>,
     /// Per-triangle vertex texture coordinates (empty when no mesh has any).
     tri_uv: Vec<[Vec2; 3]>,
+    /// Per-triangle vertex normals for smooth shading (empty when no mesh has any; a mesh
+    /// without them gets its face normal at each corner).
+    tri_normals: Vec<[Vec3; 3]>,
     spheres: Vec<Sphere>,
     sphere_material: Vec<u32>,
     sphere_light: Vec<u32>,
@@ -134,6 +137,11 @@ impl Scene {
         let mut tri_visibility = Vec::new();
         let mut tri_uv = Vec::new();
         let any_uvs = desc.meshes.iter().any(|m| !m.uvs.is_empty());
+        let mut tri_normals = Vec::new();
+        let any_normals = desc
+            .meshes
+            .iter()
+            .any(|m| !m.normals.is_empty() && m.normals.len() == m.positions.len());
         let mut lights = Vec::new();
         let mut sampleable = Vec::new();
         for mesh in &desc.meshes {
@@ -171,6 +179,22 @@ impl Scene {
                             .unwrap_or([Vec2::ZERO, Vec2::X, Vec2::Y][k])
                     };
                     tri_uv.push([uv(0), uv(1), uv(2)]);
+                }
+                if any_normals {
+                    let face = t.normal();
+                    let normal = |k: usize| {
+                        if mesh.normals.len() != mesh.positions.len() {
+                            return face;
+                        }
+                        let n = mesh.normals[tri[k] as usize];
+                        // Shading normals stay on the front (winding) side of the face.
+                        match n.try_normalize() {
+                            Some(n) if n.dot(face) >= 0.0 => n,
+                            Some(n) => -n,
+                            None => face,
+                        }
+                    };
+                    tri_normals.push([normal(0), normal(1), normal(2)]);
                 }
                 tri_material.push(material);
                 tri_visibility.push(mesh.visibility);
@@ -292,6 +316,7 @@ impl Scene {
             tri_material,
             tri_light,
             tri_uv,
+            tri_normals,
             spheres,
             sphere_material,
             sphere_light,
@@ -419,11 +444,18 @@ impl Scene {
                         Some(uv) => (1.0 - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2],
                         None => Vec2::new(b1, b2),
                     };
+                    let ns = match self.tri_normals.get(i as usize) {
+                        Some(n) => ((1.0 - b1 - b2) * n[0] + b1 * n[1] + b2 * n[2])
+                            .try_normalize()
+                            .filter(|ns| ns.dot(ng) > 0.0)
+                            .unwrap_or(ng),
+                        None => ng,
+                    };
                     SurfaceInteraction {
                         p,
                         t,
                         ng,
-                        ns: ng,
+                        ns,
                         material: self.tri_material[i as usize],
                         light: (light != NO_LIGHT).then_some(light),
                         uv,
@@ -497,5 +529,46 @@ pub fn diffuse(reflectance: Rgb, two_sided: bool) -> MaterialDesc {
     MaterialDesc::Diffuse {
         reflectance,
         two_sided,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::desc::MeshDesc;
+
+    fn triangle_with_normals(normals: Vec<Vec3>) -> Scene {
+        let desc = SceneDesc {
+            meshes: vec![MeshDesc {
+                name: "tri".into(),
+                positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+                indices: vec![0, 1, 2],
+                normals,
+                ..Default::default()
+            }],
+            materials: vec![diffuse(Vec3::ONE, false)],
+            resolution: [4, 4],
+            ..Default::default()
+        };
+        Scene::build(&desc).unwrap()
+    }
+
+    #[test]
+    fn vertex_normals_are_interpolated_and_kept_on_the_front_side() {
+        let tilted = Vec3::new(1.0, 0.0, 1.0).normalize();
+        let scene = triangle_with_normals(vec![Vec3::Z, tilted, Vec3::Z]);
+        let ray = Ray::new(Vec3::new(0.5, 0.25, 1.0), -Vec3::Z);
+        let si = scene.intersect(&ray).0.unwrap();
+        assert_eq!(si.ng, Vec3::Z);
+        // Barycentrics (0.25, 0.5, 0.25): the tilted normal has weight ½.
+        let expected = (0.5 * Vec3::Z + 0.5 * tilted).normalize();
+        assert!((si.ns - expected).length() < 1e-5, "{}", si.ns);
+        // Normals pointing against the winding are flipped to its side.
+        let scene = triangle_with_normals(vec![-Vec3::Z; 3]);
+        let si = scene.intersect(&ray).0.unwrap();
+        assert!((si.ns - Vec3::Z).length() < 1e-6);
+        // Without normals, shading is flat.
+        let scene = triangle_with_normals(Vec::new());
+        assert_eq!(scene.intersect(&ray).0.unwrap().ns, Vec3::Z);
     }
 }
