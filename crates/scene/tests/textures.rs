@@ -159,3 +159,69 @@ fn a_missing_texture_is_a_warning_not_a_failure() {
     );
     assert!(matches!(desc.materials[0], MaterialDesc::Diffuse { .. }));
 }
+
+#[test]
+fn gltf_base_colour_texture_times_factor() {
+    let dir = fixture("gltf");
+    let mut bin = Vec::new();
+    for p in [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ] {
+        for c in p {
+            bin.extend(c.to_le_bytes());
+        }
+    }
+    // glTF's v runs down the image: the corner at y = 1 shows the top row.
+    for t in [[0.0f32, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]] {
+        for c in t {
+            bin.extend(c.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        bin.extend(i.to_le_bytes());
+    }
+    std::fs::write(dir.join("quad.bin"), &bin).unwrap();
+    let json = format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0]}}],
+  "nodes": [{{"mesh": 0}}],
+  "images": [{{"uri": "tex.png"}}],
+  "textures": [{{"source": 0}}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.5, 0.5, 0.5, 1], "baseColorTexture": {{"index": 0}}, "metallicFactor": 0}}}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "indices": 2, "material": 0}}]}}],
+  "buffers": [{{"uri": "quad.bin", "byteLength": {len}}}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 48, "byteLength": 32}},
+    {{"buffer": 0, "byteOffset": 80, "byteLength": 12}}
+  ],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"}},
+    {{"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}}
+  ]
+}}"#,
+        len = bin.len()
+    );
+    std::fs::write(dir.join("quad.gltf"), json).unwrap();
+    let desc = pathlab_scene::load(dir.join("quad.gltf").to_str().unwrap()).unwrap();
+    assert!(
+        desc.warnings.iter().all(|w| !w.contains("image")),
+        "{:?}",
+        desc.warnings
+    );
+    let scene = Scene::build(&desc).unwrap();
+    assert_close(
+        albedo_at(&scene, Vec3::new(0.25, 0.25, 1.0)),
+        Vec3::new(0.0, 0.0, 0.5),
+    );
+    assert_close(
+        albedo_at(&scene, Vec3::new(0.25, 0.75, 1.0)),
+        Vec3::new(0.5, 0.0, 0.0),
+    );
+}
