@@ -34,7 +34,7 @@ pub struct CompareArgs {
     #[arg(short = 's', long, default_value_t = 16)]
     pub spp: u32,
     /// Largest bounce for the path strategy.
-    #[arg(short = 'm', long, default_value_t = 1)]
+    #[arg(short = 'm', long, default_value = "1", value_parser = crate::render_cmd::parse_depth_arg)]
     pub max_depth: u32,
     /// A reference image (linear EXR of the same size) for RMSE.
     #[arg(long = "ref", value_name = "REF.exr")]
@@ -147,7 +147,12 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         });
     }
     write_side_by_side(&rows, &args.output)?;
-    let efficiency = |r: &Row| 1.0 / (r.variance * r.seconds).max(f64::MIN_POSITIVE);
+    // Undefined when the variance is unknown (one sample per pixel) or the time too short to
+    // measure.
+    let efficiency = |r: &Row| {
+        let cost = r.variance * r.seconds;
+        (args.spp > 1 && cost > 0.0).then(|| 1.0 / cost)
+    };
     if args.json {
         let out = json!({
             "scene": args.scene,
@@ -177,13 +182,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     );
     for r in &rows {
         let rmse = r.rmse.map_or("-".to_string(), |e| format!("{e:.5}"));
+        let efficiency = efficiency(r).map_or("-".to_string(), |e| format!("{e:.4e}"));
         println!(
-            "  {:<12} {:>9.3} {:>16.6} {:>12} {:>14.4e}",
-            r.name,
-            r.seconds,
-            r.variance,
-            rmse,
-            efficiency(r)
+            "  {:<12} {:>9.3} {:>16.6} {:>12} {:>14}",
+            r.name, r.seconds, r.variance, rmse, efficiency
         );
     }
     println!(

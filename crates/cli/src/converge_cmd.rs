@@ -24,7 +24,7 @@ pub struct ConvergeArgs {
     #[arg(long = "ref", value_name = "REF.exr")]
     pub reference: PathBuf,
     /// Largest bounce (default 1: direct lighting).
-    #[arg(short = 'm', long, default_value_t = 1)]
+    #[arg(short = 'm', long, default_value = "1", value_parser = crate::render_cmd::parse_depth_arg)]
     pub max_depth: u32,
     /// Largest samples per pixel (powers of two from 1 up to this).
     #[arg(long, default_value_t = 256)]

@@ -190,7 +190,13 @@ pub struct RenderArgs {
     pub json: bool,
 }
 
-fn parse_max_depth(text: &str) -> Result<u32> {
+/// [`parse_max_depth`] as a clap value parser.
+pub(crate) fn parse_depth_arg(text: &str) -> std::result::Result<u32, String> {
+    parse_max_depth(text).map_err(|e| e.to_string())
+}
+
+/// A `--max-depth` value: a number of bounces or `inf` (also `-1`).
+pub(crate) fn parse_max_depth(text: &str) -> Result<u32> {
     if text.eq_ignore_ascii_case("inf") || text == "-1" {
         return Ok(u32::MAX);
     }
