@@ -90,6 +90,42 @@ fn compare(film: &Film, r: &Reference) -> Comparison {
     }
 }
 
+/// Per-pixel outliers as in [`compare`], but each variance (ours and the reference's) is the
+/// larger of the pixel's own estimate and the mean over its 3 x 3 neighbourhood. Where radiance
+/// arrives by rare paths (caustics seen through delta BSDFs, found only by BSDF sampling), a
+/// pixel that drew none of them estimates a variance far below the true one, and its z is then
+/// meaningless; its neighbours, which share the same rare paths, tell the true variance.
+/// Taking the larger of the two never lowers a variance, so the test only loses power (how
+/// much is checked by scaling our image by `scale` ≠ 1).
+fn compare_pooled(film: &Film, r: &Reference, scale: f64) -> [usize; 3] {
+    let (w, h) = (film.width() as usize, film.height() as usize);
+    let ours: Vec<DVec3> = film.pixels().iter().map(|p| p.variance_of_mean()).collect();
+    let reference: Vec<DVec3> = r.stderr.iter().map(|s| *s * *s).collect();
+    let pooled = |v: &[DVec3], x: usize, y: usize| {
+        let (mut sum, mut n) = (DVec3::ZERO, 0.0);
+        for yy in y.saturating_sub(1)..(y + 2).min(h) {
+            for xx in x.saturating_sub(1)..(x + 2).min(w) {
+                sum += v[yy * w + xx];
+                n += 1.0;
+            }
+        }
+        v[y * w + x].max(sum / n)
+    };
+    let mut outliers = [0usize; 3];
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let rounding = r.mean[i].abs() * REFERENCE_ROUNDING;
+            let se2 = pooled(&ours, x, y) + pooled(&reference, x, y) + rounding * rounding;
+            let diff = (film.pixels()[i].mean() * scale - r.mean[i]).abs();
+            for c in 0..3 {
+                outliers[c] += (diff[c] > MAX_Z * se2[c].sqrt()) as usize;
+            }
+        }
+    }
+    outliers
+}
+
 /// Block size of the block comparison.
 const BLOCK: usize = 8;
 
@@ -604,19 +640,16 @@ fn render_reference_scene(folder: &str, spp: u32, seed: u64) -> (Film, Reference
 
 #[test]
 fn thin_lens_matches_mitsuba() {
-    let (film, r) = render_reference_scene("cornell-thinlens", 128, 91);
+    let (film, r) = render_reference_scene("cornell-thinlens", 512, 91);
     let c = compare(&film, &r);
     let (out, blocks) = compare_blocks(&film, &r, 0.0);
-    eprintln!(
-        "cornell-thinlens -m inf, 128 spp: per-pixel outliers {:?}; blocks {out:?} of {blocks}; image mean z {:.2?}",
-        c.outliers, c.mean_z
-    );
+    eprintln!("cornell-thinlens -m inf, 512 spp: blocks {out:?} of {blocks}");
+    assert_agrees("cornell-thinlens", &c);
     assert!(
         out.iter()
             .all(|&o| (o as f64) < MAX_OUTLIER_FRACTION * blocks as f64 + 1.0),
         "{out:?}"
     );
-    assert!(c.mean_z.abs().max_element() <= MAX_MEAN_Z, "{:?}", c.mean_z);
 }
 
 #[test]
@@ -624,17 +657,23 @@ fn mirror_and_glass_spheres_match_mitsuba() {
     let (film, r) = render_reference_scene("cornell-spheres", 256, 81);
     let c = compare(&film, &r);
     let (out, blocks) = compare_blocks(&film, &r, 0.0);
+    let (regions, count) = compare_blocks_of(&film, &r, 0.0, 64);
+    let pooled = compare_pooled(&film, &r, 1.0);
+    let biased = compare_pooled(&film, &r, 0.9);
     eprintln!(
-        "cornell-spheres -m inf: per-pixel outliers {:?}; blocks {out:?} of {blocks}; image mean {:.5?} vs {:.5?}, z {:.2?}",
+        "cornell-spheres -m inf, 256 spp: per-pixel outliers {:?} (own variances), {pooled:?} \
+         (neighbourhood-pooled), {biased:?} (pooled, our image scaled by 0.9); blocks {out:?} \
+         of {blocks}; 64 x 64 regions {regions:?} of {count}; image mean {:.5?} vs {:.5?}, z {:.2?}",
         c.outliers, c.ours_mean, c.ref_mean, c.mean_z
     );
-    // Caustics through the glass sphere (light reaching the walls only through it) are rare,
-    // bright paths: at 256 spp even 8 x 8 blocks often miss them and then underestimate both
-    // their mean and their variance (all the outlier blocks above are low). Means over 64 x 64
-    // regions (16 384 pixels' samples each) are close to normal: none of the 48 region-channel
-    // z values may exceed 4, and the image mean must agree within 3 combined standard errors.
-    let (regions, count) = compare_blocks_of(&film, &r, 0.0, 64);
-    eprintln!("64 x 64 regions beyond 4 sigma: {regions:?} of {count}");
+    // Light reaches the ceiling and walls through the mirror and glass spheres by caustic
+    // paths that only BSDF sampling finds, rarely: most pixels draw none of them and then
+    // underestimate mean and variance together (all the raw outliers are low, up to 1024 spp).
+    // With each variance taken as the larger of the pixel's and its neighbourhood's, the
+    // per-pixel z-test holds, and it still rejects an image 10% too dark.
+    let limit = MAX_OUTLIER_FRACTION * c.pixels as f64;
+    assert!(pooled.iter().all(|&o| (o as f64) < limit), "{pooled:?}");
+    assert!(biased.iter().all(|&o| (o as f64) > limit), "{biased:?}");
     assert_eq!(regions, [0, 0, 0]);
     assert!(c.mean_z.abs().max_element() <= MAX_MEAN_Z, "{:?}", c.mean_z);
 }
