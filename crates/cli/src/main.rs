@@ -1,5 +1,6 @@
 //! `pathlab`: the command-line front end of the pathlab renderer and Monte Carlo toolkit.
 
+mod bench_cmd;
 mod compare_cmd;
 mod converge_cmd;
 mod expr;
@@ -34,6 +35,8 @@ enum Command {
     Sample(sample::SampleArgs),
     /// Estimate an integral over a box by Monte Carlo, with its error.
     Integrate(integrate::IntegrateArgs),
+    /// Measure speed (not a test): BVH build and ray throughput against Embree's ray files.
+    Bench(bench_cmd::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +48,7 @@ fn main() -> ExitCode {
         Command::Converge(args) => converge_cmd::run(args),
         Command::Sample(args) => sample::run(args),
         Command::Integrate(args) => integrate::run(args),
+        Command::Bench(args) => bench_cmd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,13 +3,15 @@
 
 use glam::Vec3;
 
-/// A ray `o + t d` for `t` in `(0, t_max)`.
+/// A ray `o + t d` for `t` in `(t_min, t_max)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     /// Origin.
     pub o: Vec3,
     /// Direction (unit length where the code says so; intersection works with any length).
     pub d: Vec3,
+    /// The near end of the ray's extent (0 for rays the renderer makes: it offsets origins).
+    pub t_min: f32,
     /// The far end of the ray's extent.
     pub t_max: f32,
 }
@@ -20,6 +22,7 @@ impl Ray {
         Ray {
             o,
             d,
+            t_min: 0.0,
             t_max: f32::INFINITY,
         }
     }
@@ -196,6 +199,7 @@ pub fn spawn_ray_to(p: Vec3, ng: Vec3, target: Vec3, ng_target: Option<Vec3>) ->
     Ray {
         o,
         d,
+        t_min: 0.0,
         t_max: 1.0 - 1e-4,
     }
 }

@@ -1,6 +1,6 @@
 //! The renderable scene: flattened shapes, the BVH over them, materials, lights and camera.
 
-use crate::accel::{Bvh, BvhParams};
+use crate::accel::{Bvh4, BvhParams, MAX_PRIMITIVES};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc, Visibility};
@@ -48,6 +48,11 @@ pub enum SceneError {
 enum Prim {
     Triangle(u32),
     Sphere(u32),
+}
+
+/// `items` rearranged so that position `i` holds `items[order[i]]`.
+fn permute<T: Copy>(items: &[T], order: &[u32]) -> Vec<T> {
+    order.iter().map(|&i| items[i as usize]).collect()
 }
 
 /// A ray's nearest hit.
@@ -103,7 +108,7 @@ pub struct Scene {
     prim_visibility: Vec<Visibility>,
     /// Whether every primitive is seen by every ray (the common case, checked once).
     all_visible: bool,
-    bvh: Bvh,
+    bvh: Bvh4,
     materials: Vec<Material>,
     lights: Vec<Light>,
     light_sampler: LightSampler,
@@ -262,8 +267,50 @@ impl Scene {
                 Prim::Sphere(i) => spheres[i as usize].bounds(),
             })
             .collect();
+        if prims.len() > MAX_PRIMITIVES {
+            return Err(SceneError::Invalid(format!(
+                "{} primitives: at most {MAX_PRIMITIVES} fit the BVH",
+                prims.len()
+            )));
+        }
         let start = Instant::now();
-        let bvh = Bvh::build(&bounds, BvhParams::default());
+        let mut bvh = Bvh4::build(&bounds, BvhParams::default());
+        // Lay primitives and triangles out in leaf order, so that a leaf's triangles are
+        // neighbours in memory (one cache miss per leaf rather than one per triangle).
+        let order = bvh.take_leaf_order();
+        let mut tri_order: Vec<u32> = Vec::with_capacity(triangles.len());
+        let prims: Vec<Prim> = order
+            .iter()
+            .map(|&p| match prims[p as usize] {
+                Prim::Triangle(t) => {
+                    tri_order.push(t);
+                    Prim::Triangle(tri_order.len() as u32 - 1)
+                }
+                sphere => sphere,
+            })
+            .collect();
+        if tri_order.len() < triangles.len() {
+            // Triangles the BVH left out (non-finite boxes) keep their data, unreachable.
+            let mut seen = vec![false; triangles.len()];
+            for &t in &tri_order {
+                seen[t as usize] = true;
+            }
+            tri_order.extend((0..triangles.len() as u32).filter(|&t| !seen[t as usize]));
+        }
+        let triangles = permute(&triangles, &tri_order);
+        let tri_material = permute(&tri_material, &tri_order);
+        let tri_light = permute(&tri_light, &tri_order);
+        let tri_visibility = permute(&tri_visibility, &tri_order);
+        let tri_uv = if tri_uv.is_empty() {
+            tri_uv
+        } else {
+            permute(&tri_uv, &tri_order)
+        };
+        let tri_normals = if tri_normals.is_empty() {
+            tri_normals
+        } else {
+            permute(&tri_normals, &tri_order)
+        };
         let bvh_seconds = start.elapsed().as_secs_f64();
         let scene_radius = bounding_radius(&bvh.bounds());
         for dl in &desc.directional_lights {
@@ -346,6 +393,23 @@ impl Scene {
     /// Bounds of all shapes.
     pub fn bounds(&self) -> Aabb {
         self.bvh.bounds()
+    }
+
+    /// Bytes held by the geometry and the acceleration structure (shapes, per-primitive tables,
+    /// BVH), for memory reports.
+    pub fn geometry_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(self.triangles.as_slice())
+            + size_of_val(self.tri_material.as_slice())
+            + size_of_val(self.tri_light.as_slice())
+            + size_of_val(self.tri_uv.as_slice())
+            + size_of_val(self.tri_normals.as_slice())
+            + size_of_val(self.spheres.as_slice())
+            + size_of_val(self.sphere_material.as_slice())
+            + size_of_val(self.sphere_light.as_slice())
+            + size_of_val(self.prims.as_slice())
+            + size_of_val(self.prim_visibility.as_slice())
+            + self.bvh.memory_bytes()
     }
 
     /// The BSDF at a surface point seen from `wo`.

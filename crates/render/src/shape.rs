@@ -55,7 +55,7 @@ impl Triangle {
     }
 
     /// Möller–Trumbore intersection ("Fast, Minimum Storage Ray/Triangle Intersection",
-    /// 1997), both sides, within `(0, ray.t_max)`.
+    /// 1997), both sides, within `(ray.t_min, ray.t_max)`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<TriangleHit> {
         let e1 = self.p[1] - self.p[0];
@@ -77,7 +77,7 @@ impl Triangle {
             return None;
         }
         let t = e2.dot(qvec) * inv_det;
-        (t > 0.0 && t < ray.t_max).then_some(TriangleHit { t, b1, b2 })
+        (t > ray.t_min && t < ray.t_max).then_some(TriangleHit { t, b1, b2 })
     }
 
     /// A point uniform over the triangle.
@@ -138,10 +138,10 @@ impl Sphere {
         let q = -(b + disc.sqrt().copysign(b));
         let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
         let (t0, t1) = (t0.min(t1), t0.max(t1));
-        let t_max = ray.t_max as f64;
+        let (t_min, t_max) = (ray.t_min as f64, ray.t_max as f64);
         [t0, t1]
             .into_iter()
-            .find(|&t| t > 0.0 && t < t_max)
+            .find(|&t| t > t_min && t < t_max)
             .map(|t| t as f32)
     }
 

@@ -95,6 +95,12 @@ impl Bvh {
         bvh
     }
 
+    /// Bytes held by the nodes and the primitive index list.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.prim_indices.as_slice())
+    }
+
     /// Number of nodes.
     pub fn node_count(&self) -> usize {
         self.nodes.len()

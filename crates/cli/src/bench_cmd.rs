@@ -1,0 +1,321 @@
+//! `pathlab bench`: measurements that are not tests. `bench rays MESH RAYS` traces the exact
+//! rays of a ray file written by the Embree benchmark (`bench/embree/`), checks every hit
+//! distance against Embree's, and reports build time, throughput and memory, so that the two
+//! can be compared as ratios in one script.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand};
+use glam::Vec3;
+use pathlab_render::geometry::Ray;
+use pathlab_render::scene::Scene;
+use rayon::prelude::*;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Raw command-line arguments of `pathlab bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    what: BenchWhat,
+}
+
+#[derive(Subcommand, Debug)]
+enum BenchWhat {
+    /// Trace a ray file (primary and bounce rays with Embree's hit distances) through the BVH of
+    /// a mesh: build time, Mrays/s for 1 and all threads, hits checked against Embree's.
+    Rays(RaysArgs),
+}
+
+#[derive(Args, Debug)]
+struct RaysArgs {
+    /// The mesh (any scene file pathlab reads; OBJ for the Embree comparison).
+    mesh: String,
+    /// The ray file written by `embree_bench MESH THREADS RAYS`.
+    rays: PathBuf,
+    /// Threads for the parallel run (0: all cores).
+    #[arg(short = 't', long, default_value_t = 0)]
+    threads: usize,
+    /// Timed repetitions per measurement (the best is reported).
+    #[arg(long, default_value_t = 3)]
+    repeat: u32,
+    /// Print the results as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// One ray of the file: origin, unit direction, the start of its extent and Embree's hit
+/// distance (infinite for a miss).
+#[derive(Clone, Copy, Debug)]
+struct FileRay {
+    o: Vec3,
+    d: Vec3,
+    t_near: f32,
+    t_hit: f32,
+}
+
+/// Reads the ray file: 8-byte magic `PLRAYS1\0`, u64 primary count, u64 bounce count, then
+/// records of 8 little-endian f32 (origin, direction, t_near, t_hit).
+fn read_rays(path: &Path) -> Result<(Vec<FileRay>, Vec<FileRay>)> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
+    let bad = |what: &str| anyhow::anyhow!("{}: {what}", path.display());
+    if bytes.len() < 24 || &bytes[..8] != b"PLRAYS1\0" {
+        return Err(bad("not a ray file (expected the magic PLRAYS1)"));
+    }
+    let word =
+        |i: usize| u64::from_le_bytes(bytes[8 + 8 * i..16 + 8 * i].try_into().unwrap_or([0; 8]));
+    let (n_primary, n_bounce) = (word(0) as usize, word(1) as usize);
+    let records = n_primary
+        .checked_add(n_bounce)
+        .filter(|n| n.checked_mul(32).is_some_and(|b| b == bytes.len() - 24))
+        .ok_or_else(|| {
+            bad(&format!(
+                "{} bytes of records do not hold {n_primary} + {n_bounce} rays of 32 bytes",
+                bytes.len() - 24
+            ))
+        })?;
+    let rays: Vec<FileRay> = bytes[24..]
+        .chunks_exact(32)
+        .take(records)
+        .map(|r| {
+            let f =
+                |k: usize| f32::from_le_bytes([r[4 * k], r[4 * k + 1], r[4 * k + 2], r[4 * k + 3]]);
+            FileRay {
+                o: Vec3::new(f(0), f(1), f(2)),
+                d: Vec3::new(f(3), f(4), f(5)),
+                t_near: f(6),
+                t_hit: f(7),
+            }
+        })
+        .collect();
+    let mut primary = rays;
+    let bounce = primary.split_off(n_primary);
+    Ok((primary, bounce))
+}
+
+/// The ray as pathlab traces it.
+fn to_ray(r: &FileRay) -> Ray {
+    Ray {
+        t_min: r.t_near,
+        ..Ray::new(r.o, r.d)
+    }
+}
+
+/// Hit distances of every ray (infinite for a miss), measured from the file's origin.
+fn trace_all(scene: &Scene, rays: &[FileRay], pool: Option<&rayon::ThreadPool>) -> Vec<f32> {
+    let one = |r: &FileRay| {
+        scene
+            .intersect(&to_ray(r))
+            .0
+            .map_or(f32::INFINITY, |si| si.t)
+    };
+    match pool {
+        None => rays.iter().map(one).collect(),
+        Some(pool) => pool.install(|| rays.par_iter().with_min_len(4096).map(one).collect()),
+    }
+}
+
+/// Best throughput in Mrays/s over `repeat` runs, and the hits of the last run.
+fn timed(
+    scene: &Scene,
+    rays: &[FileRay],
+    pool: Option<&rayon::ThreadPool>,
+    repeat: u32,
+) -> (f64, Vec<f32>) {
+    let mut best = 0.0f64;
+    let mut hits = Vec::new();
+    for _ in 0..repeat.max(1) {
+        let start = Instant::now();
+        hits = trace_all(scene, rays, pool);
+        let rate = rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6;
+        best = best.max(rate);
+    }
+    (best, hits)
+}
+
+/// How many hits agree with Embree's: both miss, or distances within 1e-4 relative.
+fn agreement(rays: &[FileRay], hits: &[f32]) -> usize {
+    rays.iter()
+        .zip(hits)
+        .filter(|(r, &t)| {
+            if r.t_hit.is_infinite() || t.is_infinite() {
+                r.t_hit.is_infinite() && t.is_infinite()
+            } else {
+                (t - r.t_hit).abs() <= 1e-4 * r.t_hit.abs().max(1e-3)
+            }
+        })
+        .count()
+}
+
+/// Runs `pathlab bench`.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    match &args.what {
+        BenchWhat::Rays(a) => rays(a),
+    }
+}
+
+fn rays(args: &RaysArgs) -> Result<()> {
+    let (primary, bounce) = read_rays(&args.rays)?;
+    let mut desc = pathlab_scene::load(&args.mesh)?;
+    // Only the geometry matters here.
+    desc.environment = None;
+    desc.environment_map = None;
+    desc.point_lights.clear();
+    desc.spot_lights.clear();
+    desc.directional_lights.clear();
+    for m in &mut desc.meshes {
+        m.emission = None;
+    }
+    let start = Instant::now();
+    let scene = Scene::build(&desc).context("cannot build the scene")?;
+    let build_total = start.elapsed().as_secs_f64();
+    let stats = scene.stats();
+    if stats.triangles == 0 {
+        bail!("{}: no triangles", args.mesh);
+    }
+    let threads = if args.threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        args.threads
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let mut sets = Vec::new();
+    for (name, rays) in [("primary", &primary), ("bounce", &bounce)] {
+        let (one, hits) = timed(&scene, rays, None, args.repeat);
+        let (all, _) = timed(&scene, rays, Some(&pool), args.repeat);
+        let agree = agreement(rays, &hits);
+        let visited: u64 = rays
+            .iter()
+            .map(|r| u64::from(scene.intersect(&to_ray(r)).1))
+            .sum();
+        sets.push(json!({
+            "rays": name,
+            "count": rays.len(),
+            "mrays_per_s_1_thread": one,
+            "mrays_per_s_all_threads": all,
+            "agreeing_hits": agree,
+            "agreement": agree as f64 / rays.len().max(1) as f64,
+            "nodes_per_ray": visited as f64 / rays.len().max(1) as f64,
+        }));
+    }
+    let baseline = binary_baseline(&desc, &primary, &bounce, args.repeat);
+    let bytes_per_triangle = scene.geometry_bytes() as f64 / stats.triangles as f64;
+    let out = json!({
+        "mesh": args.mesh,
+        "triangles": stats.triangles,
+        "bvh_build_seconds": stats.bvh_seconds,
+        "scene_build_seconds": build_total,
+        "bvh_nodes": stats.bvh_nodes,
+        "bytes_per_triangle": bytes_per_triangle,
+        "threads": threads,
+        "sets": sets,
+        "binary_bvh_baseline": baseline,
+    });
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        println!(
+            "{}: {} triangles, BVH build {:.3} s ({} nodes), {:.0} bytes/triangle",
+            args.mesh, stats.triangles, stats.bvh_seconds, stats.bvh_nodes, bytes_per_triangle
+        );
+        for s in &sets {
+            println!(
+                "  {:<8} {:>8} rays: {:>7.2} Mrays/s (1 thread), {:>7.2} Mrays/s ({threads} threads), {:.1} nodes/ray, hits agreeing with Embree {:.4}%",
+                s["rays"].as_str().unwrap_or(""),
+                s["count"],
+                s["mrays_per_s_1_thread"].as_f64().unwrap_or(0.0),
+                s["mrays_per_s_all_threads"].as_f64().unwrap_or(0.0),
+                s["nodes_per_ray"].as_f64().unwrap_or(0.0),
+                100.0 * s["agreement"].as_f64().unwrap_or(0.0)
+            );
+        }
+    }
+    if !args.json {
+        println!(
+            "  baseline, 1 thread, triangles only: binary BVH build {:.3} s, primary {:.2} / bounce {:.2} Mrays/s; 4-wide build {:.3} s, {:.2} / {:.2} Mrays/s",
+            baseline["binary"]["build_seconds"].as_f64().unwrap_or(0.0),
+            baseline["binary"]["primary"].as_f64().unwrap_or(0.0),
+            baseline["binary"]["bounce"].as_f64().unwrap_or(0.0),
+            baseline["wide"]["build_seconds"].as_f64().unwrap_or(0.0),
+            baseline["wide"]["primary"].as_f64().unwrap_or(0.0),
+            baseline["wide"]["bounce"].as_f64().unwrap_or(0.0),
+        );
+    }
+    let worst = sets
+        .iter()
+        .map(|s| s["agreement"].as_f64().unwrap_or(0.0))
+        .fold(1.0, f64::min);
+    if worst < 0.9999 {
+        bail!(
+            "only {:.4}% of hits agree with Embree's (at least 99.99% expected)",
+            100.0 * worst
+        );
+    }
+    Ok(())
+}
+
+/// The binary BVH against the 4-wide one on the same triangles and rays, one thread, without
+/// the scene around them (closest hit by Möller–Trumbore in a closure): what the wide tree
+/// gains by itself.
+fn binary_baseline(
+    desc: &pathlab_render::desc::SceneDesc,
+    primary: &[FileRay],
+    bounce: &[FileRay],
+    repeat: u32,
+) -> serde_json::Value {
+    use pathlab_render::accel::{Bvh, Bvh4, BvhParams};
+    use pathlab_render::shape::Triangle;
+    let triangles: Vec<Triangle> = desc
+        .meshes
+        .iter()
+        .flat_map(|m| {
+            m.indices.chunks_exact(3).filter_map(move |t| {
+                let p = |k: usize| m.positions.get(t[k] as usize).copied();
+                Some(Triangle {
+                    p: [p(0)?, p(1)?, p(2)?],
+                })
+            })
+        })
+        .collect();
+    let bounds: Vec<_> = triangles.iter().map(|t| t.bounds()).collect();
+    let hit = |i: u32, r: &mut Ray| match triangles[i as usize].intersect(r) {
+        Some(h) => {
+            r.t_max = h.t;
+            true
+        }
+        None => false,
+    };
+    let rate = |rays: &[FileRay], trace: &dyn Fn(&mut Ray) -> bool| {
+        let mut best = 0.0f64;
+        for _ in 0..repeat.max(1) {
+            let start = Instant::now();
+            let hits = rays.iter().filter(|r| trace(&mut to_ray(r))).count();
+            std::hint::black_box(hits);
+            best = best.max(rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6);
+        }
+        best
+    };
+    let start = Instant::now();
+    let binary = Bvh::build(&bounds, BvhParams::default());
+    let binary_build = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let wide = Bvh4::build(&bounds, BvhParams::default());
+    let wide_build = start.elapsed().as_secs_f64();
+    let trace_binary = |r: &mut Ray| binary.intersect(r, hit).0;
+    let trace_wide = |r: &mut Ray| wide.intersect(r, hit).0;
+    json!({
+        "binary": {
+            "build_seconds": binary_build,
+            "primary": rate(primary, &trace_binary),
+            "bounce": rate(bounce, &trace_binary),
+        },
+        "wide": {
+            "build_seconds": wide_build,
+            "primary": rate(primary, &trace_wide),
+            "bounce": rate(bounce, &trace_wide),
+        },
+    })
+}
