@@ -25,6 +25,16 @@ enum BenchWhat {
     /// Trace a ray file (primary and bounce rays with Embree's hit distances) through the BVH of
     /// a mesh: build time, Mrays/s for 1 and all threads, hits checked against Embree's.
     Rays(RaysArgs),
+    /// Write a scene's triangles (world space) as an OBJ file, for tools that read only OBJ.
+    Obj(ObjArgs),
+}
+
+#[derive(Args, Debug)]
+struct ObjArgs {
+    /// The scene.
+    scene: String,
+    /// The OBJ file to write.
+    output: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -151,7 +161,45 @@ fn agreement(rays: &[FileRay], hits: &[f32]) -> usize {
 pub fn run(args: &BenchArgs) -> Result<()> {
     match &args.what {
         BenchWhat::Rays(a) => rays(a),
+        BenchWhat::Obj(a) => export_obj(a),
     }
+}
+
+fn export_obj(args: &ObjArgs) -> Result<()> {
+    use std::io::Write;
+    let desc = pathlab_scene::load(&args.scene)?;
+    let file = std::fs::File::create(&args.output)
+        .with_context(|| format!("cannot create {}", args.output.display()))?;
+    let mut out = std::io::BufWriter::new(file);
+    let (mut base, mut faces) = (1usize, 0usize);
+    for m in &desc.meshes {
+        for p in &m.positions {
+            writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+        }
+        for t in m.indices.chunks_exact(3) {
+            writeln!(
+                out,
+                "f {} {} {}",
+                base + t[0] as usize,
+                base + t[1] as usize,
+                base + t[2] as usize
+            )?;
+            faces += 1;
+        }
+        base += m.positions.len();
+    }
+    out.flush()
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    if desc.spheres.is_empty() {
+        println!("{}: {faces} triangles", args.output.display());
+    } else {
+        println!(
+            "{}: {faces} triangles ({} spheres left out)",
+            args.output.display(),
+            desc.spheres.len()
+        );
+    }
+    Ok(())
 }
 
 fn rays(args: &RaysArgs) -> Result<()> {

@@ -1,5 +1,5 @@
 use super::Sampler;
-use crate::rng::{hash_pixel, hash_words};
+use crate::rng::{hash_pixel, hash_words, mix_bits};
 use glam::Vec2;
 
 /// Largest sample index the Sobol tables cover in one sequence (2^16).
@@ -24,12 +24,13 @@ const SEQUENCE_LENGTH: u32 = 1 << 16;
 ///
 /// Limits: `sobol_burley` covers 2^16 sample indices. Beyond them the sampler switches to a
 /// fresh scramble for each block of 2^16 indices; every sample stays uniform, and the blocks
-/// are independent randomisations. Dimensions are unlimited (padding uses only the first two).
+/// are independent randomisations. Dimensions are unlimited.
 #[derive(Clone, Debug)]
 pub struct SobolSampler {
     samples_per_pixel: u32,
     seed: u64,
-    pixel_seed: u64,
+    /// Hash of the pixel, the seed and the block of 2^16 sample indices.
+    sample_seed: u64,
     sample_index: u32,
     dimension: u32,
 }
@@ -41,17 +42,17 @@ impl SobolSampler {
         SobolSampler {
             samples_per_pixel,
             seed,
-            pixel_seed: hash_pixel([0, 0], seed),
+            sample_seed: hash_pixel([0, 0], seed),
             sample_index: 0,
             dimension: 0,
         }
     }
 
-    /// The scramble seed of the request at `dimension`.
+    /// The scramble seed of the request at `dimension`: one mix of the pixel sample's hash
+    /// (computed once per pixel sample) and the dimension.
     #[inline]
     fn seed_for(&self, dimension: u32) -> u32 {
-        let index_block = self.sample_index / SEQUENCE_LENGTH;
-        hash_words(&[self.pixel_seed, dimension as u64, index_block as u64]) as u32
+        mix_bits(self.sample_seed ^ u64::from(dimension).wrapping_mul(0x9e37_79b9_7f4a_7c15)) as u32
     }
 
     #[inline]
@@ -66,7 +67,8 @@ impl Sampler for SobolSampler {
     }
 
     fn start_pixel_sample(&mut self, pixel: [u32; 2], sample_index: u32, dimension: u32) {
-        self.pixel_seed = hash_pixel(pixel, self.seed);
+        let index_block = u64::from(sample_index / SEQUENCE_LENGTH);
+        self.sample_seed = hash_words(&[hash_pixel(pixel, self.seed), index_block]);
         self.sample_index = sample_index;
         self.dimension = dimension;
     }
@@ -80,11 +82,10 @@ impl Sampler for SobolSampler {
 
     #[inline]
     fn next_2d(&mut self) -> Vec2 {
-        let seed = self.seed_for(self.dimension);
-        let v = Vec2::new(
-            sobol_burley::sample(self.index(), 0, seed),
-            sobol_burley::sample(self.index(), 1, seed),
-        );
+        // Dimensions 0 and 1 of the four `sample_4d` computes together (with SIMD, and one
+        // index shuffle): the same values as two `sample` calls, at about a third of the cost.
+        let [x, y, _, _] = sobol_burley::sample_4d(self.index(), 0, self.seed_for(self.dimension));
+        let v = Vec2::new(x, y);
         self.dimension += 2;
         v
     }

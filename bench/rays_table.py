@@ -1,0 +1,28 @@
+#!/usr/bin/env python3
+"""Table of pathlab / Embree ratios from the files bench/run.sh writes:
+MESH.embree.txt (embree_bench's output) and MESH.pathlab.json (`pathlab bench rays --json`)."""
+import json, re, sys
+
+work, meshes = sys.argv[1], sys.argv[2:]
+rows = []
+print(f"{'mesh':<12} {'tris':>8} | {'build s':>16} {'ratio':>6} | "
+      f"{'primary 1T Mrays/s':>19} {'ratio':>6} | {'bounce 1T Mrays/s':>18} {'ratio':>6} | "
+      f"{'bounce NT':>13} {'ratio':>6} | {'B/tri':>6} {'agree %':>8}")
+for m in meshes:
+    text = open(f"{work}/{m}.embree.txt").read()
+    build = float(re.search(r"build_s ([0-9.]+)", text).group(1))
+    per_thread = {int(t): (float(p), float(b)) for t, p, b in re.findall(
+        r"threads (\d+) primary_Mrays_per_s ([0-9.]+) bounce_Mrays_per_s ([0-9.]+)", text)}
+    e1, en = per_thread[1], per_thread[max(per_thread)]
+    ours = json.load(open(f"{work}/{m}.pathlab.json"))
+    sets = {s["rays"]: s for s in ours["sets"]}
+    p1 = sets["primary"]["mrays_per_s_1_thread"]
+    b1 = sets["bounce"]["mrays_per_s_1_thread"]
+    bn = sets["bounce"]["mrays_per_s_all_threads"]
+    agree = min(s["agreement"] for s in ours["sets"]) * 100
+    print(f"{m:<12} {ours['triangles']:>8} | {ours['bvh_build_seconds']:7.3f}/{build:<8.3f} "
+          f"{ours['bvh_build_seconds'] / build:6.2f} | {p1:8.2f}/{e1[0]:<10.2f} {p1 / e1[0]:6.2f} | "
+          f"{b1:7.2f}/{e1[1]:<10.2f} {b1 / e1[1]:6.2f} | {bn:5.2f}/{en[1]:<7.2f} {bn / en[1]:6.2f} | "
+          f"{ours['bytes_per_triangle']:6.0f} {agree:8.4f}")
+print("(each cell: pathlab/Embree; ratio = pathlab / Embree, so > 1 is faster throughput, "
+      "< 1 is faster build)")

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# pathlab against Embree (BVH build and ray throughput on the same rays) and Mitsuba 3 (render
+# speed and equal-time error on the Cornell box), as ratios measured in one run on one machine.
+# A benchmark, not a test. Needs the project's shared tools (../shared, or PATHLAB_SHARED),
+# network access to Debian's packages and PyPI the first time, and root (or sudo) for apt.
+#
+#   bench/run.sh            # everything
+#   bench/run.sh rays       # Embree only
+#   bench/run.sh render     # Mitsuba only
+#
+# Results go to target/bench/ (JSON per measurement) and a table on stdout.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+shared="${PATHLAB_SHARED:-$root/../shared}"
+work="$root/target/bench"
+what="${1:-all}"
+mkdir -p "$work"
+cd "$root"
+cargo build --release --quiet
+pathlab="$root/target/release/pathlab"
+
+apt_install() {
+    local sudo=""
+    [ "$(id -u)" = 0 ] || sudo="sudo"
+    $sudo apt-get install -y "$@" >/dev/null
+}
+
+if [ "$what" = all ] || [ "$what" = rays ]; then
+    [ -e /usr/include/embree3/rtcore.h ] || apt_install libembree-dev
+    cc -O3 -o "$work/embree_bench" "$shared/tools/embree-bench/embree_bench.c" -lembree3 -lpthread -lm
+    meshes=()
+    for spec in "blob 200000" "blob 1000000" "soup 100000"; do
+        set -- $spec
+        name="$1$(( $2 / 1000 ))k"
+        [ -e "$work/$name.obj" ] || python3 "$shared/tools/meshgen.py" "$1" "$2" "$work/$name.obj" >/dev/null
+        meshes+=("$name")
+    done
+    for scene in maxplanck CBbunny; do
+        [ -e "$work/$scene.obj" ] || "$pathlab" bench obj "$root/crates/scene/tests/data/cs184/$scene.dae" "$work/$scene.obj" >/dev/null
+        meshes+=("$scene")
+    done
+    threads="$(nproc)"
+    for m in "${meshes[@]}"; do
+        "$work/embree_bench" "$work/$m.obj" "$threads" "$work/$m.rays" > "$work/$m.embree.txt"
+        "$pathlab" bench rays "$work/$m.obj" "$work/$m.rays" --json > "$work/$m.pathlab.json"
+    done
+    python3 "$root/bench/rays_table.py" "$work" "${meshes[@]}"
+fi
+
+if [ "$what" = all ] || [ "$what" = render ]; then
+    venv="$work/venv"
+    [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+    "$venv/bin/python" -c "import mitsuba, numpy" 2>/dev/null || "$venv/bin/pip" install --quiet mitsuba numpy
+    llvm="$(ls /usr/lib/x86_64-linux-gnu/libLLVM-19.so 2>/dev/null || true)"
+    if [ -z "$llvm" ]; then
+        apt_install libllvm19 || true
+        llvm="$(ls /usr/lib/x86_64-linux-gnu/libLLVM-19.so 2>/dev/null || true)"
+    fi
+    DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/mitsuba_bench.py" \
+        --pathlab "$pathlab" --scene "$root/crates/scene/tests/data/cornell-box/scene.xml" \
+        --reference "$root/crates/scene/tests/data/cornell-box/mean-maxdepth-inf.exr" \
+        --work "$work"
+fi
