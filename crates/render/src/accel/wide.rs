@@ -11,7 +11,7 @@
 //! The traversal takes the primitive test as a closure, as [`super::Bvh`] does, so the same
 //! structure serves triangles and spheres.
 
-use super::bvh::BvhParams;
+use super::bvh::{partition, BvhParams};
 use crate::geometry::{Aabb, Ray};
 use glam::Vec3;
 
@@ -617,46 +617,11 @@ fn find_split(
     best
 }
 
-/// Moves the elements satisfying `pred` to the front; returns how many there are.
-fn partition<T>(v: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
-    let mut i = 0;
-    for j in 0..v.len() {
-        if pred(&v[j]) {
-            v.swap(i, j);
-            i += 1;
-        }
-    }
-    i
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::test_util::{box_hit, random_boxes};
     use super::*;
     use pathlab_mc::rng::Pcg32;
-
-    fn random_boxes(n: usize, seed: u64) -> Vec<Aabb> {
-        let mut rng = Pcg32::new(seed, 1);
-        (0..n)
-            .map(|_| {
-                let c = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 10.0;
-                let e = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 0.3;
-                Aabb {
-                    min: c - e,
-                    max: c + e,
-                }
-            })
-            .collect()
-    }
-
-    fn box_hit(boxes: &[Aabb]) -> impl Fn(u32, &mut Ray) -> bool + '_ {
-        move |i, ray: &mut Ray| match boxes[i as usize].hit(ray.o, ray.d.recip(), ray.t_max) {
-            Some(t) if t > 0.0 && t < ray.t_max => {
-                ray.t_max = t;
-                true
-            }
-            _ => false,
-        }
-    }
 
     #[test]
     fn finds_the_same_nearest_hit_as_brute_force() {

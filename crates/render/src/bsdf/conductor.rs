@@ -63,13 +63,7 @@ impl Conductor {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| LocalSample {
-            f: self.f(wo, wi),
-            wi,
-            pdf,
-            delta: false,
-        })
+        LocalSample::evaluated(wi, self.pdf(wo, wi), || self.f(wo, wi))
     }
 
     /// Density of [`Conductor::sample`]: pdf(wm) / (4 wo·wm).

@@ -82,13 +82,7 @@ impl Plastic {
             return specular_reflection(wo, Rgb::splat(f_o), p_spec);
         }
         let wi = sample_cosine_hemisphere(u);
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| LocalSample {
-            f: self.f(wo, wi),
-            wi,
-            pdf,
-            delta: false,
-        })
+        LocalSample::evaluated(wi, self.pdf(wo, wi), || self.f(wo, wi))
     }
 
     /// Density of the non-delta part of [`Plastic::sample`].

@@ -93,13 +93,7 @@ impl RoughDielectric {
         if (wi.z * wo.z > 0.0) != reflection || wi.z == 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| LocalSample {
-            f: self.f(wo, wi),
-            wi,
-            pdf,
-            delta: false,
-        })
+        LocalSample::evaluated(wi, self.pdf(wo, wi), || self.f(wo, wi))
     }
 
     /// Density of [`RoughDielectric::sample`].
