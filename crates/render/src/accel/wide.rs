@@ -71,6 +71,11 @@ pub struct Node4 {
     hi: [[f32; 4]; 3],
     /// Child words.
     child: [u32; 4],
+    /// Bit per lane that holds a child. Empty lanes have inverted boxes, which no ray with
+    /// finite parameters enters; a ray with infinite or NaN parameters can make the slab test
+    /// pass for them (NaN bounds are ignored so that the test stays conservative), so the
+    /// traversal masks them out.
+    valid: u32,
 }
 
 impl Node4 {
@@ -78,6 +83,7 @@ impl Node4 {
         lo: [[f32::INFINITY; 4]; 3],
         hi: [[f32::NEG_INFINITY; 4]; 3],
         child: [EMPTY_LANE; 4],
+        valid: 0,
     };
 
     fn set_bounds(&mut self, lane: usize, b: &Aabb) {
@@ -183,7 +189,7 @@ impl RayBoxes {
         for lane in 0..4 {
             mask |= u32::from(t_near[lane] <= t_far[lane]) << lane;
         }
-        (t_near, mask)
+        (t_near, mask & n.valid)
     }
 }
 
@@ -237,6 +243,7 @@ impl Bvh4 {
 
     fn set_lane(&mut self, node: &mut Node4, lane: usize, child: &BuildNode, depth: usize) {
         node.set_bounds(lane, child.bounds());
+        node.valid |= 1 << lane;
         node.child[lane] = match child {
             BuildNode::Leaf { start, count, .. } => leaf_word(*start, *count),
             BuildNode::Inner { .. } => self.collapse(child, depth + 1) as u32,
@@ -657,6 +664,35 @@ mod tests {
                 });
                 assert_eq!(occluded, any_brute);
             }
+        }
+    }
+
+    #[test]
+    fn rays_with_infinite_or_nan_parameters_never_reach_empty_lanes() {
+        // Five boxes leave empty lanes; infinite and NaN origins and directions make the slab
+        // test's products NaN, which must not open those lanes.
+        let boxes = random_boxes(5, 8);
+        let bvh = Bvh4::build(&boxes, BvhParams::default());
+        let (inf, nan) = (f32::INFINITY, f32::NAN);
+        for (o, d) in [
+            (Vec3::splat(inf), Vec3::X),
+            (Vec3::new(1.0, inf, -inf), Vec3::new(0.0, 1.0, 0.0)),
+            (Vec3::ZERO, Vec3::new(inf, 0.0, 0.0)),
+            (Vec3::ZERO, Vec3::ZERO),
+            (Vec3::splat(nan), Vec3::Y),
+            (Vec3::ONE, Vec3::new(nan, 1.0, 0.0)),
+            (Vec3::splat(1e38), Vec3::splat(-1e38)),
+        ] {
+            let mut ray = Ray::new(o, d);
+            let (any, _) = bvh.intersect(&mut ray, |i, _| {
+                assert!((i as usize) < boxes.len());
+                false
+            });
+            assert!(!any);
+            assert!(!bvh.occluded(&Ray::new(o, d), |i, _| {
+                assert!((i as usize) < boxes.len());
+                false
+            }));
         }
     }
 
