@@ -8,6 +8,7 @@ use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
 use pathlab_scene::collada;
 use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -154,7 +155,9 @@ const MANGLED: [&str; 10] = [
 ];
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 200, failure_persistence: None, ..ProptestConfig::default() })]
+    // Fixed seeds: the suite tests the same cases on every run (a new seed explores others;
+    // set it here to look further).
+    #![proptest_config(ProptestConfig { cases: 200, failure_persistence: None, rng_seed: RngSeed::Fixed(0x5eed_0001), ..ProptestConfig::default() })]
 
     #[test]
     fn truncated(which in 0usize..3, cut in 0.0f64..1.0) {
@@ -202,7 +205,7 @@ fn ply_square() -> Vec<u8> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 100, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 100, failure_persistence: None, rng_seed: RngSeed::Fixed(0x5eed_0002), ..ProptestConfig::default() })]
 
     #[test]
     fn ply_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6)) {
