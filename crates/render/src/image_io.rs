@@ -98,15 +98,9 @@ pub fn read_exr_rgb(path: &Path) -> std::result::Result<(u32, u32, Vec<Rgb>), Im
     Ok((w as u32, h as u32, px))
 }
 
-/// Reads an image as linear RGB: (width, height, pixels row-major from the top). OpenEXR and
-/// Radiance HDR are linear already; 8- and 16-bit formats (PNG, JPEG) are sRGB-encoded colour
-/// and are decoded to linear.
-pub fn read_linear_rgb(path: &Path) -> std::result::Result<(u32, u32, Vec<Rgb>), ImageError> {
-    read_rgb(path, true)
-}
-
-/// Reads an image's RGB values: as [`read_linear_rgb`], but 8- and 16-bit values are decoded
-/// from sRGB only when `decode_srgb` (otherwise they are taken as they are, scaled to [0, 1]).
+/// Reads an image's RGB values: (width, height, pixels row-major from the top). OpenEXR and
+/// Radiance HDR are linear already; 8- and 16-bit formats (PNG, JPEG) are sRGB-encoded colour,
+/// decoded to linear when `decode_srgb` (otherwise taken as they are, scaled to [0, 1]).
 pub fn read_rgb(
     path: &Path,
     decode_srgb: bool,

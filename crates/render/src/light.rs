@@ -153,8 +153,7 @@ impl Light {
                     Rgb::ZERO
                 }
             }
-            Light::Environment { radiance, .. } => radiance,
-            Light::EnvironmentMap { ref map, .. } => map.eval(w),
+            Light::Environment { .. } | Light::EnvironmentMap { .. } => self.le_environment(w),
             Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => Rgb::ZERO,
         }
     }

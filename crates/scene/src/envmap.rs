@@ -3,20 +3,14 @@
 use crate::Error;
 use glam::Mat3;
 use pathlab_render::desc::EnvironmentMapDesc;
-use pathlab_render::image_io::{read_linear_rgb, ImageError};
 use std::path::Path;
 use std::sync::Arc;
 
 /// Reads the image at `path` as an environment map rotated by `to_world` and scaled by
 /// `scale`.
 pub fn load(path: &Path, to_world: Mat3, scale: f32) -> Result<EnvironmentMapDesc, Error> {
-    let (w, h, texels) = read_linear_rgb(path).map_err(|e| Error::Io {
-        path: path.display().to_string(),
-        message: match e {
-            ImageError::Exr { message, .. } | ImageError::Decode { message, .. } => message,
-            other => other.to_string(),
-        },
-    })?;
+    // 8-bit images are sRGB-encoded: decode them to linear radiance.
+    let (w, h, texels) = crate::texture::read_image(path, true)?;
     if w < 2 || h < 3 {
         return Err(Error::Parse {
             path: path.display().to_string(),

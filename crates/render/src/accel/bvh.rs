@@ -341,9 +341,8 @@ pub(super) fn partition<T>(v: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_util::{box_hit, random_boxes};
+    use super::super::test_util::{check_against_brute_force, random_boxes};
     use super::*;
-    use pathlab_mc::rng::Pcg32;
 
     #[test]
     fn finds_the_same_nearest_hit_as_brute_force() {
@@ -352,29 +351,13 @@ mod tests {
         let mut seen: Vec<u32> = bvh.primitive_indices().to_vec();
         seen.sort();
         assert_eq!(seen, (0..2000).collect::<Vec<u32>>());
-        let mut rng = Pcg32::new(4, 4);
-        for _ in 0..2000 {
-            let o = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 14.0 - 2.0;
-            let d = Vec3::new(
-                rng.uniform_f32() - 0.5,
-                rng.uniform_f32() - 0.5,
-                rng.uniform_f32() - 0.5,
-            );
-            let mut brute = Ray::new(o, d);
-            let f = box_hit(&boxes);
-            let any_brute = (0..boxes.len() as u32).fold(false, |a, i| f(i, &mut brute) | a);
-            let mut ray = Ray::new(o, d);
-            let (any, visited) = bvh.intersect(&mut ray, box_hit(&boxes));
-            assert_eq!(any, any_brute);
-            assert_eq!(ray.t_max, brute.t_max);
-            assert!(visited >= 1);
-            let occluded = bvh.occluded(&Ray::new(o, d), |i, r| {
-                boxes[i as usize]
-                    .hit(r.o, r.d.recip(), r.t_max)
-                    .is_some_and(|t| t > 0.0)
-            });
-            assert_eq!(occluded, any_brute);
-        }
+        check_against_brute_force(
+            &boxes,
+            2000,
+            (4, 4),
+            |r, h| bvh.intersect(r, h),
+            |r, h| bvh.occluded(r, h),
+        );
     }
 
     #[test]

@@ -30,6 +30,40 @@ mod test_util {
             .collect()
     }
 
+    /// Checks a BVH's closest-hit and any-hit traversals against testing every box, for
+    /// `count` random rays from PCG32 stream (`seed`, `stream`).
+    pub fn check_against_brute_force(
+        boxes: &[Aabb],
+        count: usize,
+        (seed, stream): (u64, u64),
+        intersect: impl Fn(&mut Ray, &dyn Fn(u32, &mut Ray) -> bool) -> (bool, u32),
+        occluded: impl Fn(&Ray, &dyn Fn(u32, &Ray) -> bool) -> bool,
+    ) {
+        let mut rng = Pcg32::new(seed, stream);
+        let hit = box_hit(boxes);
+        for _ in 0..count {
+            let o = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 14.0 - 2.0;
+            let d = Vec3::new(
+                rng.uniform_f32() - 0.5,
+                rng.uniform_f32() - 0.5,
+                rng.uniform_f32() - 0.5,
+            );
+            let mut brute = Ray::new(o, d);
+            let any_brute = (0..boxes.len() as u32).fold(false, |a, i| hit(i, &mut brute) | a);
+            let mut ray = Ray::new(o, d);
+            let (any, visited) = intersect(&mut ray, &hit);
+            assert_eq!(any, any_brute);
+            assert_eq!(ray.t_max, brute.t_max);
+            assert!(visited >= 1);
+            let blocked = occluded(&Ray::new(o, d), &|i, r| {
+                boxes[i as usize]
+                    .hit(r.o, r.d.recip(), r.t_max)
+                    .is_some_and(|t| t > 0.0)
+            });
+            assert_eq!(blocked, any_brute);
+        }
+    }
+
     /// Ray-box "primitive": a hit at the box's entry distance.
     pub fn box_hit(boxes: &[Aabb]) -> impl Fn(u32, &mut Ray) -> bool + '_ {
         move |i, ray: &mut Ray| match boxes[i as usize].hit(ray.o, ray.d.recip(), ray.t_max) {

@@ -168,6 +168,15 @@ impl Material {
     }
 }
 
+/// A description's index of refraction, or glass's 1.5 where it is not a positive number.
+fn usable_ior(ior: f32) -> f32 {
+    if ior > 0.0 && ior.is_finite() {
+        ior
+    } else {
+        1.5
+    }
+}
+
 /// Roughness below which a microfacet model is drawn as its smooth (delta) limit.
 const SMOOTH_ALPHA: f32 = 1e-4;
 
@@ -206,11 +215,7 @@ impl From<&MaterialDesc> for Material {
                 distribution,
                 fresnel,
             } => {
-                let eta = if ior > 0.0 && ior.is_finite() {
-                    ior
-                } else {
-                    1.5
-                };
+                let eta = usable_ior(ior);
                 let bxdf = if roughness > SMOOTH_ALPHA {
                     Bxdf::RoughDielectric(RoughDielectric {
                         eta,
@@ -250,11 +255,7 @@ impl From<&MaterialDesc> for Material {
             } => Material::new(
                 Bxdf::Plastic(Plastic::new(
                     diffuse.clamp(Vec3::ZERO, Vec3::ONE),
-                    if ior > 0.0 && ior.is_finite() {
-                        ior
-                    } else {
-                        1.5
-                    },
+                    usable_ior(ior),
                     nonlinear,
                 )),
                 false,

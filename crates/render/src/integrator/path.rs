@@ -69,10 +69,11 @@ impl Integrator for PathIntegrator {
     ) -> Rgb {
         let mut l = Rgb::ZERO;
         let mut beta = Rgb::ONE;
+        let n_light = self.light_samples.max(1);
         // MIS weight of emission found by a BSDF-sampled direction of density `pdf_bsdf`
         // (infinite after a delta bounce) that light sampling would find with `pdf_light`.
         let bsdf_weight = |pdf_bsdf: f32, pdf_light: f32| match self.lighting {
-            PathLighting::Mis => power_heuristic(1, pdf_bsdf, self.light_samples.max(1), pdf_light),
+            PathLighting::Mis => power_heuristic(1, pdf_bsdf, n_light, pdf_light),
             PathLighting::Bsdf => 1.0,
             PathLighting::Light => {
                 if pdf_bsdf.is_infinite() {
@@ -84,7 +85,6 @@ impl Integrator for PathIntegrator {
         };
         let bsdf_samples = u32::from(self.lighting == PathLighting::Mis);
         let wants = |bounce: u32| self.only_bounce.is_none_or(|k| k == bounce);
-        let n_light = self.light_samples.max(1);
         // The previous vertex and the BSDF density of the direction that left it (infinite
         // for a delta lobe, which gives emission found through it MIS weight one).
         let mut prev: Option<(glam::Vec3, f32)> = None;
