@@ -6,7 +6,7 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use glam::{Vec2, Vec3};
 use pathlab_mc::rng::Pcg32;
 use pathlab_mc::sampler::{AnySampler, Sampler, SamplerKind};
-use pathlab_render::accel::{Bvh, Bvh4, BvhParams};
+use pathlab_render::accel::{Bvh, Bvh4, BvhParams, TriBlock};
 use pathlab_render::bsdf::{Bxdf, Conductor, Microfacet, NormalDistribution, RoughDielectric};
 use pathlab_render::geometry::Ray;
 use pathlab_render::shape::Triangle;
@@ -96,6 +96,10 @@ fn traversal(c: &mut Criterion) {
         Vec3::new(0.0, 0.0, 3.0),
         (tri.p[0] - Vec3::new(0.0, 0.0, 3.0)).normalize(),
     );
+    let block = TriBlock::new(&tris[12344..12348]);
+    c.bench_function("ray against a block of 4 triangles", |b| {
+        b.iter(|| black_box(&block).intersect(black_box(&ray), 0b1111))
+    });
     c.bench_function("ray-triangle test", |b| {
         b.iter(|| black_box(&tri).intersect(black_box(&ray)))
     });

@@ -53,6 +53,8 @@ pub mod progressive;
 pub mod render;
 pub mod scene;
 pub mod shape;
+#[cfg(target_arch = "x86_64")]
+pub mod simd;
 pub mod texture;
 
 pub use pathlab_mc as mc;

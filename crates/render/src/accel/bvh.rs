@@ -19,6 +19,9 @@ pub struct BvhParams {
     pub bins: usize,
     /// Cost of a traversal step relative to one primitive test.
     pub traversal_cost: f32,
+    /// Primitives a leaf test handles together (the 4-wide tree's SAH counts a leaf's cost in
+    /// blocks of this many; 1 counts primitives, as the binary tree always does).
+    pub leaf_block: usize,
 }
 
 impl Default for BvhParams {
@@ -27,6 +30,7 @@ impl Default for BvhParams {
             max_leaf_size: 4,
             bins: 16,
             traversal_cost: 1.0,
+            leaf_block: 1,
         }
     }
 }

@@ -3,10 +3,12 @@
 //! binary [`Bvh`] stays as the baseline it is measured against.
 
 mod bvh;
+mod tri_block;
 mod wide;
 
 pub use bvh::{Bvh, BvhNode, BvhParams};
-pub use wide::{Bvh4, MAX_PRIMITIVES};
+pub use tri_block::{BlockHit, TriBlock, LANES};
+pub use wide::{BoxTest, Bvh4, Bvh8, Node, Portable, WideBvh, MAX_PRIMITIVES};
 
 /// Test helpers shared by the BVHs' tests: random boxes as primitives.
 #[cfg(test)]

@@ -1,10 +1,11 @@
-//! A 4-wide bounding volume hierarchy: each node holds the boxes of up to four children in
-//! structure-of-arrays form, so that one ray is tested against all four with the same
-//! instructions (the compiler turns the loops over the four lanes into SIMD), and the hit
-//! children are visited nearest first.
+//! Wide bounding volume hierarchies ([`Bvh4`], [`Bvh8`]): each node holds the boxes of up to
+//! four or eight children in structure-of-arrays form, so that one ray is tested against all of
+//! them with the same instructions (the compiler turns the loops over the lanes into SIMD: four
+//! lanes fill an SSE register, eight an AVX one), and the hit children are visited nearest
+//! first.
 //!
 //! Built in two steps: a binary tree by the binned surface area heuristic (subtrees built in
-//! parallel with rayon, no allocation per binning step), then collapsed into 4-wide nodes by
+//! parallel with rayon, no allocation per binning step), then collapsed into wide nodes by
 //! repeatedly opening the child of largest surface area (Wald et al., "Getting Rid of Packets",
 //! 2008; the same construction as Embree's BVH4 from a binary SAH tree).
 //!
@@ -14,6 +15,7 @@
 use super::bvh::{partition, BvhParams};
 use crate::geometry::{Aabb, Ray};
 use glam::Vec3;
+use std::mem::MaybeUninit;
 
 /// Number of SAH bins per axis (fixed, so that binning needs no allocation).
 const BINS: usize = 16;
@@ -22,14 +24,10 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// Depth of the binary tree from which splits are at the median: below it, at most 32 more
 /// levels for up to 2^32 primitives.
 const MEDIAN_DEPTH: usize = 32;
-/// Traversal stack entries: the binary tree is at most 64 levels deep, the 4-wide tree made
-/// from it no deeper, and each level leaves at most three siblings on the stack.
-const STACK_SIZE: usize = 3 * 64 + 4;
-/// Trees at most this deep (nearly all) are traversed with a smaller stack, which is cheaper
-/// to set up for every ray.
-const SHALLOW_DEPTH: usize = 20;
-/// The stack of a shallow tree.
-const SHALLOW_STACK: usize = 3 * SHALLOW_DEPTH + 4;
+/// Traversal stack entries for any tree: the binary tree is at most 64 levels deep, the wide
+/// tree made from it no deeper, and each level leaves at most seven siblings on the stack.
+/// (The stack is not initialised, so its size costs nothing per ray.)
+const STACK_SIZE: usize = 7 * 64 + 8;
 /// Relative widening of the far distance of a box test, so that rounding never culls a box
 /// the ray touches (pbrt-v4's 1 + 2γ₃).
 const FAR_SCALE: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON * 0.5 / (1.0 - 3.0 * f32::EPSILON * 0.5);
@@ -60,17 +58,17 @@ fn leaf_range(word: u32) -> (u32, u32) {
     )
 }
 
-/// One node: four children's boxes (lanes), each an inner node (the child word is the node
+/// One node: `W` children's boxes (lanes), each an inner node (the child word is the node
 /// index), a leaf (the word has [`LEAF`] set), or empty (an inverted box).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub struct Node4 {
-    /// Lower corners: `lo[axis][lane]`.
-    lo: [[f32; 4]; 3],
-    /// Upper corners: `hi[axis][lane]`.
-    hi: [[f32; 4]; 3],
+pub struct Node<const W: usize> {
+    /// The lanes' slabs: `planes[k][lane]` is the lower corner's coordinate on axis `k` for
+    /// `k < 3` and the upper corner's on axis `k - 3` otherwise, so that a ray picks its near
+    /// and far planes by index (from the signs of its direction) rather than by branching.
+    planes: [[f32; W]; 6],
     /// Child words.
-    child: [u32; 4],
+    child: [u32; W],
     /// Bit per lane that holds a child. Empty lanes have inverted boxes, which no ray with
     /// finite parameters enters; a ray with infinite or NaN parameters can make the slab test
     /// pass for them (NaN bounds are ignored so that the test stays conservative), so the
@@ -78,39 +76,69 @@ pub struct Node4 {
     valid: u32,
 }
 
-impl Node4 {
-    const EMPTY: Node4 = Node4 {
-        lo: [[f32::INFINITY; 4]; 3],
-        hi: [[f32::NEG_INFINITY; 4]; 3],
-        child: [EMPTY_LANE; 4],
+impl<const W: usize> Node<W> {
+    const EMPTY: Node<W> = Node {
+        planes: [
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+        ],
+        child: [EMPTY_LANE; W],
         valid: 0,
     };
 
     fn set_bounds(&mut self, lane: usize, b: &Aabb) {
         for axis in 0..3 {
-            self.lo[axis][lane] = b.min[axis];
-            self.hi[axis][lane] = b.max[axis];
+            self.planes[axis][lane] = b.min[axis];
+            self.planes[axis + 3][lane] = b.max[axis];
         }
     }
 
     #[cfg(test)]
     fn bounds(&self, lane: usize) -> Aabb {
         Aabb {
-            min: Vec3::new(self.lo[0][lane], self.lo[1][lane], self.lo[2][lane]),
-            max: Vec3::new(self.hi[0][lane], self.hi[1][lane], self.hi[2][lane]),
+            min: Vec3::new(
+                self.planes[0][lane],
+                self.planes[1][lane],
+                self.planes[2][lane],
+            ),
+            max: Vec3::new(
+                self.planes[3][lane],
+                self.planes[4][lane],
+                self.planes[5][lane],
+            ),
         }
     }
 }
 
-/// A 4-wide BVH over primitives given by their bounding boxes.
-#[derive(Clone, Debug, Default)]
-pub struct Bvh4 {
-    nodes: Vec<Node4>,
-    /// Levels of 4-wide nodes on the longest path from the root.
+/// A BVH of width `W` (4 or 8) over primitives given by their bounding boxes.
+#[derive(Clone, Debug)]
+pub struct WideBvh<const W: usize> {
+    nodes: Vec<Node<W>>,
+    /// Levels of wide nodes on the longest path from the root.
     depth: usize,
     /// Primitive indices in leaf order.
     prim_indices: Vec<u32>,
     bounds: Aabb,
+}
+
+/// Four children per node: one SSE register per plane.
+pub type Bvh4 = WideBvh<4>;
+/// Eight children per node: one AVX register per plane.
+pub type Bvh8 = WideBvh<8>;
+
+impl<const W: usize> Default for WideBvh<W> {
+    fn default() -> Self {
+        WideBvh {
+            nodes: Vec::new(),
+            depth: 0,
+            prim_indices: Vec::new(),
+            bounds: Aabb::EMPTY,
+        }
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -142,40 +170,43 @@ impl BuildNode {
 }
 
 /// The ray quantities every box test uses.
-struct RayBoxes {
-    o: Vec3,
-    inv_d: Vec3,
+#[doc(hidden)]
+pub struct RayBoxes {
+    o: [f32; 3],
+    inv_d: [f32; 3],
     /// `inv_d` widened by [`FAR_SCALE`], for far planes.
-    inv_far: Vec3,
-    /// Whether each direction component is negative (the near plane is then the upper one).
-    neg: [bool; 3],
+    inv_far: [f32; 3],
+    /// Per axis, the index in [`Node::planes`] of the plane the ray enters by (the upper one
+    /// when the direction is negative) and of the one it leaves by.
+    near: [usize; 3],
+    far: [usize; 3],
 }
 
 impl RayBoxes {
+    #[inline(always)]
     fn new(ray: &Ray) -> Self {
         let inv_d = ray.d.recip();
+        let near = [0, 1, 2].map(|axis| if inv_d[axis] < 0.0 { axis + 3 } else { axis });
         RayBoxes {
-            o: ray.o,
-            inv_d,
-            inv_far: inv_d * FAR_SCALE,
-            neg: [inv_d.x < 0.0, inv_d.y < 0.0, inv_d.z < 0.0],
+            o: ray.o.to_array(),
+            inv_d: inv_d.to_array(),
+            inv_far: (inv_d * FAR_SCALE).to_array(),
+            near,
+            far: near.map(|k| if k < 3 { k + 3 } else { k - 3 }),
         }
     }
 
     /// Entry distances of the four lanes and the mask (bit per lane) of those the ray meets
     /// within (0, t_max).
     #[inline(always)]
-    fn test(&self, n: &Node4, t_max: f32) -> ([f32; 4], u32) {
-        let mut t_near = [0.0f32; 4];
-        let mut t_far = [t_max; 4];
+    fn test<const W: usize>(&self, n: &Node<W>, t_max: f32) -> ([f32; W], u32) {
+        let mut t_near = [0.0f32; W];
+        let mut t_far = [t_max; W];
         for axis in 0..3 {
-            let (near, far) = if self.neg[axis] {
-                (&n.hi[axis], &n.lo[axis])
-            } else {
-                (&n.lo[axis], &n.hi[axis])
-            };
+            let near = &n.planes[self.near[axis]];
+            let far = &n.planes[self.far[axis]];
             let (o, inv, inv_far) = (self.o[axis], self.inv_d[axis], self.inv_far[axis]);
-            for lane in 0..4 {
+            for lane in 0..W {
                 // Comparisons rather than f32::max/min: they compile to single SIMD min/max
                 // instructions, and a NaN (0 · ∞ for a ray in a box's plane) leaves the
                 // running value unchanged, which keeps the test conservative.
@@ -186,22 +217,157 @@ impl RayBoxes {
             }
         }
         let mut mask = 0u32;
-        for lane in 0..4 {
+        for lane in 0..W {
             mask |= u32::from(t_near[lane] <= t_far[lane]) << lane;
         }
         (t_near, mask & n.valid)
     }
 }
 
-impl Bvh4 {
+/// How a traversal tests a ray against a node's `W` boxes: [`Portable`] on any CPU, or with
+/// the instructions a CPU extension offers (on x86-64, [`crate::simd::Avx2`] for eight lanes).
+/// Every implementation gives the same entry distances and mask.
+pub trait BoxTest<const W: usize>: Copy {
+    /// Entry distances of the lanes and the mask of those `ray` meets within `(0, t_max)`.
+    #[doc(hidden)]
+    fn test(self, ray: &RayBoxes, node: &Node<W>, t_max: f32) -> ([f32; W], u32);
+}
+
+/// The box test written as loops over lanes, which the compiler vectorises for the target's
+/// baseline instructions.
+#[derive(Clone, Copy, Debug)]
+pub struct Portable;
+
+impl<const W: usize> BoxTest<W> for Portable {
+    #[inline(always)]
+    fn test(self, ray: &RayBoxes, node: &Node<W>, t_max: f32) -> ([f32; W], u32) {
+        ray.test(node, t_max)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl BoxTest<8> for crate::simd::Avx2 {
+    #[inline(always)]
+    fn test(self, ray: &RayBoxes, node: &Node<8>, t_max: f32) -> ([f32; 8], u32) {
+        // SAFETY: `self` exists only where the CPU has AVX2 and FMA, all that
+        // `test8_avx2` requires.
+        unsafe { test8_avx2(ray, node, t_max) }
+    }
+}
+
+/// [`RayBoxes::test`] for eight lanes in AVX registers: the same operations in the same order
+/// (`max`/`min` keep their second operand when the first is NaN, as the portable comparisons
+/// do), so the results are identical.
+///
+/// # Safety
+///
+/// The CPU must have AVX. (Not a `#[target_feature]` function, so that it can be inlined
+/// into its callers, which are.)
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn test8_avx2(ray: &RayBoxes, n: &Node<8>, t_max: f32) -> ([f32; 8], u32) {
+    use std::arch::x86_64::*;
+    // SAFETY: the caller guarantees AVX; the loads and the store go through pointers to
+    // `[f32; 8]`, valid for exactly the 32 bytes each moves.
+    unsafe {
+        let mut t_near = _mm256_setzero_ps();
+        let mut t_far = _mm256_set1_ps(t_max);
+        for axis in 0..3 {
+            let o = _mm256_set1_ps(ray.o[axis]);
+            let near = _mm256_loadu_ps(n.planes[ray.near[axis]].as_ptr());
+            let far = _mm256_loadu_ps(n.planes[ray.far[axis]].as_ptr());
+            let tn = _mm256_mul_ps(_mm256_sub_ps(near, o), _mm256_set1_ps(ray.inv_d[axis]));
+            let tf = _mm256_mul_ps(_mm256_sub_ps(far, o), _mm256_set1_ps(ray.inv_far[axis]));
+            t_near = _mm256_max_ps(tn, t_near);
+            t_far = _mm256_min_ps(tf, t_far);
+        }
+        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32;
+        let mut out = [0.0f32; 8];
+        _mm256_storeu_ps(out.as_mut_ptr(), t_near);
+        (out, mask & n.valid)
+    }
+}
+
+/// A stack of at most `N` entries whose storage is left uninitialised until pushed to, so
+/// that setting one up for every ray costs nothing. Pushing past `N` panics.
+struct Stack<T: Copy, const N: usize> {
+    items: [MaybeUninit<T>; N],
+    /// Entries `items[..len]` have been written.
+    len: usize,
+}
+
+impl<T: Copy + Ord, const N: usize> Stack<T, N> {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack {
+            items: [const { MaybeUninit::uninit() }; N],
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    #[inline(always)]
+    fn push(&mut self, item: T) {
+        self.items[self.len].write(item);
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<T> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: `items[..len]` were written (invariant), and `len` was above this index.
+        Some(unsafe { self.items[self.len].assume_init() })
+    }
+
+    /// Sorts the entries from `base` to the top, largest deepest, by insertion (few entries).
+    #[inline(always)]
+    fn sort_descending_from(&mut self, base: usize) {
+        // SAFETY: every index read is below `len`, so written (invariant).
+        let at = |items: &[MaybeUninit<T>; N], i: usize| unsafe { items[i].assume_init() };
+        for i in base + 1..self.len {
+            let e = at(&self.items, i);
+            let mut j = i;
+            while j > base && at(&self.items, j - 1) < e {
+                let moved = at(&self.items, j - 1);
+                self.items[j].write(moved);
+                j -= 1;
+            }
+            self.items[j].write(e);
+        }
+    }
+}
+
+/// A traversal stack entry: a child's entry distance (high half) and word (low half). Entry
+/// distances are non-negative, so entries order as their distances do.
+#[inline(always)]
+fn stack_entry(word: u32, t: f32) -> u64 {
+    (u64::from(t.to_bits()) << 32) | u64::from(word)
+}
+
+/// `(min, max)` of two stack entries, without branches.
+#[inline(always)]
+fn order(a: u64, b: u64) -> (u64, u64) {
+    (a.min(b), a.max(b))
+}
+
+impl<const W: usize> WideBvh<W> {
     /// Builds the tree over `bounds` (primitive `i` has box `bounds[i]`); primitives with an
     /// empty or non-finite box are left out. Uses `params.max_leaf_size` (at most 16),
-    /// `params.traversal_cost` (relative to one primitive test) and 16 bins. At most
+    /// `params.traversal_cost` (relative to one leaf block test), `params.leaf_block` and 16
+    /// bins. At most
     /// [`MAX_PRIMITIVES`] primitives: the caller checks.
-    pub fn build(bounds: &[Aabb], params: BvhParams) -> Bvh4 {
+    pub fn build(bounds: &[Aabb], params: BvhParams) -> WideBvh<W> {
+        assert!(W == 4 || W == 8, "wide BVHs have 4 or 8 lanes");
         assert!(
             bounds.len() <= MAX_PRIMITIVES,
-            "too many primitives for a Bvh4"
+            "too many primitives for a wide BVH"
         );
         let params = BvhParams {
             max_leaf_size: params.max_leaf_size.clamp(1, MAX_LEAF),
@@ -218,10 +384,10 @@ impl Bvh4 {
             })
             .collect();
         if prims.is_empty() {
-            return Bvh4::default();
+            return WideBvh::default();
         }
         let root = build_binary(&mut prims, 0, &params, 0);
-        let mut bvh = Bvh4 {
+        let mut bvh = WideBvh {
             nodes: Vec::with_capacity(prims.len() / 2 + 1),
             depth: 0,
             prim_indices: prims.iter().map(|p| p.index).collect(),
@@ -229,7 +395,7 @@ impl Bvh4 {
         };
         match &root {
             BuildNode::Leaf { .. } => {
-                let mut node = Node4::EMPTY;
+                let mut node = Node::EMPTY;
                 bvh.set_lane(&mut node, 0, &root, 1);
                 bvh.depth = 1;
                 bvh.nodes.push(node);
@@ -241,7 +407,7 @@ impl Bvh4 {
         bvh
     }
 
-    fn set_lane(&mut self, node: &mut Node4, lane: usize, child: &BuildNode, depth: usize) {
+    fn set_lane(&mut self, node: &mut Node<W>, lane: usize, child: &BuildNode, depth: usize) {
         node.set_bounds(lane, child.bounds());
         node.valid |= 1 << lane;
         node.child[lane] = match child {
@@ -250,15 +416,15 @@ impl Bvh4 {
         };
     }
 
-    /// Makes the 4-wide node of an inner binary node: its two children, opened (the largest
-    /// inner one first) until there are four; returns the node's index.
+    /// Makes the wide node of an inner binary node: its two children, opened (the largest
+    /// inner one first) until there are `W`; returns the node's index.
     fn collapse(&mut self, inner: &BuildNode, depth: usize) -> usize {
         self.depth = self.depth.max(depth);
         let BuildNode::Inner { children, .. } = inner else {
             unreachable!("collapse is called on inner nodes only");
         };
         let mut lanes: Vec<&BuildNode> = vec![&children[0], &children[1]];
-        while lanes.len() < 4 {
+        while lanes.len() < W {
             let widest = lanes
                 .iter()
                 .enumerate()
@@ -277,8 +443,8 @@ impl Bvh4 {
             lanes.push(&children[1]);
         }
         let index = self.nodes.len();
-        self.nodes.push(Node4::EMPTY);
-        let mut node = Node4::EMPTY;
+        self.nodes.push(Node::EMPTY);
+        let mut node = Node::EMPTY;
         for (lane, child) in lanes.into_iter().enumerate() {
             self.set_lane(&mut node, lane, child, depth);
         }
@@ -286,12 +452,12 @@ impl Bvh4 {
         index
     }
 
-    /// Number of 4-wide nodes.
+    /// Number of wide nodes.
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
 
-    /// Primitive indices in leaf order (empty after [`Bvh4::take_leaf_order`]).
+    /// Primitive indices in leaf order (empty after [`WideBvh::take_leaf_order`]).
     pub fn primitive_indices(&self) -> &[u32] {
         &self.prim_indices
     }
@@ -330,32 +496,99 @@ impl Bvh4 {
 
     /// Finds the nearest primitive hit by `ray`. `hit(prim, ray)` tests one primitive and, when
     /// it hits closer than `ray.t_max`, shortens `ray.t_max` to the hit and returns true.
-    /// Returns whether anything was hit and how many nodes were visited.
+    /// Returns whether anything was hit and how many nodes were visited. For trees whose
+    /// leaves have not been remapped.
     #[inline]
-    pub fn intersect(&self, ray: &mut Ray, hit: impl FnMut(u32, &mut Ray) -> bool) -> (bool, u32) {
-        if self.nodes.is_empty() {
-            return (false, 0);
-        }
-        if self.depth <= SHALLOW_DEPTH {
-            self.intersect_with::<SHALLOW_STACK>(ray, hit)
-        } else {
-            self.intersect_with::<STACK_SIZE>(ray, hit)
-        }
-    }
-
-    /// [`Bvh4::intersect`] with a stack of `N` entries (at least 3 × depth + 1).
-    #[inline(always)]
-    fn intersect_with<const N: usize>(
+    pub fn intersect(
         &self,
         ray: &mut Ray,
         mut hit: impl FnMut(u32, &mut Ray) -> bool,
     ) -> (bool, u32) {
+        self.intersect_leaves(ray, |leaf, ray| {
+            let (start, count) = Self::leaf_range(leaf);
+            let mut any = false;
+            for slot in start..start + count {
+                any |= hit(self.prim(slot), ray);
+            }
+            any
+        })
+    }
+
+    /// Whether any primitive blocks `ray` (any hit, stopping at the first). For trees whose
+    /// leaves have not been remapped.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, mut hit: impl FnMut(u32, &Ray) -> bool) -> bool {
+        self.occluded_leaves(ray, |leaf, ray| {
+            let (start, count) = Self::leaf_range(leaf);
+            (start..start + count).any(|slot| hit(self.prim(slot), ray))
+        })
+    }
+
+    /// The (first slot, count) a leaf's word names: what [`WideBvh::intersect_leaves`] and
+    /// [`WideBvh::occluded_leaves`] hand to their leaf test, in slots of the leaf order or in
+    /// the units [`WideBvh::remap_leaves`] gave.
+    #[inline(always)]
+    pub fn leaf_range(leaf: u32) -> (u32, u32) {
+        leaf_range(leaf)
+    }
+
+    /// Renames every leaf's range: `f(first slot, count)` returns the leaf's new (first,
+    /// count), in whatever units the caller's leaf test uses (blocks of primitives, say).
+    /// Counts must be 1 to 16 and firsts below [`MAX_PRIMITIVES`].
+    pub fn remap_leaves(&mut self, mut f: impl FnMut(u32, u32) -> (u32, u32)) {
+        for n in &mut self.nodes {
+            for lane in 0..W {
+                let word = n.child[lane];
+                if n.valid & (1 << lane) != 0 && word & LEAF != 0 {
+                    let (start, count) = leaf_range(word);
+                    let (start, count) = f(start, count);
+                    assert!(
+                        (1..=MAX_LEAF as u32).contains(&count) && (start as usize) < MAX_PRIMITIVES,
+                        "leaf range ({start}, {count}) does not fit a leaf word"
+                    );
+                    n.child[lane] = leaf_word(start as usize, count as usize);
+                }
+            }
+        }
+    }
+
+    /// Finds the nearest hit by `ray`, nearest boxes first. `leaf(word, ray)` tests the leaf
+    /// whose range [`WideBvh::leaf_range`] decodes from `word` and, when something in it hits
+    /// closer than `ray.t_max`, shortens `ray.t_max` to the hit and returns true. Returns
+    /// whether anything was hit and how many nodes were visited.
+    #[inline(always)]
+    pub fn intersect_leaves(
+        &self,
+        ray: &mut Ray,
+        leaf: impl FnMut(u32, &mut Ray) -> bool,
+    ) -> (bool, u32) {
+        self.intersect_leaves_with(Portable, ray, leaf)
+    }
+
+    /// [`WideBvh::intersect_leaves`] with the box test `boxes`.
+    #[inline(always)]
+    pub fn intersect_leaves_with(
+        &self,
+        boxes: impl BoxTest<W>,
+        ray: &mut Ray,
+        leaf: impl FnMut(u32, &mut Ray) -> bool,
+    ) -> (bool, u32) {
+        if self.nodes.is_empty() {
+            return (false, 0);
+        }
+        self.intersect_with::<STACK_SIZE>(boxes, ray, leaf)
+    }
+
+    /// [`WideBvh::intersect_leaves`] with a stack of `N` entries (at least (W - 1) × depth + 1).
+    #[inline(always)]
+    fn intersect_with<const N: usize>(
+        &self,
+        boxes: impl BoxTest<W>,
+        ray: &mut Ray,
+        mut leaf: impl FnMut(u32, &mut Ray) -> bool,
+    ) -> (bool, u32) {
         let rb = RayBoxes::new(ray);
-        // Entries: the lane's entry distance (high half) and child word (low half), packed in
-        // one word so that the stack is cheap to set up.
-        let mut stack = [0u64; N];
-        let entry = |word: u32, t: f32| (u64::from(t.to_bits()) << 32) | u64::from(word);
-        let mut sp = 0usize;
+        let mut stack = Stack::<u64, N>::new();
         let mut word = 0u32; // the root, an inner node
         let mut visited = 0u32;
         let mut any = false;
@@ -363,59 +596,68 @@ impl Bvh4 {
             if word & LEAF == 0 {
                 visited += 1;
                 let n = &self.nodes[word as usize];
-                let (t_near, mut mask) = rb.test(n, ray.t_max);
+                let (t_near, mut mask) = boxes.test(&rb, n, ray.t_max);
                 if mask != 0 {
-                    let a = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                    let next = |mask: &mut u32| {
+                        let lane = mask.trailing_zeros() as usize;
+                        *mask &= *mask - 1;
+                        stack_entry(n.child[lane], t_near[lane])
+                    };
+                    let a = next(&mut mask);
                     if mask == 0 {
-                        word = n.child[a];
+                        word = a as u32;
                         continue 'walk;
                     }
-                    let b = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                    // Two or more: keep the farther ones on the stack, farthest deepest, and
+                    // go to the nearest (a sorting network, no branches on distances).
+                    let (a, b) = order(a, next(&mut mask));
                     if mask == 0 {
-                        // Two children: go to the nearer, keep the other.
-                        let (near, far) = if t_near[a] <= t_near[b] {
-                            (a, b)
-                        } else {
-                            (b, a)
-                        };
-                        stack[sp] = entry(n.child[far], t_near[far]);
-                        sp += 1;
-                        word = n.child[near];
+                        stack.push(b);
+                        word = a as u32;
                         continue 'walk;
                     }
-                    // Three or four: push all, sorted so that the nearest is on top; take it.
-                    let base = sp;
-                    for lane in [a, b] {
-                        stack[sp] = entry(n.child[lane], t_near[lane]);
-                        sp += 1;
+                    let c = next(&mut mask);
+                    if mask == 0 {
+                        let (b, c) = order(b, c);
+                        let (a, b) = order(a, b);
+                        stack.push(c);
+                        stack.push(b);
+                        word = a as u32;
+                        continue 'walk;
+                    }
+                    let (c, d) = order(c, next(&mut mask));
+                    let (a, c) = order(a, c);
+                    let (b, d) = order(b, d);
+                    let (b, c) = order(b, c);
+                    if mask == 0 {
+                        stack.push(d);
+                        stack.push(c);
+                        stack.push(b);
+                        word = a as u32;
+                        continue 'walk;
+                    }
+                    // More than four (eight-wide nodes): push them all and sort the pushed
+                    // entries, farthest deepest, by insertion.
+                    let base = stack.len();
+                    for e in [a, b, c, d] {
+                        stack.push(e);
                     }
                     while mask != 0 {
-                        let lane = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        stack[sp] = entry(n.child[lane], t_near[lane]);
-                        sp += 1;
+                        stack.push(next(&mut mask));
                     }
-                    // Entry distances are non-negative, so their bit patterns sort as values.
-                    stack[base..sp].sort_unstable_by(|x, y| y.cmp(x));
-                    sp -= 1;
-                    word = stack[sp] as u32;
+                    stack.sort_descending_from(base);
+                    // The nearest is on top now (the stack holds at least the four pushed).
+                    word = stack.pop().unwrap_or(a) as u32;
                     continue 'walk;
                 }
             } else {
-                let (start, count) = leaf_range(word);
-                for slot in start..start + count {
-                    any |= hit(self.prim(slot), ray);
-                }
+                any |= leaf(word, ray);
             }
             // Next: the nearest kept entry that can still hold a closer hit.
             loop {
-                if sp == 0 {
+                let Some(e) = stack.pop() else {
                     break 'walk;
-                }
-                sp -= 1;
-                let e = stack[sp];
+                };
                 if f32::from_bits((e >> 32) as u32) <= ray.t_max {
                     word = e as u32;
                     continue 'walk;
@@ -425,52 +667,55 @@ impl Bvh4 {
         (any, visited)
     }
 
-    /// Whether any primitive blocks `ray` (any hit, stopping at the first).
-    #[inline]
-    pub fn occluded(&self, ray: &Ray, hit: impl FnMut(u32, &Ray) -> bool) -> bool {
+    /// Whether `leaf(word, ray)` (see [`WideBvh::intersect_leaves`]) reports a hit for any leaf
+    /// `ray` reaches; stops at the first.
+    #[inline(always)]
+    pub fn occluded_leaves(&self, ray: &Ray, leaf: impl FnMut(u32, &Ray) -> bool) -> bool {
+        self.occluded_leaves_with(Portable, ray, leaf)
+    }
+
+    /// [`WideBvh::occluded_leaves`] with the box test `boxes`.
+    #[inline(always)]
+    pub fn occluded_leaves_with(
+        &self,
+        boxes: impl BoxTest<W>,
+        ray: &Ray,
+        leaf: impl FnMut(u32, &Ray) -> bool,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        if self.depth <= SHALLOW_DEPTH {
-            self.occluded_with::<SHALLOW_STACK>(ray, hit)
-        } else {
-            self.occluded_with::<STACK_SIZE>(ray, hit)
-        }
+        self.occluded_with::<STACK_SIZE>(boxes, ray, leaf)
     }
 
-    /// [`Bvh4::occluded`] with a stack of `N` entries (at least 3 × depth + 1).
+    /// [`WideBvh::occluded_leaves`] with a stack of `N` entries (at least (W - 1) × depth + 1).
     #[inline(always)]
     fn occluded_with<const N: usize>(
         &self,
+        boxes: impl BoxTest<W>,
         ray: &Ray,
-        mut hit: impl FnMut(u32, &Ray) -> bool,
+        mut leaf: impl FnMut(u32, &Ray) -> bool,
     ) -> bool {
         let rb = RayBoxes::new(ray);
-        let mut stack = [0u32; N];
-        let mut sp = 0usize;
+        let mut stack = Stack::<u32, N>::new();
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];
-            let (_, mut mask) = rb.test(n, ray.t_max);
+            let (_, mut mask) = boxes.test(&rb, n, ray.t_max);
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 let word = n.child[lane];
                 if word & LEAF == 0 {
-                    stack[sp] = word;
-                    sp += 1;
-                } else {
-                    let (start, count) = leaf_range(word);
-                    if (start..start + count).any(|slot| hit(self.prim(slot), ray)) {
-                        return true;
-                    }
+                    stack.push(word);
+                } else if leaf(word, ray) {
+                    return true;
                 }
             }
-            if sp == 0 {
-                return false;
+            match stack.pop() {
+                Some(next) => node = next,
+                None => return false,
             }
-            sp -= 1;
-            node = stack[sp];
         }
     }
 
@@ -481,7 +726,7 @@ impl Bvh4 {
             outer.min.cmple(inner.min).all() && outer.max.cmpge(inner.max).all()
         }
         for n in &self.nodes {
-            for lane in 0..4 {
+            for lane in 0..W {
                 let word = n.child[lane];
                 if word == EMPTY_LANE {
                     continue;
@@ -495,7 +740,7 @@ impl Bvh4 {
                     }
                 } else {
                     let c = &self.nodes[word as usize];
-                    for l in 0..4 {
+                    for l in 0..W {
                         if c.child[l] != EMPTY_LANE {
                             assert!(contains(&b, &c.bounds(l)));
                         }
@@ -532,7 +777,7 @@ fn build_binary(
     };
     let mid = match split {
         Some((axis, bin, cost)) => {
-            if n <= params.max_leaf_size && cost >= n as f32 {
+            if n <= params.max_leaf_size && cost >= blocks(n, params) {
                 return leaf();
             }
             let (lo, extent) = (centroids.min[axis], centroids.extent()[axis]);
@@ -567,6 +812,12 @@ fn build_binary(
         bounds,
         children: Box::new([a, b]),
     }
+}
+
+/// SAH cost of testing `n` primitives, in blocks of `params.leaf_block`.
+#[inline]
+fn blocks(n: usize, params: &BvhParams) -> f32 {
+    n.div_ceil(params.leaf_block.max(1)) as f32
 }
 
 #[inline]
@@ -614,7 +865,8 @@ fn find_split(
                 continue;
             }
             let cost = params.traversal_cost
-                + (acc.surface_area() * cnt as f32 + right_area[i + 1] * right_count[i + 1] as f32)
+                + (acc.surface_area() * blocks(cnt, params)
+                    + right_area[i + 1] * blocks(right_count[i + 1], params))
                     / area;
             if best.is_none_or(|b| cost < b.2) {
                 best = Some((axis, i, cost));
@@ -628,13 +880,89 @@ fn find_split(
 mod tests {
     use super::super::test_util::{box_hit, check_against_brute_force, random_boxes};
     use super::*;
+    use pathlab_mc::rng::Pcg32;
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_box_test_gives_the_portable_results_to_the_bit() {
+        let Some(avx2) = crate::simd::Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: only the portable box test runs here");
+            return;
+        };
+        let boxes = random_boxes(3000, 11);
+        let bvh = Bvh8::build(&boxes, BvhParams::default());
+        let mut rng = Pcg32::new(12, 1);
+        let mut tested = 0;
+        for k in 0..2000 {
+            let o = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 14.0 - 2.0;
+            let mut d = Vec3::new(
+                rng.uniform_f32() - 0.5,
+                rng.uniform_f32() - 0.5,
+                rng.uniform_f32() - 0.5,
+            );
+            // Axis-parallel, zero, infinite and NaN components: the NaN handling must match.
+            match k % 8 {
+                1 => d.x = 0.0,
+                2 => d = Vec3::new(0.0, 0.0, d.z),
+                3 => d.y = f32::NAN,
+                4 => d.z = f32::INFINITY,
+                _ => {}
+            }
+            let rb = RayBoxes::new(&Ray::new(o, d));
+            for node in &bvh.nodes {
+                for t_max in [f32::INFINITY, 3.0] {
+                    let (tp, mp) = Portable.test(&rb, node, t_max);
+                    let (ta, ma) = avx2.test(&rb, node, t_max);
+                    assert_eq!(mp, ma);
+                    assert_eq!(tp.map(f32::to_bits), ta.map(f32::to_bits));
+                    tested += 1;
+                }
+            }
+        }
+        assert!(tested > 1000);
+    }
+
+    #[test]
+    fn stack_pops_what_was_pushed_and_sorts_its_top() {
+        let mut stack = Stack::<u64, 8>::new();
+        assert_eq!(stack.pop(), None);
+        for e in [5, 1, 9, 3, 7] {
+            stack.push(e);
+        }
+        stack.sort_descending_from(1);
+        let popped: Vec<u64> = std::iter::from_fn(|| stack.pop()).collect();
+        assert_eq!(popped, [1, 3, 7, 9, 5]);
+        assert_eq!(stack.len(), 0);
+    }
+
+    #[test]
+    #[should_panic]
+    fn stack_refuses_to_overflow() {
+        let mut stack = Stack::<u32, 2>::new();
+        for e in 0..3 {
+            stack.push(e);
+        }
+    }
 
     #[test]
     fn finds_the_same_nearest_hit_as_brute_force() {
+        nearest_hits_match_brute_force::<4>();
+        nearest_hits_match_brute_force::<8>();
+    }
+
+    fn nearest_hits_match_brute_force<const W: usize>() {
         // Sizes around the parallel threshold and the leaf size, and one large tree.
-        for (n, seed) in [(1, 1), (3, 2), (5, 3), (17, 4), (2000, 5), (20_000, 6)] {
+        for (n, seed) in [
+            (1, 1),
+            (3, 2),
+            (5, 3),
+            (9, 10),
+            (17, 4),
+            (2000, 5),
+            (20_000, 6),
+        ] {
             let boxes = random_boxes(n, seed);
-            let bvh = Bvh4::build(&boxes, BvhParams::default());
+            let bvh = WideBvh::<W>::build(&boxes, BvhParams::default());
             bvh.check(&boxes);
             let mut seen: Vec<u32> = bvh.primitive_indices().to_vec();
             seen.sort();
@@ -651,10 +979,15 @@ mod tests {
 
     #[test]
     fn rays_with_infinite_or_nan_parameters_never_reach_empty_lanes() {
+        bad_rays_never_reach_empty_lanes::<4>();
+        bad_rays_never_reach_empty_lanes::<8>();
+    }
+
+    fn bad_rays_never_reach_empty_lanes<const W: usize>() {
         // Five boxes leave empty lanes; infinite and NaN origins and directions make the slab
         // test's products NaN, which must not open those lanes.
         let boxes = random_boxes(5, 8);
-        let bvh = Bvh4::build(&boxes, BvhParams::default());
+        let bvh = WideBvh::<W>::build(&boxes, BvhParams::default());
         let (inf, nan) = (f32::INFINITY, f32::NAN);
         for (o, d) in [
             (Vec3::splat(inf), Vec3::X),
@@ -680,8 +1013,13 @@ mod tests {
 
     #[test]
     fn axis_parallel_rays_and_degenerate_input() {
+        axis_parallel_and_degenerate::<4>();
+        axis_parallel_and_degenerate::<8>();
+    }
+
+    fn axis_parallel_and_degenerate<const W: usize>() {
         let boxes = random_boxes(500, 7);
-        let bvh = Bvh4::build(&boxes, BvhParams::default());
+        let bvh = WideBvh::<W>::build(&boxes, BvhParams::default());
         for d in [Vec3::X, Vec3::NEG_Y, Vec3::Z] {
             for k in 0..50 {
                 let o = Vec3::new(k as f32 * 0.2, 5.0, 5.0) - d * 20.0;
@@ -693,7 +1031,7 @@ mod tests {
                 assert_eq!(ray.t_max, brute.t_max);
             }
         }
-        let empty = Bvh4::build(&[], BvhParams::default());
+        let empty = WideBvh::<W>::build(&[], BvhParams::default());
         assert_eq!(empty.node_count(), 0);
         assert!(!empty.occluded(&Ray::new(Vec3::ZERO, Vec3::X), |_, _| true));
         let same = vec![
@@ -703,7 +1041,7 @@ mod tests {
             };
             100
         ];
-        let bvh = Bvh4::build(&same, BvhParams::default());
+        let bvh = WideBvh::<W>::build(&same, BvhParams::default());
         assert_eq!(bvh.primitive_indices().len(), 100);
         let mut ray = Ray::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z);
         assert!(bvh.intersect(&mut ray, box_hit(&same)).0);
@@ -715,7 +1053,7 @@ mod tests {
             Aabb::EMPTY,
         ];
         assert_eq!(
-            Bvh4::build(&bad, BvhParams::default())
+            WideBvh::<W>::build(&bad, BvhParams::default())
                 .primitive_indices()
                 .len(),
             0

@@ -1,0 +1,240 @@
+//! Four triangles laid out for one ray to test them together: the Möller–Trumbore test of
+//! [`Triangle::intersect`], with the vertex and both edges of each lane stored side by side
+//! (structure of arrays), so that the compiler turns the loops over the four lanes into SIMD.
+//!
+//! Every lane computes exactly what [`Triangle::intersect`] computes, in the same order, so a
+//! block reports the same distances and barycentrics to the bit.
+
+use crate::geometry::Ray;
+use crate::shape::Triangle;
+
+/// Lanes per block.
+pub const LANES: usize = 4;
+
+/// Up to four triangles. Unused lanes have zero edges, which no ray hits (their determinant
+/// is zero).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct TriBlock {
+    /// First vertex: `v0[axis][lane]`.
+    v0: [[f32; LANES]; 3],
+    /// Edge from the first to the second vertex.
+    e1: [[f32; LANES]; 3],
+    /// Edge from the first to the third vertex.
+    e2: [[f32; LANES]; 3],
+}
+
+/// A lane's hit: distance and barycentrics of vertices 1 and 2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlockHit {
+    /// Which lane.
+    pub lane: usize,
+    /// Ray parameter.
+    pub t: f32,
+    /// Barycentric coordinate of vertex 1.
+    pub b1: f32,
+    /// Barycentric coordinate of vertex 2.
+    pub b2: f32,
+}
+
+/// Per-lane results of testing a block.
+struct LaneHits {
+    t: [f32; LANES],
+    b1: [f32; LANES],
+    b2: [f32; LANES],
+    /// Bit per lane that hits within the ray's extent.
+    mask: u32,
+}
+
+impl TriBlock {
+    /// A block of `triangles` (at most [`LANES`]), the rest of the lanes unused.
+    pub fn new(triangles: &[Triangle]) -> TriBlock {
+        assert!(
+            triangles.len() <= LANES,
+            "a block holds at most {LANES} triangles"
+        );
+        let mut b = TriBlock {
+            v0: [[0.0; LANES]; 3],
+            e1: [[0.0; LANES]; 3],
+            e2: [[0.0; LANES]; 3],
+        };
+        for (lane, tri) in triangles.iter().enumerate() {
+            let (e1, e2) = (tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
+            for axis in 0..3 {
+                b.v0[axis][lane] = tri.p[0][axis];
+                b.e1[axis][lane] = e1[axis];
+                b.e2[axis][lane] = e2[axis];
+            }
+        }
+        b
+    }
+
+    /// Tests all four lanes.
+    #[inline(always)]
+    fn test(&self, ray: &Ray) -> LaneHits {
+        let (o, d) = (ray.o, ray.d);
+        let mut t = [0.0f32; LANES];
+        let mut b1 = [0.0f32; LANES];
+        let mut b2 = [0.0f32; LANES];
+        let mut ok = [false; LANES];
+        for lane in 0..LANES {
+            let e1 = [self.e1[0][lane], self.e1[1][lane], self.e1[2][lane]];
+            let e2 = [self.e2[0][lane], self.e2[1][lane], self.e2[2][lane]];
+            // pvec = d × e2, det = e1 · pvec (glam's cross and dot, term by term).
+            let pvec = [
+                d.y * e2[2] - e2[1] * d.z,
+                d.z * e2[0] - e2[2] * d.x,
+                d.x * e2[1] - e2[0] * d.y,
+            ];
+            let det = e1[0] * pvec[0] + e1[1] * pvec[1] + e1[2] * pvec[2];
+            let inv_det = 1.0 / det;
+            let tvec = [
+                o.x - self.v0[0][lane],
+                o.y - self.v0[1][lane],
+                o.z - self.v0[2][lane],
+            ];
+            let u = (tvec[0] * pvec[0] + tvec[1] * pvec[1] + tvec[2] * pvec[2]) * inv_det;
+            // qvec = tvec × e1.
+            let qvec = [
+                tvec[1] * e1[2] - e1[1] * tvec[2],
+                tvec[2] * e1[0] - e1[2] * tvec[0],
+                tvec[0] * e1[1] - e1[0] * tvec[1],
+            ];
+            let v = (d.x * qvec[0] + d.y * qvec[1] + d.z * qvec[2]) * inv_det;
+            let dist = (e2[0] * qvec[0] + e2[1] * qvec[1] + e2[2] * qvec[2]) * inv_det;
+            // The scalar test's conditions; NaNs fail every comparison, as there.
+            ok[lane] = det != 0.0
+                && det.abs() < f32::INFINITY
+                && (0.0..=1.0).contains(&u)
+                && v >= 0.0
+                && u + v <= 1.0
+                && dist > ray.t_min
+                && dist < ray.t_max;
+            t[lane] = dist;
+            b1[lane] = u;
+            b2[lane] = v;
+        }
+        let mut mask = 0u32;
+        for (lane, &hit) in ok.iter().enumerate() {
+            mask |= u32::from(hit) << lane;
+        }
+        LaneHits { t, b1, b2, mask }
+    }
+
+    /// The nearest hit within `(ray.t_min, ray.t_max)` among the lanes in `lanes` (bit per
+    /// lane); on equal distances, the lowest lane (as testing them in order would).
+    #[inline(always)]
+    pub fn intersect(&self, ray: &Ray, lanes: u32) -> Option<BlockHit> {
+        let h = self.test(ray);
+        let mut mask = h.mask & lanes;
+        if mask == 0 {
+            return None;
+        }
+        let mut best = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        while mask != 0 {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if h.t[lane] < h.t[best] {
+                best = lane;
+            }
+        }
+        Some(BlockHit {
+            lane: best,
+            t: h.t[best],
+            b1: h.b1[best],
+            b2: h.b2[best],
+        })
+    }
+
+    /// The lanes of `lanes` that `ray` hits within its extent (bit per lane).
+    #[inline(always)]
+    pub fn hits(&self, ray: &Ray, lanes: u32) -> u32 {
+        self.test(ray).mask & lanes
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use pathlab_mc::rng::Pcg32;
+
+    fn random_point(rng: &mut Pcg32) -> Vec3 {
+        Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 2.0 - 1.0
+    }
+
+    #[test]
+    fn agrees_with_the_scalar_test_to_the_bit() {
+        let mut rng = Pcg32::new(3, 5);
+        for round in 0..20_000 {
+            let n = round % (LANES + 1);
+            let mut tris: Vec<Triangle> = (0..n)
+                .map(|_| Triangle {
+                    p: [
+                        random_point(&mut rng),
+                        random_point(&mut rng),
+                        random_point(&mut rng),
+                    ],
+                })
+                .collect();
+            if n > 1 && round % 7 == 0 {
+                // Equal distances in two lanes, and a degenerate triangle.
+                tris[1] = tris[0];
+                tris[n - 1].p[2] = tris[n - 1].p[1];
+            }
+            let block = TriBlock::new(&tris);
+            let o = random_point(&mut rng) * 3.0;
+            let d = random_point(&mut rng) - o * 0.3;
+            let ray = Ray {
+                t_min: if round % 3 == 0 { 0.5 } else { 0.0 },
+                t_max: if round % 5 == 0 { 1.5 } else { f32::INFINITY },
+                ..Ray::new(o, d)
+            };
+            let lanes = if round % 11 == 0 { 0b0101 } else { 0b1111 };
+            let mut scalar: Option<BlockHit> = None;
+            let mut r = ray;
+            for (lane, tri) in tris.iter().enumerate() {
+                if lanes & (1 << lane) == 0 {
+                    continue;
+                }
+                if let Some(h) = tri.intersect(&r) {
+                    r.t_max = h.t;
+                    scalar = Some(BlockHit {
+                        lane,
+                        t: h.t,
+                        b1: h.b1,
+                        b2: h.b2,
+                    });
+                }
+            }
+            assert_eq!(block.intersect(&ray, lanes), scalar, "round {round}");
+            let any: u32 = tris
+                .iter()
+                .enumerate()
+                .map(|(lane, tri)| u32::from(tri.intersect(&ray).is_some()) << lane)
+                .sum();
+            assert_eq!(block.hits(&ray, lanes), any & lanes);
+        }
+    }
+
+    #[test]
+    fn unused_lanes_and_bad_rays_never_hit() {
+        let tri = Triangle {
+            p: [Vec3::ZERO, Vec3::X, Vec3::Y],
+        };
+        let block = TriBlock::new(&[tri]);
+        let through = Ray::new(Vec3::new(0.2, 0.2, -1.0), Vec3::Z);
+        assert_eq!(block.hits(&through, 0b1111), 0b0001);
+        for (o, d) in [
+            (Vec3::splat(f32::NAN), Vec3::Z),
+            (
+                Vec3::new(0.2, 0.2, -1.0),
+                Vec3::new(0.0, f32::INFINITY, 1.0),
+            ),
+            (Vec3::new(0.2, 0.2, -1.0), Vec3::ZERO),
+        ] {
+            assert_eq!(block.hits(&Ray::new(o, d), 0b1111), 0);
+        }
+    }
+}
