@@ -70,6 +70,8 @@ impl TriBlock {
     }
 
     /// Tests all four lanes.
+    // The lane conditions are comparisons joined by `&`: the range form branches.
+    #[allow(clippy::manual_range_contains)]
     #[inline(always)]
     fn test(&self, ray: &Ray) -> LaneHits {
         let (o, d) = (ray.o, ray.d);
@@ -102,14 +104,17 @@ impl TriBlock {
             ];
             let v = (d.x * qvec[0] + d.y * qvec[1] + d.z * qvec[2]) * inv_det;
             let dist = (e2[0] * qvec[0] + e2[1] * qvec[1] + e2[2] * qvec[2]) * inv_det;
-            // The scalar test's conditions; NaNs fail every comparison, as there.
-            ok[lane] = det != 0.0
-                && det.abs() < f32::INFINITY
-                && (0.0..=1.0).contains(&u)
-                && v >= 0.0
-                && u + v <= 1.0
-                && dist > ray.t_min
-                && dist < ray.t_max;
+            // The scalar test's conditions; NaNs fail every comparison, as there. (Written as
+            // comparisons joined by `&`, not `&&` or range `contains`, so that no lane
+            // branches and the loop stays one SIMD sequence.)
+            ok[lane] = (det != 0.0)
+                & (det.abs() < f32::INFINITY)
+                & (u >= 0.0)
+                & (u <= 1.0)
+                & (v >= 0.0)
+                & (u + v <= 1.0)
+                & (dist > ray.t_min)
+                & (dist < ray.t_max);
             t[lane] = dist;
             b1[lane] = u;
             b2[lane] = v;
