@@ -186,13 +186,15 @@ impl RayBoxes {
     #[inline(always)]
     fn new(ray: &Ray) -> Self {
         let inv_d = ray.d.recip();
-        let near = [0, 1, 2].map(|axis| if inv_d[axis] < 0.0 { axis + 3 } else { axis });
+        // Written out rather than with `array::map`, which is not inlined here.
+        let plane = |axis: usize, upper: bool| axis + 3 * usize::from(upper);
+        let neg = [inv_d.x < 0.0, inv_d.y < 0.0, inv_d.z < 0.0];
         RayBoxes {
             o: ray.o.to_array(),
             inv_d: inv_d.to_array(),
             inv_far: (inv_d * FAR_SCALE).to_array(),
-            near,
-            far: near.map(|k| if k < 3 { k + 3 } else { k - 3 }),
+            near: [plane(0, neg[0]), plane(1, neg[1]), plane(2, neg[2])],
+            far: [plane(0, !neg[0]), plane(1, !neg[1]), plane(2, !neg[2])],
         }
     }
 
