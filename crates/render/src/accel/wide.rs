@@ -779,7 +779,10 @@ fn build_binary(
     };
     let mid = match split {
         Some((axis, bin, cost)) => {
-            if n <= params.max_leaf_size && cost >= blocks(n, params) {
+            // Splitting a small set makes two leaves that the collapse puts side by side in
+            // one wide node: what it adds is `leaf_split_cost`, not a traversal step.
+            let split_cost = cost - params.traversal_cost + params.leaf_split_cost;
+            if n <= params.max_leaf_size && split_cost >= blocks(n, params) {
                 return leaf();
             }
             let (lo, extent) = (centroids.min[axis], centroids.extent()[axis]);
