@@ -1,6 +1,6 @@
 //! The renderable scene: flattened shapes, the BVH over them, materials, lights and camera.
 
-use crate::accel::{BoxTest, Bvh8, BvhParams, Portable, TriBlock, LANES, MAX_PRIMITIVES};
+use crate::accel::{Bvh8, BvhParams, TriBlock, LANES, MAX_PRIMITIVES};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc, Visibility};
@@ -8,12 +8,14 @@ use crate::envmap::EnvironmentMap;
 use crate::geometry::{Aabb, Ray};
 use crate::light::{bounding_radius, AreaShape, Light, LightSampler};
 use crate::shape::{Sphere, Triangle};
-#[cfg(target_arch = "x86_64")]
-use crate::simd::Avx2;
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
 use std::time::Instant;
 use thiserror::Error;
+
+mod trace;
+
+use trace::{leaf_blocks, BlockInfo, Hit};
 
 /// Marks a shape that emits no light.
 const NO_LIGHT: u32 = u32::MAX;
@@ -50,30 +52,6 @@ pub enum SceneError {
 enum Prim {
     Triangle(u32),
     Sphere(u32),
-}
-
-/// Where a ray's nearest hit is, before the surface interaction is made from it.
-#[derive(Clone, Copy)]
-struct Hit {
-    /// Leaf slot of the primitive.
-    slot: u32,
-    /// Barycentrics of vertices 1 and 2 (triangles).
-    b1: f32,
-    b2: f32,
-}
-
-/// What a [`TriBlock`]'s lanes hold: their primitives' leaf slots and which lanes are
-/// spheres (tested one by one) or seen by camera and other rays.
-#[derive(Clone, Copy, Debug)]
-struct BlockInfo {
-    /// Leaf slot of each lane's primitive (`u32::MAX` for an unused lane).
-    slots: [u32; LANES],
-    /// Lanes that hold spheres.
-    spheres: u8,
-    /// Lanes seen by camera rays.
-    camera: u8,
-    /// Lanes seen by other rays.
-    indirect: u8,
 }
 
 /// `items` rearranged so that position `i` holds `items[order[i]]`.
@@ -308,8 +286,9 @@ impl Scene {
             &bounds,
             BvhParams {
                 leaf_block: LANES,
-                // Measured: 0.25 keeps the walls of a room in separate leaves (the Cornell box
-                // renders 12-17% faster than with 1.0) and large meshes as fast as before.
+                // Measured against 1.0: 0.25 keeps the walls of a room in separate leaves (the
+                // Cornell box renders 12-17% faster); the blobs and maxplanck trace as fast as
+                // before, a soup of random triangles (smaller leaves) about 15% slower.
                 leaf_split_cost: 0.25,
                 ..BvhParams::default()
             },
@@ -489,139 +468,6 @@ impl Scene {
             .map_or(Rgb::ZERO, |i| self.lights[i as usize].le_environment(w))
     }
 
-    /// The lanes of block `b` that a camera ray (`camera`) or another ray tests as triangles,
-    /// and the lanes it tests as spheres.
-    #[inline(always)]
-    fn block_lanes(&self, b: usize, camera: bool) -> (u32, u32) {
-        if self.all_visible && !self.has_spheres {
-            // Unused lanes never hit, so all four can be tested.
-            return (0b1111, 0);
-        }
-        let info = &self.block_info[b];
-        let seen = u32::from(if camera { info.camera } else { info.indirect });
-        let spheres = u32::from(info.spheres);
-        (seen & !spheres, seen & spheres)
-    }
-
-    /// The sphere in leaf slot `slot`.
-    #[inline]
-    fn sphere_at(&self, slot: u32) -> &Sphere {
-        match self.prims[slot as usize] {
-            Prim::Sphere(s) => &self.spheres[s as usize],
-            Prim::Triangle(_) => unreachable!("block lanes marked as spheres hold spheres"),
-        }
-    }
-
-    /// The nearest hit along `ray` (whose `t_max` it shortens to the hit), and the number of
-    /// BVH nodes visited. Compiled twice: for CPUs with AVX2 and FMA, chosen at run time, and
-    /// for the target's baseline.
-    #[inline]
-    fn closest_hit(&self, ray: &mut Ray, camera: bool) -> (Option<Hit>, u32) {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(avx2) = Avx2::detect() {
-            // SAFETY: `closest_hit_avx2` requires AVX2 and FMA, which `avx2` proves this CPU
-            // has. Its body is safe code.
-            return unsafe { self.closest_hit_avx2(avx2, ray, camera) };
-        }
-        self.closest_hit_with(Portable, ray, camera)
-    }
-
-    /// [`Scene::closest_hit`] compiled for AVX2 and FMA.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn closest_hit_avx2(&self, avx2: Avx2, ray: &mut Ray, camera: bool) -> (Option<Hit>, u32) {
-        self.closest_hit_with(avx2, ray, camera)
-    }
-
-    /// [`Scene::any_hit`] compiled for AVX2 and FMA.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn any_hit_avx2(&self, avx2: Avx2, ray: &Ray, camera: bool) -> bool {
-        self.any_hit_with(avx2, ray, camera)
-    }
-
-    /// Whether anything a camera ray (`camera`) or another ray sees blocks `ray`; compiled
-    /// twice, as [`Scene::closest_hit`] is.
-    #[inline]
-    fn any_hit(&self, ray: &Ray, camera: bool) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(avx2) = Avx2::detect() {
-            // SAFETY: as in `closest_hit`: `avx2` proves the features `any_hit_avx2` requires.
-            return unsafe { self.any_hit_avx2(avx2, ray, camera) };
-        }
-        self.any_hit_with(Portable, ray, camera)
-    }
-
-    /// [`Scene::closest_hit`] with the box test `boxes`.
-    #[inline(always)]
-    fn closest_hit_with(
-        &self,
-        boxes: impl BoxTest<8>,
-        ray: &mut Ray,
-        camera: bool,
-    ) -> (Option<Hit>, u32) {
-        let mut best: Option<Hit> = None;
-        let (_, visited) = self.bvh.intersect_leaves_with(boxes, ray, |leaf, r| {
-            let (first, count) = Bvh8::leaf_range(leaf);
-            let mut any = false;
-            for b in first as usize..(first + count) as usize {
-                let (triangles, spheres) = self.block_lanes(b, camera);
-                if let Some(h) = self.blocks[b].intersect(r, triangles) {
-                    r.t_max = h.t;
-                    best = Some(Hit {
-                        slot: self.block_info[b].slots[h.lane],
-                        b1: h.b1,
-                        b2: h.b2,
-                    });
-                    any = true;
-                }
-                let mut spheres = spheres;
-                while spheres != 0 {
-                    let lane = spheres.trailing_zeros() as usize;
-                    spheres &= spheres - 1;
-                    let slot = self.block_info[b].slots[lane];
-                    if let Some(t) = self.sphere_at(slot).intersect(r) {
-                        r.t_max = t;
-                        best = Some(Hit {
-                            slot,
-                            b1: 0.0,
-                            b2: 0.0,
-                        });
-                        any = true;
-                    }
-                }
-            }
-            any
-        });
-        (best, visited)
-    }
-
-    /// [`Scene::any_hit`] with the box test `boxes`.
-    #[inline(always)]
-    fn any_hit_with(&self, boxes: impl BoxTest<8>, ray: &Ray, camera: bool) -> bool {
-        self.bvh.occluded_leaves_with(boxes, ray, |leaf, r| {
-            let (first, count) = Bvh8::leaf_range(leaf);
-            (first as usize..(first + count) as usize).any(|b| {
-                let (triangles, mut spheres) = self.block_lanes(b, camera);
-                if self.blocks[b].hits(r, triangles) != 0 {
-                    return true;
-                }
-                while spheres != 0 {
-                    let lane = spheres.trailing_zeros() as usize;
-                    spheres &= spheres - 1;
-                    if self
-                        .sphere_at(self.block_info[b].slots[lane])
-                        .intersect(r)
-                        .is_some()
-                    {
-                        return true;
-                    }
-                }
-                false
-            })
-        })
-    }
-
     /// The nearest surface along a camera ray, and the number of BVH nodes visited.
     pub fn intersect_camera(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u32) {
         self.intersect_as(ray, true)
@@ -706,45 +552,6 @@ impl Scene {
     }
 }
 
-/// Packs the primitives of each of `bvh`'s leaves into blocks of [`LANES`] and renames the
-/// leaves' ranges from leaf slots to blocks.
-fn leaf_blocks(
-    bvh: &mut Bvh8,
-    prims: &[Prim],
-    triangles: &[Triangle],
-    visibility: &[Visibility],
-) -> (Vec<TriBlock>, Vec<BlockInfo>) {
-    let mut blocks = Vec::with_capacity(prims.len() / 2 + 1);
-    let mut info = Vec::with_capacity(prims.len() / 2 + 1);
-    bvh.remap_leaves(|start, count| {
-        let first = blocks.len() as u32;
-        let slots: Vec<u32> = (start..start + count).collect();
-        for chunk in slots.chunks(LANES) {
-            let mut lanes = BlockInfo {
-                slots: [u32::MAX; LANES],
-                spheres: 0,
-                camera: 0,
-                indirect: 0,
-            };
-            let mut tris = [Triangle { p: [Vec3::ZERO; 3] }; LANES];
-            for (lane, &slot) in chunk.iter().enumerate() {
-                lanes.slots[lane] = slot;
-                match prims[slot as usize] {
-                    Prim::Triangle(t) => tris[lane] = triangles[t as usize],
-                    Prim::Sphere(_) => lanes.spheres |= 1 << lane,
-                }
-                let v = visibility[slot as usize];
-                lanes.camera |= u8::from(v.camera) << lane;
-                lanes.indirect |= u8::from(v.indirect) << lane;
-            }
-            blocks.push(TriBlock::new(&tris));
-            info.push(lanes);
-        }
-        (first, blocks.len() as u32 - first)
-    });
-    (blocks, info)
-}
-
 /// Adds an area light for `shape` if it emits; returns its index, or [`NO_LIGHT`]. Shapes that
 /// only camera rays see show their emission but are never sampled as lights.
 fn add_area_light(
@@ -795,110 +602,6 @@ mod tests {
             ..Default::default()
         };
         Scene::build(&desc).unwrap()
-    }
-
-    /// Nearest distance along `ray` by testing every shape the ray kind sees.
-    fn brute_force(desc: &SceneDesc, ray: &Ray, camera: bool) -> Option<f32> {
-        let mut best: Option<f32> = None;
-        let mut r = *ray;
-        for m in &desc.meshes {
-            if !(if camera {
-                m.visibility.camera
-            } else {
-                m.visibility.indirect
-            }) {
-                continue;
-            }
-            for f in m.indices.chunks(3) {
-                let tri = Triangle {
-                    p: [0, 1, 2].map(|k| m.positions[f[k] as usize]),
-                };
-                if let Some(h) = tri.intersect(&r) {
-                    r.t_max = h.t;
-                    best = Some(h.t);
-                }
-            }
-        }
-        for s in &desc.spheres {
-            let sphere = Sphere {
-                center: s.center,
-                radius: s.radius,
-            };
-            if let Some(t) = sphere.intersect(&r) {
-                r.t_max = t;
-                best = Some(t);
-            }
-        }
-        best
-    }
-
-    #[test]
-    fn simd_traversal_finds_what_testing_every_shape_finds() {
-        // Two triangle soups (one hidden from camera rays) and spheres among them, so that
-        // blocks mix triangles, spheres and visibilities.
-        let mut rng = pathlab_mc::rng::Pcg32::new(21, 3);
-        let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
-        let soup = |point: &mut dyn FnMut() -> Vec3, n: usize, visibility| {
-            let mut positions = Vec::new();
-            for _ in 0..n {
-                let c = point() * 10.0;
-                positions.extend([c, c + point() - 0.5, c + point() - 0.5]);
-            }
-            MeshDesc {
-                name: "soup".into(),
-                indices: (0..positions.len() as u32).collect(),
-                positions,
-                visibility,
-                ..Default::default()
-            }
-        };
-        let hidden = Visibility {
-            camera: false,
-            indirect: true,
-        };
-        let desc = SceneDesc {
-            meshes: vec![
-                soup(&mut point, 300, Visibility::ALL),
-                soup(&mut point, 100, hidden),
-            ],
-            spheres: (0..20)
-                .map(|_| crate::desc::SphereDesc {
-                    center: point() * 10.0,
-                    radius: 0.2,
-                    material: 0,
-                    emission: None,
-                })
-                .collect(),
-            materials: vec![diffuse(Vec3::ONE, false)],
-            resolution: [4, 4],
-            ..Default::default()
-        };
-        let scene = Scene::build(&desc).unwrap();
-        let mut hits = 0;
-        for k in 0..3000 {
-            let o = point() * 14.0 - 2.0;
-            let ray = Ray::new(o, point() * 10.0 - o);
-            let camera = k % 2 == 0;
-            let expected = brute_force(&desc, &ray, camera);
-            let mut r = ray;
-            let (portable, _) = scene.closest_hit_with(Portable, &mut r, camera);
-            assert_eq!(portable.map(|_| r.t_max), expected);
-            let found = if camera {
-                scene.intersect_camera(&ray).0
-            } else {
-                scene.intersect(&ray).0
-            };
-            assert_eq!(found.map(|si| si.t), expected);
-            if !camera {
-                assert_eq!(scene.occluded(&ray), expected.is_some());
-                assert_eq!(
-                    scene.any_hit_with(Portable, &ray, false),
-                    expected.is_some()
-                );
-            }
-            hits += usize::from(expected.is_some());
-        }
-        assert!(hits > 300, "{hits} rays hit");
     }
 
     #[test]
