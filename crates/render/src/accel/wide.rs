@@ -1,16 +1,19 @@
 //! Wide bounding volume hierarchies ([`Bvh4`], [`Bvh8`]): each node holds the boxes of up to
 //! four or eight children in structure-of-arrays form, so that one ray is tested against all of
-//! them with the same instructions (the compiler turns the loops over the lanes into SIMD: four
-//! lanes fill an SSE register, eight an AVX one), and the hit children are visited nearest
-//! first.
+//! them with the same instructions, and the hit children are visited nearest first. The box
+//! test is a [`BoxTest`]: loops over the lanes that the compiler vectorises ([`Portable`]), or
+//! on x86-64 CPUs with AVX2 eight lanes in one AVX register ([`crate::simd::Avx2`]), which the
+//! caller picks at run time.
 //!
 //! Built in two steps: a binary tree by the binned surface area heuristic (subtrees built in
 //! parallel with rayon, no allocation per binning step), then collapsed into wide nodes by
 //! repeatedly opening the child of largest surface area (Wald et al., "Getting Rid of Packets",
 //! 2008; the same construction as Embree's BVH4 from a binary SAH tree).
 //!
-//! The traversal takes the primitive test as a closure, as [`super::Bvh`] does, so the same
-//! structure serves triangles and spheres.
+//! The traversal takes the leaf test as a closure, so the same structure serves any
+//! primitives: one primitive at a time ([`WideBvh::intersect`], as [`super::Bvh`] does), or
+//! blocks the caller packs the leaves into ([`WideBvh::remap_leaves`]; the scene's blocks of
+//! four triangles).
 
 use super::bvh::{partition, BvhParams};
 use crate::geometry::{Aabb, Ray};
@@ -37,7 +40,7 @@ const FAR_SCALE: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON * 0.5 / (1.0 - 3.0 * f32::
 const LEAF: u32 = 1 << 31;
 /// Bits of the first primitive slot of a leaf.
 const SLOT_BITS: u32 = 27;
-/// The most primitives a tree can hold (slots must fit [`SLOT_BITS`]).
+/// The most primitives a tree can hold (a leaf word has 27 bits for its first slot).
 pub const MAX_PRIMITIVES: usize = 1 << SLOT_BITS;
 /// The most primitives one leaf can hold.
 const MAX_LEAF: usize = 16;
@@ -59,7 +62,7 @@ fn leaf_range(word: u32) -> (u32, u32) {
 }
 
 /// One node: `W` children's boxes (lanes), each an inner node (the child word is the node
-/// index), a leaf (the word has [`LEAF`] set), or empty (an inverted box).
+/// index), a leaf (the word has its top bit set), or empty (an inverted box).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct Node<const W: usize> {
