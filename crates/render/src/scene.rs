@@ -97,6 +97,8 @@ pub struct BuildStats {
 #[derive(Clone, Debug)]
 pub struct Scene {
     triangles: Vec<Triangle>,
+    /// Unit geometric normal of each triangle (its winding's side), computed once.
+    tri_ng: Vec<Vec3>,
     tri_material: Vec<u32>,
     tri_light: Vec<u32>,
     /// Per-triangle vertex texture coordinates (empty when no mesh has any).
@@ -316,6 +318,7 @@ impl Scene {
             tri_order.extend((0..triangles.len() as u32).filter(|&t| !seen[t as usize]));
         }
         let triangles = permute(&triangles, &tri_order);
+        let tri_ng: Vec<Vec3> = triangles.iter().map(Triangle::normal).collect();
         let tri_material = permute(&tri_material, &tri_order);
         let tri_light = permute(&tri_light, &tri_order);
         let tri_visibility = permute(&tri_visibility, &tri_order);
@@ -379,6 +382,7 @@ impl Scene {
         };
         Ok(Scene {
             triangles,
+            tri_ng,
             tri_material,
             tri_light,
             tri_uv,
@@ -421,6 +425,7 @@ impl Scene {
     pub fn geometry_bytes(&self) -> usize {
         use std::mem::size_of_val;
         size_of_val(self.triangles.as_slice())
+            + size_of_val(self.tri_ng.as_slice())
             + size_of_val(self.tri_material.as_slice())
             + size_of_val(self.tri_light.as_slice())
             + size_of_val(self.tri_uv.as_slice())
@@ -495,7 +500,7 @@ impl Scene {
                 Prim::Triangle(i) => {
                     let tri = &self.triangles[i as usize];
                     let p = (1.0 - b1 - b2) * tri.p[0] + b1 * tri.p[1] + b2 * tri.p[2];
-                    let ng = tri.normal();
+                    let ng = self.tri_ng[i as usize];
                     let light = self.tri_light[i as usize];
                     let uv = match self.tri_uv.get(i as usize) {
                         Some(uv) => (1.0 - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2],
