@@ -26,3 +26,19 @@ for m in meshes:
           f"{ours['bytes_per_triangle']:6.0f} {agree:8.4f}")
 print("(each cell: pathlab/Embree; ratio = pathlab / Embree, so > 1 is faster throughput, "
       "< 1 is faster build)")
+
+# The obvhs crate's compressed wide BVH on the same rays, where pathlab was built with it.
+rows = [(m, json.load(open(f"{work}/{m}.pathlab.json"))) for m in meshes]
+rows = [(m, d) for m, d in rows if "obvhs" in d.get("binary_bvh_baseline", {})]
+if rows:
+    print()
+    print(f"{'mesh':<12} | {'obvhs build s':>13} | {'obvhs primary 1T':>17} {'pathlab/obvhs':>14} | "
+          f"{'obvhs bounce 1T':>16} {'pathlab/obvhs':>14}")
+    for m, d in rows:
+        o = d["binary_bvh_baseline"]["obvhs"]
+        sets = {s["rays"]: s for s in d["sets"]}
+        p1 = sets["primary"]["mrays_per_s_1_thread"]
+        b1 = sets["bounce"]["mrays_per_s_1_thread"]
+        print(f"{m:<12} | {o['build_seconds']:13.3f} | {o['primary']['mrays_per_s']:17.2f} "
+              f"{p1 / o['primary']['mrays_per_s']:14.2f} | {o['bounce']['mrays_per_s']:16.2f} "
+              f"{b1 / o['bounce']['mrays_per_s']:14.2f}")

@@ -16,7 +16,8 @@ work="$root/target/bench"
 what="${1:-all}"
 mkdir -p "$work"
 cd "$root"
-cargo build --release --quiet
+# The obvhs feature adds that crate's BVH as a second baseline to `pathlab bench rays`.
+cargo build --release --quiet -p pathlab --features obvhs
 pathlab="$root/target/release/pathlab"
 
 apt_install() {

@@ -312,6 +312,16 @@ fn rays(args: &RaysArgs) -> Result<()> {
             baseline["wide"]["primary"].as_f64().unwrap_or(0.0),
             baseline["wide"]["bounce"].as_f64().unwrap_or(0.0),
         );
+        if let Some(o) = baseline.get("obvhs") {
+            println!(
+                "  obvhs (medium build), 1 thread: build {:.3} s, primary {:.2} / bounce {:.2} Mrays/s, hits agreeing {:.4}% / {:.4}%",
+                o["build_seconds"].as_f64().unwrap_or(0.0),
+                o["primary"]["mrays_per_s"].as_f64().unwrap_or(0.0),
+                o["bounce"]["mrays_per_s"].as_f64().unwrap_or(0.0),
+                100.0 * o["primary"]["agreement"].as_f64().unwrap_or(0.0),
+                100.0 * o["bounce"]["agreement"].as_f64().unwrap_or(0.0),
+            );
+        }
     }
     let worst = sets
         .iter()
@@ -375,7 +385,8 @@ fn binary_baseline(
     let wide_build = start.elapsed().as_secs_f64();
     let trace_binary = |r: &mut Ray| binary.intersect(r, hit).0;
     let trace_wide = |r: &mut Ray| wide.intersect(r, hit).0;
-    json!({
+    #[allow(unused_mut)]
+    let mut out = json!({
         "binary": {
             "build_seconds": binary_build,
             "primary": rate(primary, &trace_binary),
@@ -386,5 +397,67 @@ fn binary_baseline(
             "primary": rate(primary, &trace_wide),
             "bounce": rate(bounce, &trace_wide),
         },
+    });
+    #[cfg(feature = "obvhs")]
+    {
+        out["obvhs"] = obvhs_baseline(&triangles, primary, bounce, repeat);
+    }
+    out
+}
+
+/// The obvhs crate's compressed wide BVH (its `medium_build` preset, "around the same build
+/// time as Embree") on the same triangles and rays, one thread, with its own Möller–Trumbore
+/// test: build seconds, Mrays/s and agreement with Embree's hits.
+#[cfg(feature = "obvhs")]
+fn obvhs_baseline(
+    triangles: &[pathlab_render::shape::Triangle],
+    primary: &[FileRay],
+    bounce: &[FileRay],
+    repeat: u32,
+) -> serde_json::Value {
+    use obvhs::{cwbvh::builder::build_cwbvh_from_tris, ray::RayHit, BvhBuildParams};
+    let tris: Vec<obvhs::triangle::Triangle> = triangles
+        .iter()
+        .map(|t| obvhs::triangle::Triangle {
+            v0: t.p[0].into(),
+            v1: t.p[1].into(),
+            v2: t.p[2].into(),
+        })
+        .collect();
+    let start = Instant::now();
+    let bvh = build_cwbvh_from_tris(
+        &tris,
+        BvhBuildParams::medium_build(),
+        &mut std::time::Duration::default(),
+    );
+    let build_seconds = start.elapsed().as_secs_f64();
+    let trace = |r: &FileRay| {
+        let ray = obvhs::ray::Ray::new(r.o.into(), r.d.into(), r.t_near, f32::INFINITY);
+        let mut hit = RayHit::none();
+        if bvh.ray_traverse(ray, &mut hit, |ray, id| {
+            tris[bvh.primitive_indices[id] as usize].intersect(ray)
+        }) {
+            hit.t
+        } else {
+            f32::INFINITY
+        }
+    };
+    let set = |rays: &[FileRay]| {
+        let mut best = 0.0f64;
+        let mut hits = Vec::new();
+        for _ in 0..repeat.max(1) {
+            let start = Instant::now();
+            hits = rays.iter().map(trace).collect::<Vec<f32>>();
+            best = best.max(rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6);
+        }
+        json!({
+            "mrays_per_s": best,
+            "agreement": agreement(rays, &hits) as f64 / rays.len().max(1) as f64,
+        })
+    };
+    json!({
+        "build_seconds": build_seconds,
+        "primary": set(primary),
+        "bounce": set(bounce),
     })
 }
