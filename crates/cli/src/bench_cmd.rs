@@ -141,20 +141,15 @@ fn trace_all(
     }
 }
 
-/// Best throughput in Mrays/s over `repeat` runs, and the hits of the last run.
-fn timed(
-    scene: &Scene,
-    rays: &[FileRay],
-    pool: Option<&rayon::ThreadPool>,
-    query: Query,
-    repeat: u32,
-) -> (f64, Vec<f32>) {
+/// Best throughput in Mrays/s over `repeat` runs of `trace` (which traces all `count` rays and
+/// returns their hit distances), and the hits of the last run.
+fn timed(count: usize, repeat: u32, mut trace: impl FnMut() -> Vec<f32>) -> (f64, Vec<f32>) {
     let mut best = 0.0f64;
     let mut hits = Vec::new();
     for _ in 0..repeat.max(1) {
         let start = Instant::now();
-        hits = trace_all(scene, rays, pool, query);
-        let rate = rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6;
+        hits = trace();
+        let rate = count as f64 / start.elapsed().as_secs_f64() / 1e6;
         best = best.max(rate);
     }
     (best, hits)
@@ -249,10 +244,14 @@ fn rays(args: &RaysArgs) -> Result<()> {
         .context("cannot start the worker threads")?;
     let mut sets = Vec::new();
     for (name, rays) in [("primary", &primary), ("bounce", &bounce)] {
-        let (one, hits) = timed(&scene, rays, None, Query::Distance, args.repeat);
-        let (all, _) = timed(&scene, rays, Some(&pool), Query::Distance, args.repeat);
-        let (with_interaction, full_hits) =
-            timed(&scene, rays, None, Query::Interaction, args.repeat);
+        let run = |pool, query| {
+            timed(rays.len(), args.repeat, || {
+                trace_all(&scene, rays, pool, query)
+            })
+        };
+        let (one, hits) = run(None, Query::Distance);
+        let (all, _) = run(Some(&pool), Query::Distance);
+        let (with_interaction, full_hits) = run(None, Query::Interaction);
         let agree = agreement(rays, &hits).min(agreement(rays, &full_hits));
         let visited: u64 = rays
             .iter()
@@ -443,13 +442,7 @@ fn obvhs_baseline(
         }
     };
     let set = |rays: &[FileRay]| {
-        let mut best = 0.0f64;
-        let mut hits = Vec::new();
-        for _ in 0..repeat.max(1) {
-            let start = Instant::now();
-            hits = rays.iter().map(trace).collect::<Vec<f32>>();
-            best = best.max(rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6);
-        }
+        let (best, hits) = timed(rays.len(), repeat, || rays.iter().map(trace).collect());
         json!({
             "mrays_per_s": best,
             "agreement": agreement(rays, &hits) as f64 / rays.len().max(1) as f64,

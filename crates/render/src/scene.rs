@@ -112,8 +112,6 @@ pub struct Scene {
     prims: Vec<Prim>,
     /// Whether every primitive is seen by every ray (the common case, checked once).
     all_visible: bool,
-    /// Whether any primitive is a sphere (lanes of blocks other than triangles).
-    has_spheres: bool,
     /// The BVH, whose leaves name ranges of `blocks`.
     bvh: Bvh8,
     /// The primitives of the BVH's leaves, four to a block, in leaf order.
@@ -392,7 +390,6 @@ impl Scene {
             sphere_light,
             prims,
             all_visible,
-            has_spheres: stats.spheres > 0,
             bvh,
             blocks,
             block_info,

@@ -19,7 +19,7 @@ pub struct BvhParams {
     pub bins: usize,
     /// Cost of a traversal step relative to one primitive test.
     pub traversal_cost: f32,
-    /// Primitives a leaf test handles together (the 4-wide tree's SAH counts a leaf's cost in
+    /// Primitives a leaf test handles together (the wide trees' SAH counts a leaf's cost in
     /// blocks of this many; 1 counts primitives, as the binary tree always does).
     pub leaf_block: usize,
     /// The wide trees' cost of splitting a set that could be a leaf into two leaves (which the

@@ -121,8 +121,6 @@ impl<const W: usize> Node<W> {
 #[derive(Clone, Debug)]
 pub struct WideBvh<const W: usize> {
     nodes: Vec<Node<W>>,
-    /// Levels of wide nodes on the longest path from the root.
-    depth: usize,
     /// Primitive indices in leaf order.
     prim_indices: Vec<u32>,
     bounds: Aabb,
@@ -137,7 +135,6 @@ impl<const W: usize> Default for WideBvh<W> {
     fn default() -> Self {
         WideBvh {
             nodes: Vec::new(),
-            depth: 0,
             prim_indices: Vec::new(),
             bounds: Aabb::EMPTY,
         }
@@ -394,37 +391,34 @@ impl<const W: usize> WideBvh<W> {
         let root = build_binary(&mut prims, 0, &params, 0);
         let mut bvh = WideBvh {
             nodes: Vec::with_capacity(prims.len() / 2 + 1),
-            depth: 0,
             prim_indices: prims.iter().map(|p| p.index).collect(),
             bounds: *root.bounds(),
         };
         match &root {
             BuildNode::Leaf { .. } => {
                 let mut node = Node::EMPTY;
-                bvh.set_lane(&mut node, 0, &root, 1);
-                bvh.depth = 1;
+                bvh.set_lane(&mut node, 0, &root);
                 bvh.nodes.push(node);
             }
             BuildNode::Inner { .. } => {
-                bvh.collapse(&root, 1);
+                bvh.collapse(&root);
             }
         }
         bvh
     }
 
-    fn set_lane(&mut self, node: &mut Node<W>, lane: usize, child: &BuildNode, depth: usize) {
+    fn set_lane(&mut self, node: &mut Node<W>, lane: usize, child: &BuildNode) {
         node.set_bounds(lane, child.bounds());
         node.valid |= 1 << lane;
         node.child[lane] = match child {
             BuildNode::Leaf { start, count, .. } => leaf_word(*start, *count),
-            BuildNode::Inner { .. } => self.collapse(child, depth + 1) as u32,
+            BuildNode::Inner { .. } => self.collapse(child) as u32,
         };
     }
 
     /// Makes the wide node of an inner binary node: its two children, opened (the largest
     /// inner one first) until there are `W`; returns the node's index.
-    fn collapse(&mut self, inner: &BuildNode, depth: usize) -> usize {
-        self.depth = self.depth.max(depth);
+    fn collapse(&mut self, inner: &BuildNode) -> usize {
         let BuildNode::Inner { children, .. } = inner else {
             unreachable!("collapse is called on inner nodes only");
         };
@@ -451,7 +445,7 @@ impl<const W: usize> WideBvh<W> {
         self.nodes.push(Node::EMPTY);
         let mut node = Node::EMPTY;
         for (lane, child) in lanes.into_iter().enumerate() {
-            self.set_lane(&mut node, lane, child, depth);
+            self.set_lane(&mut node, lane, child);
         }
         self.nodes[index] = node;
         index
@@ -576,24 +570,13 @@ impl<const W: usize> WideBvh<W> {
         &self,
         boxes: impl BoxTest<W>,
         ray: &mut Ray,
-        leaf: impl FnMut(u32, &mut Ray) -> bool,
+        mut leaf: impl FnMut(u32, &mut Ray) -> bool,
     ) -> (bool, u32) {
         if self.nodes.is_empty() {
             return (false, 0);
         }
-        self.intersect_with::<STACK_SIZE>(boxes, ray, leaf)
-    }
-
-    /// [`WideBvh::intersect_leaves`] with a stack of `N` entries (at least (W - 1) × depth + 1).
-    #[inline(always)]
-    fn intersect_with<const N: usize>(
-        &self,
-        boxes: impl BoxTest<W>,
-        ray: &mut Ray,
-        mut leaf: impl FnMut(u32, &mut Ray) -> bool,
-    ) -> (bool, u32) {
         let rb = RayBoxes::new(ray);
-        let mut stack = Stack::<u64, N>::new();
+        let mut stack = Stack::<u64, STACK_SIZE>::new();
         let mut word = 0u32; // the root, an inner node
         let mut visited = 0u32;
         let mut any = false;
@@ -685,24 +668,13 @@ impl<const W: usize> WideBvh<W> {
         &self,
         boxes: impl BoxTest<W>,
         ray: &Ray,
-        leaf: impl FnMut(u32, &Ray) -> bool,
+        mut leaf: impl FnMut(u32, &Ray) -> bool,
     ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        self.occluded_with::<STACK_SIZE>(boxes, ray, leaf)
-    }
-
-    /// [`WideBvh::occluded_leaves`] with a stack of `N` entries (at least (W - 1) × depth + 1).
-    #[inline(always)]
-    fn occluded_with<const N: usize>(
-        &self,
-        boxes: impl BoxTest<W>,
-        ray: &Ray,
-        mut leaf: impl FnMut(u32, &Ray) -> bool,
-    ) -> bool {
         let rb = RayBoxes::new(ray);
-        let mut stack = Stack::<u32, N>::new();
+        let mut stack = Stack::<u32, STACK_SIZE>::new();
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];

@@ -40,7 +40,7 @@ impl Scene {
     /// and the lanes it tests as spheres.
     #[inline(always)]
     fn block_lanes(&self, b: usize, camera: bool) -> (u32, u32) {
-        if self.all_visible && !self.has_spheres {
+        if self.all_visible && self.spheres.is_empty() {
             // Unused lanes never hit, so all four can be tested.
             return (0b1111, 0);
         }
@@ -182,8 +182,8 @@ pub(super) fn leaf_blocks(
     let mut info = Vec::with_capacity(prims.len() / 2 + 1);
     bvh.remap_leaves(|start, count| {
         let first = blocks.len() as u32;
-        let slots: Vec<u32> = (start..start + count).collect();
-        for chunk in slots.chunks(LANES) {
+        for chunk_start in (start..start + count).step_by(LANES) {
+            let chunk = chunk_start..(chunk_start + LANES as u32).min(start + count);
             let mut lanes = BlockInfo {
                 slots: [u32::MAX; LANES],
                 spheres: 0,
@@ -191,7 +191,7 @@ pub(super) fn leaf_blocks(
                 indirect: 0,
             };
             let mut tris = [Triangle { p: [Vec3::ZERO; 3] }; LANES];
-            for (lane, &slot) in chunk.iter().enumerate() {
+            for (lane, slot) in chunk.enumerate() {
                 lanes.slots[lane] = slot;
                 match prims[slot as usize] {
                     Prim::Triangle(t) => tris[lane] = triangles[t as usize],
