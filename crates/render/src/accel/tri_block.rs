@@ -1,6 +1,7 @@
 //! Four triangles laid out for one ray to test them together: the Möller–Trumbore test of
 //! [`Triangle::intersect`], with the vertex and both edges of each lane stored side by side
-//! (structure of arrays), so that the compiler turns the loops over the four lanes into SIMD.
+//! (structure of arrays), so that the four lanes are computed together: in SSE registers on
+//! x86-64, as loops over the lanes (which the compiler vectorises in part) elsewhere.
 //!
 //! Every lane computes exactly what [`Triangle::intersect`] computes, in the same order, so a
 //! block reports the same distances and barycentrics to the bit.
@@ -69,11 +70,23 @@ impl TriBlock {
         b
     }
 
-    /// Tests all four lanes.
-    // The lane conditions are comparisons joined by `&`: the range form branches.
-    #[allow(clippy::manual_range_contains)]
+    /// Tests all four lanes: in SSE registers on x86-64 (the comparisons too, which the
+    /// compiler leaves as scalar code in the lane loop), with lane loops elsewhere. Both give
+    /// the same results.
     #[inline(always)]
     fn test(&self, ray: &Ray) -> LaneHits {
+        #[cfg(target_arch = "x86_64")]
+        return self.test_sse(ray);
+        #[cfg(not(target_arch = "x86_64"))]
+        return self.test_lanes(ray);
+    }
+
+    /// [`TriBlock::test`] as loops over the lanes.
+    // The lane conditions are comparisons joined by `&`: the range form branches.
+    #[allow(clippy::manual_range_contains)]
+    #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+    #[inline(always)]
+    fn test_lanes(&self, ray: &Ray) -> LaneHits {
         let (o, d) = (ray.o, ray.d);
         let mut t = [0.0f32; LANES];
         let mut b1 = [0.0f32; LANES];
@@ -106,7 +119,7 @@ impl TriBlock {
             let dist = (e2[0] * qvec[0] + e2[1] * qvec[1] + e2[2] * qvec[2]) * inv_det;
             // The scalar test's conditions; NaNs fail every comparison, as there. (Written as
             // comparisons joined by `&`, not `&&` or range `contains`, so that no lane
-            // branches and the loop stays one SIMD sequence.)
+            // branches.)
             ok[lane] = (det != 0.0)
                 & (det.abs() < f32::INFINITY)
                 & (u >= 0.0)
@@ -124,6 +137,77 @@ impl TriBlock {
             mask |= u32::from(hit) << lane;
         }
         LaneHits { t, b1, b2, mask }
+    }
+
+    /// [`TriBlock::test_lanes`] in SSE registers: the same operations in the same order (no
+    /// fused multiply-adds), so the same bits; the comparisons have the scalar ones' NaN
+    /// behaviour (`!=` is true for NaN, the others false).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn test_sse(&self, ray: &Ray) -> LaneHits {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE and SSE2, all these intrinsics need, are part of the x86-64 baseline;
+        // the loads and stores go through `[f32; 4]`s, 16 bytes each, all they move.
+        unsafe {
+            let load = |a: &[f32; LANES]| _mm_loadu_ps(a.as_ptr());
+            let store = |v: __m128| {
+                let mut a = [0.0f32; LANES];
+                _mm_storeu_ps(a.as_mut_ptr(), v);
+                a
+            };
+            let mul = |a, b| _mm_mul_ps(a, b);
+            let sub = |a, b| _mm_sub_ps(a, b);
+            let add = |a, b| _mm_add_ps(a, b);
+            let splat = |x| _mm_set1_ps(x);
+            let (dx, dy, dz) = (splat(ray.d.x), splat(ray.d.y), splat(ray.d.z));
+            let e1 = [load(&self.e1[0]), load(&self.e1[1]), load(&self.e1[2])];
+            let e2 = [load(&self.e2[0]), load(&self.e2[1]), load(&self.e2[2])];
+            let pvec = [
+                sub(mul(dy, e2[2]), mul(e2[1], dz)),
+                sub(mul(dz, e2[0]), mul(e2[2], dx)),
+                sub(mul(dx, e2[1]), mul(e2[0], dy)),
+            ];
+            let dot = |a: &[__m128; 3], b: &[__m128; 3]| {
+                add(add(mul(a[0], b[0]), mul(a[1], b[1])), mul(a[2], b[2]))
+            };
+            let det = dot(&e1, &pvec);
+            let inv_det = _mm_div_ps(splat(1.0), det);
+            let tvec = [
+                sub(splat(ray.o.x), load(&self.v0[0])),
+                sub(splat(ray.o.y), load(&self.v0[1])),
+                sub(splat(ray.o.z), load(&self.v0[2])),
+            ];
+            let u = mul(dot(&tvec, &pvec), inv_det);
+            let qvec = [
+                sub(mul(tvec[1], e1[2]), mul(e1[1], tvec[2])),
+                sub(mul(tvec[2], e1[0]), mul(e1[2], tvec[0])),
+                sub(mul(tvec[0], e1[1]), mul(e1[0], tvec[1])),
+            ];
+            let v = mul(dot(&[dx, dy, dz], &qvec), inv_det);
+            let dist = mul(dot(&e2, &qvec), inv_det);
+            let zero = _mm_setzero_ps();
+            let one = splat(1.0);
+            let abs_det = _mm_andnot_ps(splat(-0.0), det);
+            let ok = [
+                _mm_cmpneq_ps(det, zero),
+                _mm_cmplt_ps(abs_det, splat(f32::INFINITY)),
+                _mm_cmpge_ps(u, zero),
+                _mm_cmple_ps(u, one),
+                _mm_cmpge_ps(v, zero),
+                _mm_cmple_ps(add(u, v), one),
+                _mm_cmpgt_ps(dist, splat(ray.t_min)),
+                _mm_cmplt_ps(dist, splat(ray.t_max)),
+            ]
+            .into_iter()
+            .reduce(|a, b| _mm_and_ps(a, b))
+            .unwrap_or(zero);
+            LaneHits {
+                t: store(dist),
+                b1: store(u),
+                b2: store(v),
+                mask: _mm_movemask_ps(ok) as u32,
+            }
+        }
     }
 
     /// The nearest hit within `(ray.t_min, ray.t_max)` among the lanes in `lanes` (bit per
@@ -220,6 +304,42 @@ mod tests {
                 .map(|(lane, tri)| u32::from(tri.intersect(&ray).is_some()) << lane)
                 .sum();
             assert_eq!(block.hits(&ray, lanes), any & lanes);
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn sse_and_lane_loops_give_the_same_bits() {
+        let mut rng = Pcg32::new(11, 2);
+        let bits = |a: [f32; LANES]| a.map(f32::to_bits);
+        let specials = [0.0, -0.0, f32::INFINITY, f32::NAN, 1e-30];
+        for round in 0..20_000 {
+            let tris: Vec<Triangle> = (0..round % (LANES + 1))
+                .map(|_| Triangle {
+                    p: [
+                        random_point(&mut rng),
+                        random_point(&mut rng),
+                        random_point(&mut rng),
+                    ],
+                })
+                .collect();
+            let block = TriBlock::new(&tris);
+            let o = random_point(&mut rng) * 3.0;
+            let mut d = random_point(&mut rng) - o * 0.3;
+            if round % 13 == 0 {
+                // Zero, infinite, NaN and tiny components.
+                d[round % 3] = specials[(round / 13) % specials.len()];
+            }
+            let ray = Ray {
+                t_min: if round % 3 == 0 { 0.5 } else { 0.0 },
+                t_max: if round % 5 == 0 { 1.5 } else { f32::INFINITY },
+                ..Ray::new(o, d)
+            };
+            let (a, b) = (block.test_sse(&ray), block.test_lanes(&ray));
+            assert_eq!(a.mask, b.mask, "round {round}");
+            assert_eq!(bits(a.t), bits(b.t), "round {round}");
+            assert_eq!(bits(a.b1), bits(b.b1), "round {round}");
+            assert_eq!(bits(a.b2), bits(b.b2), "round {round}");
         }
     }
 
