@@ -75,7 +75,7 @@ impl Sampler for SobolSampler {
 
     #[inline]
     fn next_1d(&mut self) -> f32 {
-        let v = sobol_burley::sample(self.index(), 0, self.seed_for(self.dimension));
+        let v = padded_1d(self.index(), self.seed_for(self.dimension));
         self.dimension += 1;
         v
     }
@@ -84,9 +84,89 @@ impl Sampler for SobolSampler {
     fn next_2d(&mut self) -> Vec2 {
         // Dimensions 0 and 1 of the four `sample_4d` computes together (with SIMD, and one
         // index shuffle): the same values as two `sample` calls, at about a third of the cost.
-        let [x, y, _, _] = sobol_burley::sample_4d(self.index(), 0, self.seed_for(self.dimension));
+        let [x, y] = padded_2d(self.index(), self.seed_for(self.dimension));
         let v = Vec2::new(x, y);
         self.dimension += 2;
         v
+    }
+}
+
+// The first two Sobol dimensions in closed form. `sobol_burley` evaluates any dimension by
+// XOR-ing one direction vector per set bit of the shuffled index (a loop of up to 16 steps with
+// an unpredictable exit); the padded sampler needs only dimensions 0 and 1, whose generator
+// matrices are the identity (van der Corput) and Pascal's triangle mod 2, both computable in a
+// few bit operations. The index shuffle and the scrambles are the crate's own (`parts`), so the
+// samples are `sobol_burley::sample(i, 0, seed)` and the first two of
+// `sobol_burley::sample_4d(i, 0, seed)` to the bit (tested over every index).
+
+/// The seed of the index shuffle, as `sobol_burley` derives it.
+const SHUFFLE_SEED: u32 = 0x79c6_8e4a;
+/// `sobol_burley`'s seed multiplier and per-dimension constants of the output scrambles.
+const SCRAMBLE_MUL: u32 = 0x9c8f_2d3b;
+const SCRAMBLE_DIM: [u32; 2] = [0x912f_69ba, 0x174f_18ab];
+
+/// The 16-bit shuffled sample index (`sobol_burley` keeps its top 16 bits reversed).
+#[inline(always)]
+fn shuffled_index(sample_index: u32, seed: u32) -> u32 {
+    use sobol_burley::parts::{hash, owen_scramble_rev};
+    let rev = owen_scramble_rev(sample_index.reverse_bits(), hash(seed ^ SHUFFLE_SEED));
+    (rev & 0xffff_0000).reverse_bits()
+}
+
+/// Sobol dimension 1 of index `n` (< 2^16), bit-reversed: bit `j` is the parity of the set bits
+/// `k` of `n` with binomial(k, j) odd, i.e. with `j`'s bits a subset of `k`'s (Lucas), so the
+/// sum over supersets of each bit position, taken one position bit at a time.
+#[inline(always)]
+fn pascal_rev(n: u32) -> u32 {
+    let mut y = n;
+    y ^= (y >> 1) & 0x5555;
+    y ^= (y >> 2) & 0x3333;
+    y ^= (y >> 4) & 0x0f0f;
+    y ^= (y >> 8) & 0x00ff;
+    y
+}
+
+/// Owen-scrambles the bit-reversed Sobol value `sobol_rev` of dimension `dim` as
+/// `sobol_burley` does, and maps it to [0, 1).
+#[inline(always)]
+fn scrambled(sobol_rev: u32, dim: usize, seed: u32) -> f32 {
+    use sobol_burley::parts::{hash, owen_scramble_rev, u32_to_f32_norm};
+    let scramble = seed.wrapping_mul(SCRAMBLE_MUL) ^ SCRAMBLE_DIM[dim];
+    u32_to_f32_norm(owen_scramble_rev(sobol_rev, hash(scramble)).reverse_bits())
+}
+
+/// `sobol_burley::sample(sample_index, 0, seed)`.
+#[inline]
+fn padded_1d(sample_index: u32, seed: u32) -> f32 {
+    // Dimension 0's generator is the identity: the bit-reversed value is the index itself.
+    scrambled(shuffled_index(sample_index, seed), 0, seed)
+}
+
+/// The first two values of `sobol_burley::sample_4d(sample_index, 0, seed)`.
+#[inline]
+fn padded_2d(sample_index: u32, seed: u32) -> [f32; 2] {
+    let n = shuffled_index(sample_index, seed);
+    [scrambled(n, 0, seed), scrambled(pascal_rev(n), 1, seed)]
+}
+
+#[cfg(test)]
+mod closed_form_tests {
+    use super::*;
+
+    #[test]
+    fn first_two_dimensions_match_sobol_burley_at_every_index() {
+        for seed in [0u32, 1, 0xdead_beef, 0x8000_0000, u32::MAX] {
+            for i in 0..SEQUENCE_LENGTH {
+                let [x, y, _, _] = sobol_burley::sample_4d(i, 0, seed);
+                let [a, b] = padded_2d(i, seed);
+                assert_eq!(
+                    (a.to_bits(), b.to_bits()),
+                    (x.to_bits(), y.to_bits()),
+                    "{i} {seed}"
+                );
+                let one = sobol_burley::sample(i, 0, seed);
+                assert_eq!(padded_1d(i, seed).to_bits(), one.to_bits(), "{i} {seed}");
+            }
+        }
     }
 }
