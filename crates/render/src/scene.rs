@@ -6,7 +6,7 @@ use crate::camera::Camera;
 use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc, Visibility};
 use crate::envmap::EnvironmentMap;
 use crate::geometry::{Aabb, Ray};
-use crate::light::{bounding_radius, AreaShape, Light, LightSampler};
+use crate::light::{bounding_radius, AreaShape, AreaTriangle, Light, LightSampler};
 use crate::shape::{Sphere, Triangle};
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
@@ -214,7 +214,7 @@ impl Scene {
                 tri_light.push(add_area_light(
                     &mut lights,
                     &mut sampleable,
-                    AreaShape::Triangle(t),
+                    AreaShape::Triangle(AreaTriangle::new(t)),
                     mesh.emission,
                     mesh.visibility,
                 ));
