@@ -188,7 +188,14 @@ impl RayBoxes {
         let inv_d = ray.d.recip();
         // Written out rather than with `array::map`, which is not inlined here.
         let plane = |axis: usize, upper: bool| axis + 3 * usize::from(upper);
-        let neg = [inv_d.x < 0.0, inv_d.y < 0.0, inv_d.z < 0.0];
+        // The planes come from the direction's signs, which 1/d keeps (-0 gives -∞), rather
+        // than from 1/d: the node's loads then need not wait for the division. (A NaN
+        // component makes every distance on its axis NaN, whichever planes it picks.)
+        let neg = [
+            ray.d.x.is_sign_negative(),
+            ray.d.y.is_sign_negative(),
+            ray.d.z.is_sign_negative(),
+        ];
         RayBoxes {
             o: ray.o.to_array(),
             inv_d: inv_d.to_array(),
