@@ -35,7 +35,8 @@ mod test_util {
     }
 
     /// Checks a BVH's closest-hit and any-hit traversals against testing every box, for
-    /// `count` random rays from PCG32 stream (`seed`, `stream`).
+    /// `count` random rays from PCG32 stream (`seed`, `stream`), a third of them starting at
+    /// a `t_min` above 0 (boxes whose entry lies before it are not hit).
     pub fn check_against_brute_force(
         boxes: &[Aabb],
         count: usize,
@@ -52,17 +53,25 @@ mod test_util {
                 rng.uniform_f32() - 0.5,
                 rng.uniform_f32() - 0.5,
             );
-            let mut brute = Ray::new(o, d);
+            let t_min = if rng.uniform_f32() < 1.0 / 3.0 {
+                rng.uniform_f32() * 20.0
+            } else {
+                0.0
+            };
+            let start = Ray {
+                t_min,
+                ..Ray::new(o, d)
+            };
+            let mut brute = start;
             let any_brute = (0..boxes.len() as u32).fold(false, |a, i| hit(i, &mut brute) | a);
-            let mut ray = Ray::new(o, d);
+            let mut ray = start;
             let (any, visited) = intersect(&mut ray, &hit);
             assert_eq!(any, any_brute);
             assert_eq!(ray.t_max, brute.t_max);
             assert!(visited >= 1);
-            let blocked = occluded(&Ray::new(o, d), &|i, r| {
-                boxes[i as usize]
-                    .hit(r.o, r.d.recip(), r.t_max)
-                    .is_some_and(|t| t > 0.0)
+            let blocked = occluded(&start, &|i, r| {
+                let mut r = *r;
+                hit(i, &mut r)
             });
             assert_eq!(blocked, any_brute);
         }
@@ -71,7 +80,7 @@ mod test_util {
     /// Ray-box "primitive": a hit at the box's entry distance.
     pub fn box_hit(boxes: &[Aabb]) -> impl Fn(u32, &mut Ray) -> bool + '_ {
         move |i, ray: &mut Ray| match boxes[i as usize].hit(ray.o, ray.d.recip(), ray.t_max) {
-            Some(t) if t > 0.0 && t < ray.t_max => {
+            Some(t) if t > ray.t_min.max(0.0) && t < ray.t_max => {
                 ray.t_max = t;
                 true
             }

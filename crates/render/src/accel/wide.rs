@@ -172,6 +172,10 @@ impl BuildNode {
 /// The ray quantities every box test uses.
 #[doc(hidden)]
 pub struct RayBoxes {
+    /// Where entry distances start: the ray's `t_min` (0 if negative or NaN), so that boxes
+    /// the ray leaves before it are culled (a ray leaving a surface with `t_min` > 0 does not
+    /// descend into the boxes around its origin).
+    t_min: f32,
     o: [f32; 3],
     inv_d: [f32; 3],
     /// `inv_d` widened by [`FAR_SCALE`], for far planes.
@@ -197,6 +201,7 @@ impl RayBoxes {
             ray.d.z.is_sign_negative(),
         ];
         RayBoxes {
+            t_min: ray.t_min.max(0.0),
             o: ray.o.to_array(),
             inv_d: inv_d.to_array(),
             inv_far: (inv_d * FAR_SCALE).to_array(),
@@ -206,10 +211,10 @@ impl RayBoxes {
     }
 
     /// Entry distances of the four lanes and the mask (bit per lane) of those the ray meets
-    /// within (0, t_max).
+    /// within (t_min, t_max).
     #[inline(always)]
     fn test<const W: usize>(&self, n: &Node<W>, t_max: f32) -> ([f32; W], u32) {
-        let mut t_near = [0.0f32; W];
+        let mut t_near = [self.t_min; W];
         let mut t_far = [t_max; W];
         for axis in 0..3 {
             let near = &n.planes[self.near[axis]];
@@ -237,7 +242,7 @@ impl RayBoxes {
 /// the instructions a CPU extension offers (on x86-64, [`crate::simd::Avx2`] for eight lanes).
 /// Every implementation gives the same entry distances and mask.
 pub trait BoxTest<const W: usize>: Copy {
-    /// Entry distances of the lanes and the mask of those `ray` meets within `(0, t_max)`.
+    /// Entry distances of the lanes and the mask of those `ray` meets within `(t_min, t_max)` (`t_min` the ray's).
     #[doc(hidden)]
     fn test(self, ray: &RayBoxes, node: &Node<W>, t_max: f32) -> ([f32; W], u32);
 }
@@ -279,7 +284,7 @@ unsafe fn test8_avx2(ray: &RayBoxes, n: &Node<8>, t_max: f32) -> ([f32; 8], u32)
     // SAFETY: the caller guarantees AVX; the loads and the store go through pointers to
     // `[f32; 8]`, valid for exactly the 32 bytes each moves.
     unsafe {
-        let mut t_near = _mm256_setzero_ps();
+        let mut t_near = _mm256_set1_ps(ray.t_min);
         let mut t_far = _mm256_set1_ps(t_max);
         for axis in 0..3 {
             let o = _mm256_set1_ps(ray.o[axis]);
@@ -907,6 +912,23 @@ mod tests {
             }
         }
         assert!(tested > 1000);
+    }
+
+    #[test]
+    fn boxes_left_before_t_min_are_culled_at_the_root() {
+        let boxes = random_boxes(2000, 3);
+        let bvh = Bvh8::build(&boxes, BvhParams::default());
+        // From the middle of the boxes ([0, 10]³), starting past all of them.
+        let mut ray = Ray {
+            t_min: 20.0,
+            ..Ray::new(Vec3::splat(5.0), Vec3::new(0.3, -0.5, 0.8).normalize())
+        };
+        let (any, visited) = bvh.intersect(&mut ray, box_hit(&boxes));
+        assert!(!any);
+        assert_eq!(visited, 1);
+        // The same ray from t = 0 descends.
+        let mut ray = Ray { t_min: 0.0, ..ray };
+        assert!(bvh.intersect(&mut ray, box_hit(&boxes)).1 > 1);
     }
 
     #[test]
