@@ -122,13 +122,8 @@ impl Scene {
                     });
                     any = true;
                 }
-                let mut spheres = spheres;
-                while spheres != 0 {
-                    let lane = spheres.trailing_zeros() as usize;
-                    spheres &= spheres - 1;
-                    let slot = self.block_info[b].slots[lane];
-                    if let Some(t) = self.sphere_at(slot).intersect(r) {
-                        r.t_max = t;
+                if spheres != 0 {
+                    if let Some(slot) = self.nearest_sphere(b, spheres, r) {
                         best = Some(Hit {
                             slot,
                             b1: 0.0,
@@ -143,28 +138,53 @@ impl Scene {
         (best, visited)
     }
 
+    /// The leaf slot of the nearest sphere among lanes `spheres` of block `b` that `ray` hits
+    /// within its extent, shortening `ray.t_max` to it. Kept out of line: spheres are rare, and
+    /// inlined, their set-up (in `f64`) is hoisted to the start of every traversal.
+    #[cold]
+    #[inline(never)]
+    fn nearest_sphere(&self, b: usize, mut spheres: u32, ray: &mut Ray) -> Option<u32> {
+        let mut nearest = None;
+        while spheres != 0 {
+            let lane = spheres.trailing_zeros() as usize;
+            spheres &= spheres - 1;
+            let slot = self.block_info[b].slots[lane];
+            if let Some(t) = self.sphere_at(slot).intersect(ray) {
+                ray.t_max = t;
+                nearest = Some(slot);
+            }
+        }
+        nearest
+    }
+
+    /// Whether `ray` hits any sphere among lanes `spheres` of block `b` within its extent
+    /// (out of line, as [`Scene::nearest_sphere`]).
+    #[cold]
+    #[inline(never)]
+    fn hits_sphere(&self, b: usize, mut spheres: u32, ray: &Ray) -> bool {
+        while spheres != 0 {
+            let lane = spheres.trailing_zeros() as usize;
+            spheres &= spheres - 1;
+            if self
+                .sphere_at(self.block_info[b].slots[lane])
+                .intersect(ray)
+                .is_some()
+            {
+                return true;
+            }
+        }
+        false
+    }
+
     /// [`Scene::any_hit`] with the box test `boxes`.
     #[inline(always)]
     fn any_hit_with(&self, boxes: impl BoxTest<8>, ray: &Ray, camera: bool) -> bool {
         self.bvh.occluded_leaves_with(boxes, ray, |leaf, r| {
             let (first, count) = Bvh8::leaf_range(leaf);
             (first as usize..(first + count) as usize).any(|b| {
-                let (triangles, mut spheres) = self.block_lanes(b, camera);
-                if self.blocks[b].hits(r, triangles) != 0 {
-                    return true;
-                }
-                while spheres != 0 {
-                    let lane = spheres.trailing_zeros() as usize;
-                    spheres &= spheres - 1;
-                    if self
-                        .sphere_at(self.block_info[b].slots[lane])
-                        .intersect(r)
-                        .is_some()
-                    {
-                        return true;
-                    }
-                }
-                false
+                let (triangles, spheres) = self.block_lanes(b, camera);
+                self.blocks[b].hits(r, triangles) != 0
+                    || (spheres != 0 && self.hits_sphere(b, spheres, r))
             })
         })
     }
