@@ -43,7 +43,7 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
     threads="$(nproc)"
     for m in "${meshes[@]}"; do
         "$work/embree_bench" "$work/$m.obj" "$threads" "$work/$m.rays" > "$work/$m.embree.txt"
-        "$pathlab" bench rays "$work/$m.obj" "$work/$m.rays" --json > "$work/$m.pathlab.json"
+        "$pathlab" bench rays "$work/$m.obj" "$work/$m.rays" --repeat 5 --json > "$work/$m.pathlab.json"
     done
     python3 "$root/bench/rays_table.py" "$work" "${meshes[@]}"
 fi
