@@ -76,21 +76,20 @@ impl Pcg32 {
     /// Jumps `delta` steps ahead in O(log delta) time (Brown, "Random number generation with
     /// arbitrary strides", 1994): the result equals calling [`Pcg32::next_u32`] `delta` times.
     pub fn advance(&mut self, delta: u64) {
-        let mut cur_mult = PCG32_MULT;
-        let mut cur_plus = self.inc;
-        let mut acc_mult: u64 = 1;
-        let mut acc_plus: u64 = 0;
-        let mut delta = delta;
-        while delta > 0 {
-            if delta & 1 == 1 {
-                acc_mult = acc_mult.wrapping_mul(cur_mult);
-                acc_plus = acc_plus.wrapping_mul(cur_mult).wrapping_add(cur_plus);
-            }
-            cur_plus = cur_mult.wrapping_add(1).wrapping_mul(cur_plus);
-            cur_mult = cur_mult.wrapping_mul(cur_mult);
-            delta >>= 1;
-        }
-        self.state = acc_mult.wrapping_mul(self.state).wrapping_add(acc_plus);
+        let (mult, plus) = jump_coefficients(delta);
+        self.state = mult
+            .wrapping_mul(self.state)
+            .wrapping_add(plus.wrapping_mul(self.inc));
+    }
+
+    /// Moves to the same dimension of the next pixel sample: [`Pcg32::advance`] by
+    /// [`DIMENSIONS_PER_SAMPLE`], in one multiply-add.
+    #[inline]
+    pub fn skip_pixel_sample(&mut self) {
+        let (mult, plus) = SAMPLE_JUMP;
+        self.state = mult
+            .wrapping_mul(self.state)
+            .wrapping_add(plus.wrapping_mul(self.inc));
     }
 
     /// The generator for one pixel sample: stream chosen by `(seed, pixel)`, positioned at
@@ -101,6 +100,27 @@ impl Pcg32 {
         rng
     }
 }
+
+/// `(m, p)` such that `delta` steps of the generator take `state` to `m · state + p · inc`
+/// (Brown, "Random Number Generation with Arbitrary Strides", 1994): the multiplier and
+/// increment of `delta` steps, built by squaring; the increment's part is linear in `inc`.
+const fn jump_coefficients(mut delta: u64) -> (u64, u64) {
+    let (mut cur_mult, mut cur_plus) = (PCG32_MULT, 1u64);
+    let (mut acc_mult, mut acc_plus) = (1u64, 0u64);
+    while delta > 0 {
+        if delta & 1 == 1 {
+            acc_mult = acc_mult.wrapping_mul(cur_mult);
+            acc_plus = acc_plus.wrapping_mul(cur_mult).wrapping_add(cur_plus);
+        }
+        cur_plus = cur_mult.wrapping_add(1).wrapping_mul(cur_plus);
+        cur_mult = cur_mult.wrapping_mul(cur_mult);
+        delta >>= 1;
+    }
+    (acc_mult, acc_plus)
+}
+
+/// [`jump_coefficients`] for one pixel sample.
+const SAMPLE_JUMP: (u64, u64) = jump_coefficients(DIMENSIONS_PER_SAMPLE);
 
 /// A 64-bit finaliser with good avalanche (every input bit flips each output bit with
 /// probability close to 1/2); the constants are those of Stafford's "Mix13" variant.

@@ -12,15 +12,20 @@ pub struct IndependentSampler {
     samples_per_pixel: u32,
     seed: u64,
     rng: Pcg32,
+    /// The pixel and sample index last started, and the generator at its dimension 0: the
+    /// next sample of the same pixel starts one jump from there instead of from the hash.
+    start: ([u32; 2], u32, Pcg32),
 }
 
 impl IndependentSampler {
     /// A sampler for `samples_per_pixel` samples (the count is only reported; any index works).
     pub fn new(samples_per_pixel: u32, seed: u64) -> Self {
+        let rng = Pcg32::for_pixel_sample(seed, [0, 0], 0, 0);
         IndependentSampler {
             samples_per_pixel,
             seed,
-            rng: Pcg32::for_pixel_sample(seed, [0, 0], 0, 0),
+            rng: rng.clone(),
+            start: ([0, 0], 0, rng),
         }
     }
 }
@@ -31,7 +36,23 @@ impl Sampler for IndependentSampler {
     }
 
     fn start_pixel_sample(&mut self, pixel: [u32; 2], sample_index: u32, dimension: u32) {
-        self.rng = Pcg32::for_pixel_sample(self.seed, pixel, sample_index, dimension);
+        // The same numbers as `Pcg32::for_pixel_sample(seed, pixel, sample_index, dimension)`
+        // (tested); renders ask for a pixel's samples in order, one jump apart.
+        let (last_pixel, last_index, ref last) = self.start;
+        let at_zero = if last_pixel == pixel && last_index.checked_add(1) == Some(sample_index) {
+            let mut rng = last.clone();
+            rng.skip_pixel_sample();
+            rng
+        } else if last_pixel == pixel && last_index == sample_index {
+            last.clone()
+        } else {
+            Pcg32::for_pixel_sample(self.seed, pixel, sample_index, 0)
+        };
+        self.rng = at_zero.clone();
+        if dimension > 0 {
+            self.rng.advance(u64::from(dimension));
+        }
+        self.start = (pixel, sample_index, at_zero);
     }
 
     #[inline]
@@ -43,5 +64,39 @@ impl Sampler for IndependentSampler {
     fn next_2d(&mut self) -> Vec2 {
         let x = self.rng.uniform_f32();
         Vec2::new(x, self.rng.uniform_f32())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn starts_where_the_hashed_stream_does_in_any_order() {
+        let mut s = IndependentSampler::new(16, 9);
+        let mut order = Pcg32::new(1, 2);
+        let mut requests = Vec::new();
+        for pixel in [[0, 0], [3, 4], [3, 5]] {
+            requests.extend((0..20).map(|i| (pixel, i, 0)));
+        }
+        for _ in 0..200 {
+            let pixel = [order.next_u32() % 3, order.next_u32() % 2];
+            let i = order.next_u32() % 4;
+            let d = if order.next_u32() % 4 == 0 {
+                order.next_u32() % 100
+            } else {
+                0
+            };
+            requests.push((pixel, i, d));
+        }
+        requests.push(([1, 1], u32::MAX, 0));
+        requests.push(([1, 1], 0, 0));
+        for (pixel, i, d) in requests {
+            s.start_pixel_sample(pixel, i, d);
+            let mut expected = Pcg32::for_pixel_sample(9, pixel, i, d);
+            for _ in 0..3 {
+                assert_eq!(s.next_1d(), expected.uniform_f32(), "{pixel:?} {i} {d}");
+            }
+        }
     }
 }
