@@ -253,20 +253,20 @@ mod tests {
         Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 2.0 - 1.0
     }
 
+    fn random_triangles(rng: &mut Pcg32, n: usize) -> Vec<Triangle> {
+        (0..n)
+            .map(|_| Triangle {
+                p: [random_point(rng), random_point(rng), random_point(rng)],
+            })
+            .collect()
+    }
+
     #[test]
     fn agrees_with_the_scalar_test_to_the_bit() {
         let mut rng = Pcg32::new(3, 5);
         for round in 0..20_000 {
             let n = round % (LANES + 1);
-            let mut tris: Vec<Triangle> = (0..n)
-                .map(|_| Triangle {
-                    p: [
-                        random_point(&mut rng),
-                        random_point(&mut rng),
-                        random_point(&mut rng),
-                    ],
-                })
-                .collect();
+            let mut tris = random_triangles(&mut rng, n);
             if n > 1 && round % 7 == 0 {
                 // Equal distances in two lanes, and a degenerate triangle.
                 tris[1] = tris[0];
@@ -314,15 +314,7 @@ mod tests {
         let bits = |a: [f32; LANES]| a.map(f32::to_bits);
         let specials = [0.0, -0.0, f32::INFINITY, f32::NAN, 1e-30];
         for round in 0..20_000 {
-            let tris: Vec<Triangle> = (0..round % (LANES + 1))
-                .map(|_| Triangle {
-                    p: [
-                        random_point(&mut rng),
-                        random_point(&mut rng),
-                        random_point(&mut rng),
-                    ],
-                })
-                .collect();
+            let tris = random_triangles(&mut rng, round % (LANES + 1));
             let block = TriBlock::new(&tris);
             let o = random_point(&mut rng) * 3.0;
             let mut d = random_point(&mut rng) - o * 0.3;
