@@ -82,8 +82,7 @@ impl Sampler for SobolSampler {
 
     #[inline]
     fn next_2d(&mut self) -> Vec2 {
-        // Dimensions 0 and 1 of the four `sample_4d` computes together (with SIMD, and one
-        // index shuffle): the same values as two `sample` calls, at about a third of the cost.
+        // Dimensions 0 and 1 with one index shuffle (see `padded_2d`).
         let [x, y] = padded_2d(self.index(), self.seed_for(self.dimension));
         let v = Vec2::new(x, y);
         self.dimension += 2;

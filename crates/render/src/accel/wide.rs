@@ -242,7 +242,8 @@ impl RayBoxes {
 /// the instructions a CPU extension offers (on x86-64, [`crate::simd::Avx2`] for eight lanes).
 /// Every implementation gives the same entry distances and mask.
 pub trait BoxTest<const W: usize>: Copy {
-    /// Entry distances of the lanes and the mask of those `ray` meets within `(t_min, t_max)` (`t_min` the ray's).
+    /// Entry distances of the lanes and the mask of those `ray` meets within
+    /// `(t_min, t_max)` (`t_min` the ray's).
     #[doc(hidden)]
     fn test(self, ray: &RayBoxes, node: &Node<W>, t_max: f32) -> ([f32; W], u32);
 }
