@@ -82,7 +82,7 @@ mod tests {
         for _ in 0..200 {
             let pixel = [order.next_u32() % 3, order.next_u32() % 2];
             let i = order.next_u32() % 4;
-            let d = if order.next_u32() % 4 == 0 {
+            let d = if order.next_u32().is_multiple_of(4) {
                 order.next_u32() % 100
             } else {
                 0
