@@ -172,9 +172,10 @@ impl BuildNode {
 /// The ray quantities every box test uses.
 #[doc(hidden)]
 pub struct RayBoxes {
-    /// Where entry distances start: the ray's `t_min` (0 if negative or NaN), so that boxes
-    /// the ray leaves before it are culled (a ray leaving a surface with `t_min` > 0 does not
-    /// descend into the boxes around its origin).
+    /// Where entry distances start: the ray's `t_min` (+0 if not positive, -0 and NaN
+    /// included), so that boxes the ray leaves before it are culled (a ray leaving a surface
+    /// with `t_min` > 0 does not descend into the boxes around its origin). Never negative,
+    /// not even -0, whose bits would sort the stack entries as the largest distances.
     t_min: f32,
     o: [f32; 3],
     inv_d: [f32; 3],
@@ -201,7 +202,7 @@ impl RayBoxes {
             ray.d.z.is_sign_negative(),
         ];
         RayBoxes {
-            t_min: ray.t_min.max(0.0),
+            t_min: if ray.t_min > 0.0 { ray.t_min } else { 0.0 },
             o: ray.o.to_array(),
             inv_d: inv_d.to_array(),
             inv_far: (inv_d * FAR_SCALE).to_array(),
@@ -210,7 +211,7 @@ impl RayBoxes {
         }
     }
 
-    /// Entry distances of the four lanes and the mask (bit per lane) of those the ray meets
+    /// Entry distances of the `W` lanes and the mask (bit per lane) of those the ray meets
     /// within (t_min, t_max).
     #[inline(always)]
     fn test<const W: usize>(&self, n: &Node<W>, t_max: f32) -> ([f32; W], u32) {
@@ -913,6 +914,19 @@ mod tests {
             }
         }
         assert!(tested > 1000);
+    }
+
+    #[test]
+    fn entry_distances_start_at_a_non_negative_t_min() {
+        // Stack entries order by the bits of their distances, so the start must be +0 for
+        // -0, negative and NaN `t_min` alike.
+        for (t_min, start) in [(-0.0, 0.0), (-1.0, 0.0), (f32::NAN, 0.0), (0.5, 0.5)] {
+            let ray = Ray {
+                t_min,
+                ..Ray::new(Vec3::ZERO, Vec3::X)
+            };
+            assert_eq!(RayBoxes::new(&ray).t_min.to_bits(), f32::to_bits(start));
+        }
     }
 
     #[test]
