@@ -107,7 +107,11 @@ impl Scene {
         ray: &mut Ray,
         camera: bool,
     ) -> (Option<Hit>, u32) {
-        let mut best: Option<Hit> = None;
+        // The nearest hit's fields as separate scalars (`slot` u32::MAX: none): the leaf test
+        // writes them one by one, and reading them back one by one lets the loads take the
+        // stored values directly, where reading a whole `Option<Hit>` with one wide load waits
+        // for the narrow stores to complete.
+        let (mut slot, mut b1, mut b2) = (u32::MAX, 0.0f32, 0.0f32);
         let (_, visited) = self.bvh.intersect_leaves_with(boxes, ray, |leaf, r| {
             let (first, count) = Bvh8::leaf_range(leaf);
             let mut any = false;
@@ -115,26 +119,19 @@ impl Scene {
                 let (triangles, spheres) = self.block_lanes(b, camera);
                 if let Some(h) = self.blocks[b].intersect(r, triangles) {
                     r.t_max = h.t;
-                    best = Some(Hit {
-                        slot: self.block_info[b].slots[h.lane],
-                        b1: h.b1,
-                        b2: h.b2,
-                    });
+                    (slot, b1, b2) = (self.block_info[b].slots[h.lane], h.b1, h.b2);
                     any = true;
                 }
                 if spheres != 0 {
-                    if let Some(slot) = self.nearest_sphere(b, spheres, r) {
-                        best = Some(Hit {
-                            slot,
-                            b1: 0.0,
-                            b2: 0.0,
-                        });
+                    if let Some(s) = self.nearest_sphere(b, spheres, r) {
+                        (slot, b1, b2) = (s, 0.0, 0.0);
                         any = true;
                     }
                 }
             }
             any
         });
+        let best = (slot != u32::MAX).then_some(Hit { slot, b1, b2 });
         (best, visited)
     }
 
