@@ -174,6 +174,20 @@ fn alias_table_fits_its_pmf() {
 }
 
 #[test]
+fn alias_choose_draws_what_sample_draws() {
+    // `choose` is `sample` without the remapped number: the same index and probability for
+    // every u, so the chi-square test of `sample` covers it.
+    let w: Vec<f64> = weights(50, 9).iter().map(|&x| x as f64).collect();
+    let t = AliasTable::new(&w).unwrap();
+    let edges = [0.0, 0.5, 1.0f32.next_down()];
+    let us = draws(20_000, 19, |s| s.next_1d());
+    for u in us.into_iter().chain(edges) {
+        let s = t.sample(u);
+        assert_eq!(t.choose(u), (s.index, s.pmf), "u = {u}");
+    }
+}
+
+#[test]
 fn alias_remapped_u_is_uniform() {
     // The remapped number must itself be uniform, so it can drive a second decision.
     let w = [1.0, 2.0, 3.0, 0.5];

@@ -406,8 +406,8 @@ impl LightSampler {
     #[inline]
     pub fn sample(&self, u: f32) -> Option<(usize, f32)> {
         self.table.as_ref().map(|t| {
-            let s = t.sample(u);
-            (s.index, s.pmf as f32)
+            let (index, pmf) = t.choose(u);
+            (index, pmf as f32)
         })
     }
 

@@ -93,13 +93,20 @@ impl AliasTable {
         self.pmf.get(index).copied().unwrap_or(0.0)
     }
 
-    /// An index drawn with probability [`AliasTable::pmf`], from `u` in [0, 1).
-    pub fn sample(&self, u: f32) -> AliasSample {
+    /// The bin `u` in [0, 1) falls in, where within the bin it lies (in [0, 1]), and the bin.
+    #[inline]
+    fn bin(&self, u: f32) -> (usize, f64, Bin) {
         let n = self.bins.len();
         let scaled = u as f64 * n as f64;
         let offset = (scaled as usize).min(n - 1);
         let up = (scaled - offset as f64).clamp(0.0, 1.0);
-        let bin = self.bins[offset];
+        (offset, up, self.bins[offset])
+    }
+
+    /// An index drawn with probability [`AliasTable::pmf`], from `u` in [0, 1).
+    #[inline]
+    pub fn sample(&self, u: f32) -> AliasSample {
+        let (offset, up, bin) = self.bin(u);
         let one_below = 1.0f32.next_down();
         if up < bin.q {
             AliasSample {
@@ -114,5 +121,15 @@ impl AliasTable {
                 u_remapped: (((up - bin.q) / (1.0 - bin.q)) as f32).min(one_below),
             }
         }
+    }
+
+    /// The index and probability [`AliasTable::sample`] draws from `u`, without the remapped
+    /// random number: for callers that do not reuse it, a select instead of a branch and a
+    /// division.
+    #[inline]
+    pub fn choose(&self, u: f32) -> (usize, f64) {
+        let (offset, up, bin) = self.bin(u);
+        let index = if up < bin.q { offset } else { bin.alias };
+        (index, self.pmf[index])
     }
 }
