@@ -1,10 +1,9 @@
 //! The render loop: tiles on rayon, one sampler stream per pixel, pixel statistics on the film.
 
 use crate::film::{Film, PixelStats};
-use crate::integrator::{Integrator, PathStats};
+use crate::integrator::{Integrator, PathStats, SampleRef};
 use crate::scene::Scene;
-use glam::Vec2;
-use pathlab_mc::sampler::{Sampler, SamplerKind};
+use pathlab_mc::sampler::SamplerKind;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -149,20 +148,30 @@ pub fn sample_pixel(
     path: &mut PathStats,
 ) -> (u64, u64) {
     let (mut ok, mut bad) = (0, 0);
-    for i in range {
-        sampler.start_pixel_sample([x, y], i, 0);
-        let film = Vec2::new(x as f32, y as f32) + sampler.next_pixel_2d();
-        let u_lens = sampler.next_2d();
-        let ray = scene.camera().generate_ray(film, u_lens);
-        let l = integrator.li(scene, ray, sampler, path);
-        if l.is_finite() {
-            px.add(l);
-            ok += 1;
-        } else {
-            bad += 1;
-        }
-    }
+    let mut samples = range.map(|index| SampleRef {
+        pixel: [x, y],
+        index,
+        tag: 0,
+    });
+    integrator.li_samples(
+        scene,
+        sampler,
+        &mut samples,
+        &mut |_, l| add_sample(px, l, &mut ok, &mut bad),
+        path,
+    );
     (ok, bad)
+}
+
+/// Adds radiance `l` to `px` when it is finite (counting it in `ok`), else counts it in `bad`.
+#[inline]
+fn add_sample(px: &mut PixelStats, l: crate::desc::Rgb, ok: &mut u64, bad: &mut u64) {
+    if l.is_finite() {
+        px.add(l);
+        *ok += 1;
+    } else {
+        *bad += 1;
+    }
 }
 
 /// Renders `scene` with `integrator`.
@@ -204,37 +213,57 @@ pub fn render(
                 samples: 0,
                 nonfinite: 0,
             };
-            for y in y0..y0 + h {
-                for x in x0..x0 + w {
-                    if cancel.load(Ordering::Relaxed) {
-                        continue;
-                    }
-                    let px = &mut out.pixels[((y - y0) * w + (x - x0)) as usize];
-                    let batch = settings.adaptive.map_or(settings.spp, |a| a.batch.max(1));
-                    let mut i = 0;
-                    while i < settings.spp {
-                        if i > 0
-                            && settings
-                                .adaptive
-                                .is_some_and(|a| a.converged(px.luminance()))
-                        {
-                            break;
+            if let Some(adaptive) = settings.adaptive {
+                for y in y0..y0 + h {
+                    for x in x0..x0 + w {
+                        if cancel.load(Ordering::Relaxed) {
+                            continue;
                         }
-                        let end = (i + batch).min(settings.spp);
-                        let (ok, bad) = sample_pixel(
-                            scene,
-                            integrator,
-                            &mut sampler,
-                            [x, y],
-                            i..end,
-                            px,
-                            &mut out.path,
-                        );
-                        out.samples += ok;
-                        out.nonfinite += bad;
-                        i = end;
+                        let px = &mut out.pixels[((y - y0) * w + (x - x0)) as usize];
+                        let batch = adaptive.batch.max(1);
+                        let mut i = 0;
+                        while i < settings.spp {
+                            if i > 0 && adaptive.converged(px.luminance()) {
+                                break;
+                            }
+                            let end = (i + batch).min(settings.spp);
+                            let (ok, bad) = sample_pixel(
+                                scene,
+                                integrator,
+                                &mut sampler,
+                                [x, y],
+                                i..end,
+                                px,
+                                &mut out.path,
+                            );
+                            out.samples += ok;
+                            out.nonfinite += bad;
+                            i = end;
+                        }
                     }
                 }
+            } else {
+                // The whole tile in one go, pixel after pixel, so that an integrator following
+                // several paths at once keeps them all busy to the tile's end. A cancelled
+                // render starts no further pixel.
+                let spp = settings.spp;
+                let mut samples = (0..w * h)
+                    .take_while(|_| !cancel.load(Ordering::Relaxed))
+                    .flat_map(|tag| {
+                        let pixel = [x0 + tag % w, y0 + tag / w];
+                        (0..spp).map(move |index| SampleRef { pixel, index, tag })
+                    });
+                let (mut ok, mut bad) = (0, 0);
+                let pixels = &mut out.pixels;
+                integrator.li_samples(
+                    scene,
+                    &mut sampler,
+                    &mut samples,
+                    &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
+                    &mut out.path,
+                );
+                out.samples += ok;
+                out.nonfinite += bad;
             }
             // Progress counts the budget of every pixel done, also where adaptive sampling
             // stopped early, so that the bar ends at 100%.

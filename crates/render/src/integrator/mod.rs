@@ -20,7 +20,7 @@ use crate::desc::Rgb;
 use crate::geometry::{offset_ray_origin, spawn_ray_to, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::{Vec2, Vec3};
-use pathlab_mc::sampler::AnySampler;
+use pathlab_mc::sampler::{AnySampler, Sampler};
 
 /// Counters an integrator keeps while it works.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -39,11 +39,51 @@ impl PathStats {
     }
 }
 
+/// One pixel sample to estimate: its pixel, its index among the pixel's samples, and a tag
+/// by which the caller files the result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SampleRef {
+    /// The pixel.
+    pub pixel: [u32; 2],
+    /// The sample's index in the pixel (what positions the sampler).
+    pub index: u32,
+    /// The caller's tag for the result.
+    pub tag: u32,
+}
+
 /// Computes the radiance along camera rays.
 pub trait Integrator: Sync {
     /// An estimate of the radiance arriving at the camera along `ray`, from the sampler's
     /// next dimensions.
     fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb;
+
+    /// Estimates each of `samples`: positions `sampler` at the sample, makes its camera ray
+    /// ([`camera_ray`]) and hands `(tag, radiance)` to `out`. By default one sample after
+    /// another with [`Integrator::li`]; an integrator that follows several paths together may
+    /// finish them in another order, always the same one for the same samples.
+    fn li_samples(
+        &self,
+        scene: &Scene,
+        sampler: &mut AnySampler,
+        samples: &mut dyn Iterator<Item = SampleRef>,
+        out: &mut dyn FnMut(u32, Rgb),
+        stats: &mut PathStats,
+    ) {
+        for s in samples {
+            let ray = camera_ray(scene, sampler, s);
+            out(s.tag, self.li(scene, ray, sampler, stats));
+        }
+    }
+}
+
+/// Positions `sampler` at pixel sample `s` and makes its camera ray from the first
+/// dimensions: the position in the pixel, then the point on the lens.
+#[inline]
+pub fn camera_ray(scene: &Scene, sampler: &mut AnySampler, s: SampleRef) -> Ray {
+    sampler.start_pixel_sample(s.pixel, s.index, 0);
+    let film = Vec2::new(s.pixel[0] as f32, s.pixel[1] as f32) + sampler.next_pixel_2d();
+    let u_lens = sampler.next_2d();
+    scene.camera().generate_ray(film, u_lens)
 }
 
 /// Which integrator, with its settings.
@@ -63,6 +103,21 @@ impl Integrator for IntegratorKind {
             IntegratorKind::Path(i) => i.li(scene, ray, sampler, stats),
             IntegratorKind::Direct(i) => i.li(scene, ray, sampler, stats),
             IntegratorKind::Debug(i) => i.li(scene, ray, sampler, stats),
+        }
+    }
+
+    fn li_samples(
+        &self,
+        scene: &Scene,
+        sampler: &mut AnySampler,
+        samples: &mut dyn Iterator<Item = SampleRef>,
+        out: &mut dyn FnMut(u32, Rgb),
+        stats: &mut PathStats,
+    ) {
+        match self {
+            IntegratorKind::Path(i) => i.li_samples(scene, sampler, samples, out, stats),
+            IntegratorKind::Direct(i) => i.li_samples(scene, sampler, samples, out, stats),
+            IntegratorKind::Debug(i) => i.li_samples(scene, sampler, samples, out, stats),
         }
     }
 }

@@ -1,7 +1,8 @@
 use super::{emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats};
 use crate::desc::Rgb;
 use crate::geometry::{spawn_ray, Ray};
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceInteraction};
+use glam::Vec3;
 use pathlab_mc::sampler::{AnySampler, Sampler};
 
 /// Unidirectional path tracing with next-event estimation and MIS.
@@ -59,21 +60,52 @@ impl Default for PathIntegrator {
     }
 }
 
-impl Integrator for PathIntegrator {
-    fn li(
-        &self,
-        scene: &Scene,
-        mut ray: Ray,
-        sampler: &mut AnySampler,
-        stats: &mut PathStats,
-    ) -> Rgb {
-        let mut l = Rgb::ZERO;
-        let mut beta = Rgb::ONE;
-        let n_light = self.light_samples.max(1);
-        // MIS weight of emission found by a BSDF-sampled direction of density `pdf_bsdf`
-        // (infinite after a delta bounce) that light sampling would find with `pdf_light`.
-        let bsdf_weight = |pdf_bsdf: f32, pdf_light: f32| match self.lighting {
-            PathLighting::Mis => power_heuristic(1, pdf_bsdf, n_light, pdf_light),
+/// Where a path stands between bounces: the radiance gathered so far, the throughput, the
+/// ray it follows next and what MIS needs of the vertex it left.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathState {
+    /// Radiance gathered so far.
+    pub(crate) l: Rgb,
+    /// Throughput: the product of f |cos θ| / p (and the Russian-roulette divisions) so far.
+    pub(crate) beta: Rgb,
+    /// The ray the path follows next.
+    pub(crate) ray: Ray,
+    /// The previous vertex and the BSDF density of the direction that left it (infinite for a
+    /// delta lobe, which gives emission found through it MIS weight one); none for the camera.
+    pub(crate) prev: Option<(Vec3, f32)>,
+    /// Bounces so far (0: the camera ray).
+    pub(crate) depth: u32,
+}
+
+impl PathState {
+    /// A path starting with camera ray `ray`.
+    pub(crate) fn new(ray: Ray) -> Self {
+        PathState {
+            l: Rgb::ZERO,
+            beta: Rgb::ONE,
+            ray,
+            prev: None,
+            depth: 0,
+        }
+    }
+}
+
+impl PathIntegrator {
+    /// Number of light samples per vertex.
+    fn n_light(&self) -> u32 {
+        self.light_samples.max(1)
+    }
+
+    /// Whether the radiance of bounce `bounce` counts.
+    fn wants(&self, bounce: u32) -> bool {
+        self.only_bounce.is_none_or(|k| k == bounce)
+    }
+
+    /// MIS weight of emission found by a BSDF-sampled direction of density `pdf_bsdf`
+    /// (infinite after a delta bounce) that light sampling would find with `pdf_light`.
+    fn bsdf_weight(&self, pdf_bsdf: f32, pdf_light: f32) -> f32 {
+        match self.lighting {
+            PathLighting::Mis => power_heuristic(1, pdf_bsdf, self.n_light(), pdf_light),
             PathLighting::Bsdf => 1.0,
             PathLighting::Light => {
                 if pdf_bsdf.is_infinite() {
@@ -82,81 +114,133 @@ impl Integrator for PathIntegrator {
                     0.0
                 }
             }
-        };
-        let bsdf_samples = u32::from(self.lighting == PathLighting::Mis);
-        let wants = |bounce: u32| self.only_bounce.is_none_or(|k| k == bounce);
-        // The previous vertex and the BSDF density of the direction that left it (infinite
-        // for a delta lobe, which gives emission found through it MIS weight one).
-        let mut prev: Option<(glam::Vec3, f32)> = None;
-        let mut depth = 0u32;
-        loop {
-            let Some(si) = trace(scene, &ray, depth == 0, stats) else {
-                if let Some((le, pdf_light)) = escaped(scene, &ray) {
-                    let w = prev.map_or(1.0, |(_, pdf_bsdf)| bsdf_weight(pdf_bsdf, pdf_light));
-                    if wants(depth) {
-                        l += beta * w * le;
-                    }
-                }
-                break;
-            };
-            let wo = -ray.d;
-            let p_prev = prev.map_or(ray.o, |(p, _)| p);
-            if let Some((le, pdf_light)) = emitted(scene, p_prev, &ray, &si) {
-                let w = prev.map_or(1.0, |(_, pdf_bsdf)| bsdf_weight(pdf_bsdf, pdf_light));
-                if wants(depth) {
-                    l += beta * w * le;
-                }
-            }
-            if depth >= self.max_depth {
-                break;
-            }
-            let bsdf = scene.bsdf(&si, wo);
-            if wants(depth + 1) && !bsdf.is_delta() && self.lighting != PathLighting::Bsdf {
-                let mut ld = Rgb::ZERO;
-                for _ in 0..n_light {
-                    let u_select = sampler.next_1d();
-                    let u_light = sampler.next_2d();
-                    ld += sample_light(
-                        scene,
-                        &si,
-                        &bsdf,
-                        wo,
-                        u_select,
-                        u_light,
-                        n_light,
-                        bsdf_samples,
-                        stats,
-                    );
-                }
-                l += beta * ld / n_light as f32;
-            } else {
-                for _ in 0..n_light {
-                    sampler.next_1d();
-                    sampler.next_2d();
-                }
-            }
-            let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) else {
-                break;
-            };
-            beta *= bs.f * (bs.wi.dot(si.ns).abs() / bs.pdf);
-            if beta.max_element() <= 0.0 || !beta.is_finite() {
-                break;
-            }
-            prev = Some((si.p, if bs.delta { f32::INFINITY } else { bs.pdf }));
-            depth += 1;
-            let u_rr = sampler.next_1d();
-            if depth >= self.rr_depth {
-                let q = beta.max_element().min(0.95);
-                if u_rr >= q {
-                    break;
-                }
-                beta /= q;
-            }
-            if self.only_bounce.is_some_and(|k| depth > k) {
-                break;
-            }
-            ray = spawn_ray(si.p, si.ng, bs.wi);
         }
-        l
+    }
+
+    /// What the path's ray found, `hit`: adds the environment's radiance (a miss) or the
+    /// surface's emission, weighted by MIS. Returns the surface when the path goes on to
+    /// scatter there.
+    #[inline]
+    pub(crate) fn arrive(
+        &self,
+        scene: &Scene,
+        st: &mut PathState,
+        hit: Option<SurfaceInteraction>,
+    ) -> Option<SurfaceInteraction> {
+        let Some(si) = hit else {
+            if let Some((le, pdf_light)) = escaped(scene, &st.ray) {
+                let w = st
+                    .prev
+                    .map_or(1.0, |(_, pdf_bsdf)| self.bsdf_weight(pdf_bsdf, pdf_light));
+                if self.wants(st.depth) {
+                    st.l += st.beta * w * le;
+                }
+            }
+            return None;
+        };
+        let p_prev = st.prev.map_or(st.ray.o, |(p, _)| p);
+        if let Some((le, pdf_light)) = emitted(scene, p_prev, &st.ray, &si) {
+            let w = st
+                .prev
+                .map_or(1.0, |(_, pdf_bsdf)| self.bsdf_weight(pdf_bsdf, pdf_light));
+            if self.wants(st.depth) {
+                st.l += st.beta * w * le;
+            }
+        }
+        (st.depth < self.max_depth).then_some(si)
+    }
+
+    /// Scattering at `si`: light sampling, then a BSDF-sampled direction and Russian roulette.
+    /// Returns whether the path goes on (along `st.ray`, one bounce deeper).
+    #[inline]
+    pub(crate) fn scatter(
+        &self,
+        scene: &Scene,
+        st: &mut PathState,
+        si: &SurfaceInteraction,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+    ) -> bool {
+        let n_light = self.n_light();
+        let bsdf_samples = u32::from(self.lighting == PathLighting::Mis);
+        let wo = -st.ray.d;
+        let bsdf = scene.bsdf(si, wo);
+        if self.wants(st.depth + 1) && !bsdf.is_delta() && self.lighting != PathLighting::Bsdf {
+            let mut ld = Rgb::ZERO;
+            for _ in 0..n_light {
+                let u_select = sampler.next_1d();
+                let u_light = sampler.next_2d();
+                ld += sample_light(
+                    scene,
+                    si,
+                    &bsdf,
+                    wo,
+                    u_select,
+                    u_light,
+                    n_light,
+                    bsdf_samples,
+                    stats,
+                );
+            }
+            st.l += st.beta * ld / n_light as f32;
+        } else {
+            for _ in 0..n_light {
+                sampler.next_1d();
+                sampler.next_2d();
+            }
+        }
+        let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) else {
+            return false;
+        };
+        st.beta *= bs.f * (bs.wi.dot(si.ns).abs() / bs.pdf);
+        if st.beta.max_element() <= 0.0 || !st.beta.is_finite() {
+            return false;
+        }
+        let pdf = if bs.delta { f32::INFINITY } else { bs.pdf };
+        self.survive(st, si, bs.wi, pdf, sampler.next_1d())
+    }
+
+    /// The end of a bounce whose BSDF sample `wi` (density `pdf`, infinite for a delta lobe)
+    /// left a finite, positive throughput: Russian roulette with `u_rr`, then the ray along
+    /// `wi`. Returns whether the path goes on.
+    #[inline]
+    pub(crate) fn survive(
+        &self,
+        st: &mut PathState,
+        si: &SurfaceInteraction,
+        wi: Vec3,
+        pdf: f32,
+        u_rr: f32,
+    ) -> bool {
+        st.prev = Some((si.p, pdf));
+        st.depth += 1;
+        if st.depth >= self.rr_depth {
+            let q = st.beta.max_element().min(0.95);
+            if u_rr >= q {
+                return false;
+            }
+            st.beta /= q;
+        }
+        if self.only_bounce.is_some_and(|k| st.depth > k) {
+            return false;
+        }
+        st.ray = spawn_ray(si.p, si.ng, wi);
+        true
+    }
+}
+
+impl Integrator for PathIntegrator {
+    fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
+        let mut st = PathState::new(ray);
+        loop {
+            let hit = trace(scene, &st.ray, st.depth == 0, stats);
+            let Some(si) = self.arrive(scene, &mut st, hit) else {
+                break;
+            };
+            if !self.scatter(scene, &mut st, &si, sampler, stats) {
+                break;
+            }
+        }
+        st.l
     }
 }
