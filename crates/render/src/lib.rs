@@ -48,6 +48,7 @@ pub mod film;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;
+pub mod lanes;
 pub mod light;
 pub mod progressive;
 pub mod render;

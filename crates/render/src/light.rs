@@ -28,10 +28,11 @@ pub enum AreaShape {
 pub struct AreaTriangle {
     /// The triangle.
     pub triangle: Triangle,
-    normal: Vec3,
+    /// Unit normal (the winding's side).
+    pub(crate) normal: Vec3,
     area: f32,
     /// `1 / area`, the density per unit area of a uniform point.
-    pdf_area: f32,
+    pub(crate) pdf_area: f32,
 }
 
 impl AreaTriangle {

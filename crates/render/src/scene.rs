@@ -15,7 +15,7 @@ use thiserror::Error;
 
 mod trace;
 
-use trace::{leaf_blocks, BlockInfo, Hit};
+use trace::{leaf_blocks, BlockInfo};
 
 /// Marks a shape that emits no light.
 const NO_LIGHT: u32 = u32::MAX;
@@ -471,11 +471,13 @@ impl Scene {
     }
 
     /// The nearest surface along a camera ray, and the number of BVH nodes visited.
+    #[inline]
     pub fn intersect_camera(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u32) {
         self.intersect_as(ray, true)
     }
 
     /// The nearest surface along any other ray, and the number of BVH nodes visited.
+    #[inline]
     pub fn intersect(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u32) {
         self.intersect_as(ray, false)
     }
@@ -485,67 +487,98 @@ impl Scene {
     /// traversal alone.
     pub fn hit_distance(&self, ray: &Ray) -> Option<f32> {
         let mut r = *ray;
-        self.closest_hit(&mut r, false).0.map(|_| r.t_max)
+        self.closest_hit(&mut r, false).found().then_some(r.t_max)
     }
 
+    #[inline(always)]
     fn intersect_as(&self, ray: &Ray, camera: bool) -> (Option<SurfaceInteraction>, u32) {
+        let mut si = None;
+        let visited = self.intersect_into(ray, camera, &mut si);
+        (si, visited)
+    }
+
+    /// The nearest surface along a camera ray (`camera`) or another ray, written to `si`
+    /// (`None` where the ray escapes); returns the number of BVH nodes visited. Made in place,
+    /// for callers that keep it in an array: moving a fresh interaction there would copy it
+    /// with wide loads of its narrow stores, which wait for them.
+    #[inline(always)]
+    pub fn intersect_into(
+        &self,
+        ray: &Ray,
+        camera: bool,
+        si: &mut Option<SurfaceInteraction>,
+    ) -> u32 {
         let mut r = *ray;
-        let (best, visited) = self.closest_hit(&mut r, camera);
-        let hit = best.map(|Hit { slot, b1, b2 }| {
-            let t = r.t_max;
-            match self.prims[slot as usize] {
-                Prim::Triangle(i) => {
-                    let tri = &self.triangles[i as usize];
-                    let p = (1.0 - b1 - b2) * tri.p[0] + b1 * tri.p[1] + b2 * tri.p[2];
-                    let ng = self.tri_ng[i as usize];
-                    let light = self.tri_light[i as usize];
-                    let uv = match self.tri_uv.get(i as usize) {
-                        Some(uv) => (1.0 - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2],
-                        None => Vec2::new(b1, b2),
-                    };
-                    let ns = match self.tri_normals.get(i as usize) {
-                        Some(n) => ((1.0 - b1 - b2) * n[0] + b1 * n[1] + b2 * n[2])
-                            .try_normalize()
-                            .filter(|ns| ns.dot(ng) > 0.0)
-                            .unwrap_or(ng),
-                        None => ng,
-                    };
-                    SurfaceInteraction {
-                        p,
-                        t,
-                        ng,
-                        ns,
-                        material: self.tri_material[i as usize],
-                        light: (light != NO_LIGHT).then_some(light),
-                        uv,
-                    }
-                }
-                Prim::Sphere(i) => {
-                    let s = &self.spheres[i as usize];
-                    let p = ray.at(t);
-                    let ng = ((p - s.center) / s.radius).normalize();
-                    // Project onto the surface to remove the rounding of the ray parameter.
-                    let p = s.center + ng * s.radius;
-                    let light = self.sphere_light[i as usize];
-                    // Spherical coordinates about z: u = φ / 2π, v = θ / π.
-                    let phi = ng.y.atan2(ng.x);
-                    let uv = Vec2::new(
-                        phi / std::f32::consts::TAU + if phi < 0.0 { 1.0 } else { 0.0 },
-                        ng.z.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
-                    );
-                    SurfaceInteraction {
-                        p,
-                        t,
-                        ng,
-                        ns: ng,
-                        material: self.sphere_material[i as usize],
-                        light: (light != NO_LIGHT).then_some(light),
-                        uv,
-                    }
-                }
+        let hit = self.closest_hit(&mut r, camera);
+        if !hit.found() {
+            *si = None;
+            return hit.visited();
+        }
+        let t = r.t_max;
+        match self.prims[hit.slot() as usize] {
+            Prim::Triangle(i) => {
+                let (b1, b2) = hit.barycentrics();
+                *si = Some(self.triangle_interaction(i, b1, b2, t));
             }
-        });
-        (hit, visited)
+            Prim::Sphere(i) => *si = Some(self.sphere_interaction(i, ray, t)),
+        }
+        hit.visited()
+    }
+
+    /// The surface interaction at barycentrics (b1, b2) of triangle `i`, at distance `t`.
+    #[inline(always)]
+    fn triangle_interaction(&self, i: u32, b1: f32, b2: f32, t: f32) -> SurfaceInteraction {
+        let tri = &self.triangles[i as usize];
+        let p = (1.0 - b1 - b2) * tri.p[0] + b1 * tri.p[1] + b2 * tri.p[2];
+        let ng = self.tri_ng[i as usize];
+        let light = self.tri_light[i as usize];
+        let uv = match self.tri_uv.get(i as usize) {
+            Some(uv) => (1.0 - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2],
+            None => Vec2::new(b1, b2),
+        };
+        let ns = match self.tri_normals.get(i as usize) {
+            Some(n) => ((1.0 - b1 - b2) * n[0] + b1 * n[1] + b2 * n[2])
+                .try_normalize()
+                .filter(|ns| ns.dot(ng) > 0.0)
+                .unwrap_or(ng),
+            None => ng,
+        };
+        SurfaceInteraction {
+            p,
+            t,
+            ng,
+            ns,
+            material: self.tri_material[i as usize],
+            light: (light != NO_LIGHT).then_some(light),
+            uv,
+        }
+    }
+
+    /// The surface interaction where `ray` meets sphere `i` at distance `t`. Out of line:
+    /// spheres are rare, and their set-up would weigh on every triangle hit.
+    #[inline(never)]
+    fn sphere_interaction(&self, i: u32, ray: &Ray, t: f32) -> SurfaceInteraction {
+        let s = &self.spheres[i as usize];
+        let p = ray.at(t);
+        let ng = ((p - s.center) / s.radius).normalize();
+        // Project onto the surface to remove the rounding of the ray parameter.
+        let p = s.center + ng * s.radius;
+        let light = self.sphere_light[i as usize];
+        // Spherical coordinates about z: u = φ / 2π, v = θ / π.
+        let phi = ng.y.atan2(ng.x);
+        let uv = Vec2::new(
+            phi / std::f32::consts::TAU + if phi < 0.0 { 1.0 } else { 0.0 },
+            ng.z.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
+        );
+        SurfaceInteraction {
+            p,
+            t,
+            ng,
+            ns: ng,
+            material: self.sphere_material[i as usize],
+            light: (light != NO_LIGHT).then_some(light),
+            uv,
+        }
     }
 
     /// Whether anything seen by non-camera rays blocks `ray` within its extent.

@@ -598,3 +598,97 @@ fn path_lighting_strategies_agree_under_an_environment_map() {
         );
     }
 }
+
+/// `big_light` with more to trace: a back wall (two-sided, another reflectance) that makes
+/// paths bounce, a mirror sphere (a material the packet path hands to the scalar code) and an
+/// emitting sphere (a light it samples one lane at a time).
+fn mixed_scene() -> SceneDesc {
+    let mut desc = big_light();
+    desc.materials.push(diffuse(Vec3::new(0.2, 0.8, 0.6), true));
+    desc.materials.push(MaterialDesc::Mirror {
+        reflectance: Vec3::splat(0.9),
+    });
+    desc.meshes.push(MeshDesc {
+        name: "wall".into(),
+        positions: vec![
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(1.0, 1.5, -1.2),
+            Vec3::new(-1.0, 1.5, -1.2),
+        ],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material: 1,
+        ..Default::default()
+    });
+    desc.spheres.push(SphereDesc {
+        center: Vec3::new(0.4, 0.25, 0.1),
+        radius: 0.25,
+        material: 2,
+        emission: None,
+    });
+    desc.spheres.push(SphereDesc {
+        center: Vec3::new(-0.5, 0.15, 0.3),
+        radius: 0.15,
+        material: 0,
+        emission: Some(Emission {
+            radiance: Vec3::new(2.0, 2.0, 1.0),
+            two_sided: false,
+        }),
+    });
+    desc
+}
+
+#[test]
+fn packets_compute_what_one_path_at_a_time_computes() {
+    // The path integrator follows eight paths at once, computing the scattering at
+    // Lambertian surfaces lit by emitting triangles in SIMD lanes and everything else with
+    // the scalar code: every sample's radiance must be the scalar `li`'s to the bit, and the
+    // rays and nodes counted the same.
+    let scene = Scene::build(&mixed_scene()).unwrap();
+    let [w, h] = scene.camera().resolution();
+    let samples: Vec<SampleRef> = (0..w * h)
+        .flat_map(|p| {
+            (0..6).map(move |index| SampleRef {
+                pixel: [p % w, p / w],
+                index,
+                tag: p * 6 + index,
+            })
+        })
+        .collect();
+    let mut lit = 0;
+    for kind in SamplerKind::ALL {
+        for (max_depth, rr_depth) in [(u32::MAX, 5), (u32::MAX, 1), (3, 5), (0, 5)] {
+            let integrator = PathIntegrator {
+                max_depth,
+                rr_depth,
+                ..Default::default()
+            };
+            let mut sampler = kind.build(6, 9);
+            let mut packed = vec![None; samples.len()];
+            let mut packed_stats = PathStats::default();
+            integrator.li_samples(
+                &scene,
+                &mut sampler,
+                &mut samples.iter().copied(),
+                &mut |tag, l| packed[tag as usize] = Some(l),
+                &mut packed_stats,
+            );
+            let mut stats = PathStats::default();
+            for s in &samples {
+                let ray = camera_ray(&scene, &mut sampler, *s);
+                let l = integrator.li(&scene, ray, &mut sampler, &mut stats);
+                let p = packed[s.tag as usize].expect("every sample is estimated");
+                assert_eq!(
+                    p.to_array().map(f32::to_bits),
+                    l.to_array().map(f32::to_bits),
+                    "{kind:?}, depth {max_depth}, rr {rr_depth}, {s:?}: {p} vs {l}"
+                );
+                lit += usize::from(l.max_element() > 0.0);
+            }
+            assert_eq!(packed_stats, stats, "{kind:?}, depth {max_depth}");
+        }
+    }
+    // A guard that the comparison covers lit paths, not only black ones.
+    let estimates = SamplerKind::ALL.len() * 4 * samples.len();
+    assert!(lit * 10 > estimates, "{lit} of {estimates} found light");
+}

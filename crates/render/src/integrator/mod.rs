@@ -9,6 +9,7 @@
 
 mod debug;
 mod direct;
+mod packet;
 mod path;
 
 pub use debug::DebugView;

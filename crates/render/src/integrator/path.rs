@@ -1,4 +1,7 @@
-use super::{emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats};
+use super::{
+    camera_ray, emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats,
+    SampleRef,
+};
 use crate::desc::Rgb;
 use crate::geometry::{spawn_ray, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
@@ -118,15 +121,15 @@ impl PathIntegrator {
     }
 
     /// What the path's ray found, `hit`: adds the environment's radiance (a miss) or the
-    /// surface's emission, weighted by MIS. Returns the surface when the path goes on to
-    /// scatter there.
+    /// surface's emission, weighted by MIS. Returns whether the path goes on to scatter at the
+    /// surface.
     #[inline]
     pub(crate) fn arrive(
         &self,
         scene: &Scene,
         st: &mut PathState,
-        hit: Option<SurfaceInteraction>,
-    ) -> Option<SurfaceInteraction> {
+        hit: Option<&SurfaceInteraction>,
+    ) -> bool {
         let Some(si) = hit else {
             if let Some((le, pdf_light)) = escaped(scene, &st.ray) {
                 let w = st
@@ -136,10 +139,10 @@ impl PathIntegrator {
                     st.l += st.beta * w * le;
                 }
             }
-            return None;
+            return false;
         };
         let p_prev = st.prev.map_or(st.ray.o, |(p, _)| p);
-        if let Some((le, pdf_light)) = emitted(scene, p_prev, &st.ray, &si) {
+        if let Some((le, pdf_light)) = emitted(scene, p_prev, &st.ray, si) {
             let w = st
                 .prev
                 .map_or(1.0, |(_, pdf_bsdf)| self.bsdf_weight(pdf_bsdf, pdf_light));
@@ -147,7 +150,7 @@ impl PathIntegrator {
                 st.l += st.beta * w * le;
             }
         }
-        (st.depth < self.max_depth).then_some(si)
+        st.depth < self.max_depth
     }
 
     /// Scattering at `si`: light sampling, then a BSDF-sampled direction and Russian roulette.
@@ -234,13 +237,32 @@ impl Integrator for PathIntegrator {
         let mut st = PathState::new(ray);
         loop {
             let hit = trace(scene, &st.ray, st.depth == 0, stats);
-            let Some(si) = self.arrive(scene, &mut st, hit) else {
+            if !self.arrive(scene, &mut st, hit.as_ref()) {
                 break;
-            };
-            if !self.scatter(scene, &mut st, &si, sampler, stats) {
+            }
+            let Some(si) = &hit else { break };
+            if !self.scatter(scene, &mut st, si, sampler, stats) {
                 break;
             }
         }
         st.l
+    }
+
+    fn li_samples(
+        &self,
+        scene: &Scene,
+        sampler: &mut AnySampler,
+        samples: &mut dyn Iterator<Item = SampleRef>,
+        out: &mut dyn FnMut(u32, Rgb),
+        stats: &mut PathStats,
+    ) {
+        if self.packets_apply() {
+            self.li_packets(scene, sampler, samples, out, stats);
+        } else {
+            for s in samples {
+                let ray = camera_ray(scene, sampler, s);
+                out(s.tag, self.li(scene, ray, sampler, stats));
+            }
+        }
     }
 }

@@ -11,14 +11,57 @@ use crate::shape::{Sphere, Triangle};
 use crate::simd::Avx2;
 use glam::Vec3;
 
-/// Where a ray's nearest hit is, before the surface interaction is made from it.
+/// Where a ray's nearest hit is, before the surface interaction is made from it, and how
+/// many BVH nodes the search visited: packed in two 64-bit words, so that it comes back from
+/// the (not inlined) traversal in two registers rather than through memory, where reading it
+/// back would wait for its stores.
 #[derive(Clone, Copy)]
 pub(super) struct Hit {
-    /// Leaf slot of the primitive.
-    pub(super) slot: u32,
-    /// Barycentrics of vertices 1 and 2 (triangles).
-    pub(super) b1: f32,
-    pub(super) b2: f32,
+    /// Leaf slot of the primitive (low half; [`Hit::NONE`] where nothing was hit) and BVH
+    /// nodes visited (high half).
+    slot_visited: u64,
+    /// Bits of the barycentrics of vertices 1 (low half) and 2 (high half), for triangles.
+    barycentrics: u64,
+}
+
+impl Hit {
+    /// The slot of a miss (no leaf slot reaches it: slots are below `MAX_PRIMITIVES`).
+    pub(super) const NONE: u32 = u32::MAX;
+
+    #[inline(always)]
+    fn new(slot: u32, b1: f32, b2: f32, visited: u32) -> Hit {
+        Hit {
+            slot_visited: u64::from(slot) | u64::from(visited) << 32,
+            barycentrics: u64::from(b1.to_bits()) | u64::from(b2.to_bits()) << 32,
+        }
+    }
+
+    /// Whether the ray hit anything.
+    #[inline(always)]
+    pub(super) fn found(&self) -> bool {
+        self.slot() != Hit::NONE
+    }
+
+    /// Leaf slot of the primitive hit.
+    #[inline(always)]
+    pub(super) fn slot(&self) -> u32 {
+        self.slot_visited as u32
+    }
+
+    /// BVH nodes visited.
+    #[inline(always)]
+    pub(super) fn visited(&self) -> u32 {
+        (self.slot_visited >> 32) as u32
+    }
+
+    /// Barycentric coordinates of vertices 1 and 2.
+    #[inline(always)]
+    pub(super) fn barycentrics(&self) -> (f32, f32) {
+        (
+            f32::from_bits(self.barycentrics as u32),
+            f32::from_bits((self.barycentrics >> 32) as u32),
+        )
+    }
 }
 
 /// What a [`TriBlock`]'s lanes hold: their primitives' leaf slots and which lanes are
@@ -63,7 +106,7 @@ impl Scene {
     /// BVH nodes visited. Compiled twice: for CPUs with AVX2 and FMA, chosen at run time, and
     /// for the target's baseline.
     #[inline]
-    pub(super) fn closest_hit(&self, ray: &mut Ray, camera: bool) -> (Option<Hit>, u32) {
+    pub(super) fn closest_hit(&self, ray: &mut Ray, camera: bool) -> Hit {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = Avx2::detect() {
             // SAFETY: `closest_hit_avx2` requires AVX2 and FMA, which `avx2` proves this CPU
@@ -76,7 +119,7 @@ impl Scene {
     /// [`Scene::closest_hit`] compiled for AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    fn closest_hit_avx2(&self, avx2: Avx2, ray: &mut Ray, camera: bool) -> (Option<Hit>, u32) {
+    fn closest_hit_avx2(&self, avx2: Avx2, ray: &mut Ray, camera: bool) -> Hit {
         self.closest_hit_with(avx2, ray, camera)
     }
 
@@ -101,17 +144,12 @@ impl Scene {
 
     /// [`Scene::closest_hit`] with the box test `boxes`.
     #[inline(always)]
-    fn closest_hit_with(
-        &self,
-        boxes: impl BoxTest<8>,
-        ray: &mut Ray,
-        camera: bool,
-    ) -> (Option<Hit>, u32) {
-        // The nearest hit's fields as separate scalars (`slot` u32::MAX: none): the leaf test
+    fn closest_hit_with(&self, boxes: impl BoxTest<8>, ray: &mut Ray, camera: bool) -> Hit {
+        // The nearest hit's fields as separate scalars (`slot` Hit::NONE: none): the leaf test
         // writes them one by one, and reading them back one by one lets the loads take the
         // stored values directly, where reading a whole `Option<Hit>` with one wide load waits
         // for the narrow stores to complete.
-        let (mut slot, mut b1, mut b2) = (u32::MAX, 0.0f32, 0.0f32);
+        let (mut slot, mut b1, mut b2) = (Hit::NONE, 0.0f32, 0.0f32);
         let (_, visited) = self.bvh.intersect_leaves_with(boxes, ray, |leaf, r| {
             let (first, count) = Bvh8::leaf_range(leaf);
             let mut any = false;
@@ -131,8 +169,7 @@ impl Scene {
             }
             any
         });
-        let best = (slot != u32::MAX).then_some(Hit { slot, b1, b2 });
-        (best, visited)
+        Hit::new(slot, b1, b2, visited)
     }
 
     /// The leaf slot of the nearest sphere among lanes `spheres` of block `b` that `ray` hits
@@ -316,8 +353,8 @@ mod tests {
             let camera = k % 2 == 0;
             let expected = brute_force(&desc, &ray, camera);
             let mut r = ray;
-            let (portable, _) = scene.closest_hit_with(Portable, &mut r, camera);
-            assert_eq!(portable.map(|_| r.t_max), expected);
+            let portable = scene.closest_hit_with(Portable, &mut r, camera);
+            assert_eq!(portable.found().then_some(r.t_max), expected);
             let found = if camera {
                 scene.intersect_camera(&ray).0
             } else {
