@@ -92,6 +92,17 @@ impl Pcg32 {
             .wrapping_add(plus.wrapping_mul(self.inc));
     }
 
+    /// Moves to the same dimension `samples` pixel samples on: [`Pcg32::advance`] by
+    /// `samples` times [`DIMENSIONS_PER_SAMPLE`], squaring the one-sample jump (a step per bit
+    /// of `samples`, not per bit of the whole distance).
+    #[inline]
+    pub fn skip_pixel_samples(&mut self, samples: u32) {
+        let (mult, plus) = jump_power(SAMPLE_JUMP, u64::from(samples));
+        self.state = mult
+            .wrapping_mul(self.state)
+            .wrapping_add(plus.wrapping_mul(self.inc));
+    }
+
     /// The generator for one pixel sample: stream chosen by `(seed, pixel)`, positioned at
     /// `sample_index * 2^16 + dimension`. A pure function of its arguments.
     pub fn for_pixel_sample(seed: u64, pixel: [u32; 2], sample_index: u32, dimension: u32) -> Self {
@@ -104,8 +115,14 @@ impl Pcg32 {
 /// `(m, p)` such that `delta` steps of the generator take `state` to `m · state + p · inc`
 /// (Brown, "Random Number Generation with Arbitrary Strides", 1994): the multiplier and
 /// increment of `delta` steps, built by squaring; the increment's part is linear in `inc`.
-const fn jump_coefficients(mut delta: u64) -> (u64, u64) {
-    let (mut cur_mult, mut cur_plus) = (PCG32_MULT, 1u64);
+const fn jump_coefficients(delta: u64) -> (u64, u64) {
+    jump_power((PCG32_MULT, 1), delta)
+}
+
+/// The coefficients of applying the jump `(mult, plus)` (see [`jump_coefficients`]) `delta`
+/// times, by squaring.
+const fn jump_power((mult, plus): (u64, u64), mut delta: u64) -> (u64, u64) {
+    let (mut cur_mult, mut cur_plus) = (mult, plus);
     let (mut acc_mult, mut acc_plus) = (1u64, 0u64);
     while delta > 0 {
         if delta & 1 == 1 {
@@ -164,6 +181,22 @@ mod tests {
         b.advance(1000);
         assert_eq!(a, b);
         assert_eq!(a.next_u32(), b.next_u32());
+    }
+
+    #[test]
+    fn skipping_samples_is_advancing_by_their_dimensions() {
+        let start = Pcg32::for_pixel_sample(5, [1, 2], 3, 0);
+        for k in [0, 1, 2, 7, 8, 9, 63, 1000, u32::MAX] {
+            let (mut a, mut b) = (start.clone(), start.clone());
+            a.skip_pixel_samples(k);
+            b.advance(u64::from(k) * DIMENSIONS_PER_SAMPLE);
+            assert_eq!(a, b, "{k}");
+        }
+        let mut one = start.clone();
+        one.skip_pixel_samples(1);
+        let mut next = start;
+        next.skip_pixel_sample();
+        assert_eq!(one, next);
     }
 
     #[test]

@@ -33,7 +33,9 @@ fn zip(a: F8, b: F8, f: impl Fn(f32, f32) -> f32) -> F8 {
 
 #[inline(always)]
 fn compare(a: F8, b: F8, f: impl Fn(f32, f32) -> bool) -> M8 {
-    M8(std::array::from_fn(|i| if f(a.0[i], b.0[i]) { !0 } else { 0 }))
+    M8(std::array::from_fn(
+        |i| if f(a.0[i], b.0[i]) { !0 } else { 0 },
+    ))
 }
 
 impl F8 {

@@ -37,14 +37,17 @@ impl Sampler for IndependentSampler {
 
     fn start_pixel_sample(&mut self, pixel: [u32; 2], sample_index: u32, dimension: u32) {
         // The same numbers as `Pcg32::for_pixel_sample(seed, pixel, sample_index, dimension)`
-        // (tested); renders ask for a pixel's samples in order, one jump apart.
+        // (tested); renders ask for a pixel's samples in order, one jump apart (or a few, when
+        // several paths are followed at once).
         let (last_pixel, last_index, ref last) = self.start;
         let at_zero = if last_pixel == pixel && last_index.checked_add(1) == Some(sample_index) {
             let mut rng = last.clone();
             rng.skip_pixel_sample();
             rng
-        } else if last_pixel == pixel && last_index == sample_index {
-            last.clone()
+        } else if last_pixel == pixel && last_index <= sample_index {
+            let mut rng = last.clone();
+            rng.skip_pixel_samples(sample_index - last_index);
+            rng
         } else {
             Pcg32::for_pixel_sample(self.seed, pixel, sample_index, 0)
         };
@@ -89,8 +92,11 @@ mod tests {
             };
             requests.push((pixel, i, d));
         }
+        // Forward jumps of several samples, as lanes following paths together make.
+        requests.extend((0..300).step_by(7).map(|i| ([2, 1], i, 0)));
         requests.push(([1, 1], u32::MAX, 0));
         requests.push(([1, 1], 0, 0));
+        requests.push(([1, 1], u32::MAX, 0));
         for (pixel, i, d) in requests {
             s.start_pixel_sample(pixel, i, d);
             let mut expected = Pcg32::for_pixel_sample(9, pixel, i, d);
