@@ -23,12 +23,20 @@ pub struct M8(pub [u32; W]);
 
 #[inline(always)]
 fn map(a: F8, f: impl Fn(f32) -> f32) -> F8 {
-    F8(std::array::from_fn(|i| f(a.0[i])))
+    let mut r = [0.0; W];
+    for (r, &x) in r.iter_mut().zip(&a.0) {
+        *r = f(x);
+    }
+    F8(r)
 }
 
 #[inline(always)]
 fn zip(a: F8, b: F8, f: impl Fn(f32, f32) -> f32) -> F8 {
-    F8(std::array::from_fn(|i| f(a.0[i], b.0[i])))
+    let mut r = [0.0; W];
+    for (r, (&x, &y)) in r.iter_mut().zip(a.0.iter().zip(&b.0)) {
+        *r = f(x, y);
+    }
+    F8(r)
 }
 
 #[inline(always)]
@@ -111,9 +119,11 @@ impl M8 {
     /// `a` where the mask is set, `b` elsewhere.
     #[inline(always)]
     pub fn select(self, a: F8, b: F8) -> F8 {
-        F8(std::array::from_fn(|i| {
-            f32::from_bits((a.0[i].to_bits() & self.0[i]) | (b.0[i].to_bits() & !self.0[i]))
-        }))
+        let mut r = [0.0; W];
+        for (r, (&m, (&x, &y))) in r.iter_mut().zip(self.0.iter().zip(a.0.iter().zip(&b.0))) {
+            *r = f32::from_bits((x.to_bits() & m) | (y.to_bits() & !m));
+        }
+        F8(r)
     }
 
     /// [`M8::select`] for each axis.

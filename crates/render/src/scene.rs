@@ -514,15 +514,27 @@ impl Scene {
             *si = None;
             return hit.visited();
         }
-        let t = r.t_max;
-        match self.prims[hit.slot() as usize] {
-            Prim::Triangle(i) => {
-                let (b1, b2) = hit.barycentrics();
-                *si = Some(self.triangle_interaction(i, b1, b2, t));
-            }
+        let (b1, b2) = hit.barycentrics();
+        self.interaction_into(ray, hit.slot(), r.t_max, b1, b2, si);
+        hit.visited()
+    }
+
+    /// Writes to `si` the surface interaction where `ray` meets the primitive in leaf slot
+    /// `slot` at distance `t` (barycentrics `b1`, `b2` for a triangle).
+    #[inline(always)]
+    pub(crate) fn interaction_into(
+        &self,
+        ray: &Ray,
+        slot: u32,
+        t: f32,
+        b1: f32,
+        b2: f32,
+        si: &mut Option<SurfaceInteraction>,
+    ) {
+        match self.prims[slot as usize] {
+            Prim::Triangle(i) => *si = Some(self.triangle_interaction(i, b1, b2, t)),
             Prim::Sphere(i) => *si = Some(self.sphere_interaction(i, ray, t)),
         }
-        hit.visited()
     }
 
     /// The surface interaction at barycentrics (b1, b2) of triangle `i`, at distance `t`.

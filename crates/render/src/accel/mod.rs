@@ -9,7 +9,7 @@ mod tri_block;
 mod wide;
 
 pub use bvh::{Bvh, BvhNode, BvhParams};
-pub use tri_block::{BlockHit, TriBlock, LANES};
+pub use tri_block::{BlockHit, Nearest, RayLanes, TriBlock, LANES};
 pub use wide::{BoxTest, Bvh4, Bvh8, Node, Portable, WideBvh, MAX_PRIMITIVES};
 
 /// Test helpers shared by the BVHs' tests: random boxes as primitives.

@@ -7,6 +7,7 @@
 //! block reports the same distances and barycentrics to the bit.
 
 use crate::geometry::Ray;
+use crate::lanes::{F8, V8};
 use crate::shape::Triangle;
 
 /// Lanes per block.
@@ -240,6 +241,95 @@ impl TriBlock {
     #[inline(always)]
     pub fn hits(&self, ray: &Ray, lanes: u32) -> u32 {
         self.test(ray).mask & lanes
+    }
+
+    /// Tests the triangle in lane `lane` against eight rays at once, [`Triangle::intersect`]'s
+    /// arithmetic in each ray lane (so the same distances and barycentrics to the bit): a ray
+    /// lane that hits it within `(t_min, nearest.t)` takes it as its nearest, with `slot`.
+    #[inline(always)]
+    pub fn nearest_for_rays(&self, lane: usize, slot: u32, rays: &RayLanes, nearest: &mut Nearest) {
+        let splat = |a: &[[f32; LANES]; 3]| V8 {
+            x: F8::splat(a[0][lane]),
+            y: F8::splat(a[1][lane]),
+            z: F8::splat(a[2][lane]),
+        };
+        let (v0, e1, e2) = (splat(&self.v0), splat(&self.e1), splat(&self.e2));
+        let d = rays.d;
+        let pvec = V8 {
+            x: d.y * e2.z - e2.y * d.z,
+            y: d.z * e2.x - e2.z * d.x,
+            z: d.x * e2.y - e2.x * d.y,
+        };
+        let det = e1.dot(pvec);
+        let inv_det = F8::splat(1.0) / det;
+        let tvec = rays.o - v0;
+        let u = tvec.dot(pvec) * inv_det;
+        let qvec = V8 {
+            x: tvec.y * e1.z - e1.y * tvec.z,
+            y: tvec.z * e1.x - e1.z * tvec.x,
+            z: tvec.x * e1.y - e1.x * tvec.y,
+        };
+        let v = d.dot(qvec) * inv_det;
+        let t = e2.dot(qvec) * inv_det;
+        let (zero, one) = (F8::splat(0.0), F8::splat(1.0));
+        // `det != 0` is left out: where det is ±0, u is ±∞ or NaN and fails its range test
+        // (written out, the two determinant tests would be merged into a per-lane
+        // classification of det that the vector unit cannot do).
+        let hit = det.abs().lt(F8::splat(f32::INFINITY))
+            & zero.le(u)
+            & u.le(one)
+            & zero.le(v)
+            & (u + v).le(one)
+            & t.gt(rays.t_min)
+            & t.lt(nearest.t);
+        nearest.t = hit.select(t, nearest.t);
+        nearest.b1 = hit.select(u, nearest.b1);
+        nearest.b2 = hit.select(v, nearest.b2);
+        nearest.slot = hit.select(F8::splat(f32::from_bits(slot)), nearest.slot);
+    }
+}
+
+/// Eight rays, a lane each: origins, directions and extents.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RayLanes {
+    /// Origins.
+    pub o: V8,
+    /// Directions.
+    pub d: V8,
+    /// Near ends of the extents.
+    pub t_min: F8,
+}
+
+/// Each ray lane's nearest hit so far: its distance (the ray's far end before any hit), the
+/// barycentrics of vertices 1 and 2, and the hit primitive's leaf slot (as `f32` bits;
+/// `u32::MAX` for none).
+#[derive(Clone, Copy, Debug)]
+pub struct Nearest {
+    /// Distances.
+    pub t: F8,
+    /// Barycentric coordinates of vertex 1.
+    pub b1: F8,
+    /// Barycentric coordinates of vertex 2.
+    pub b2: F8,
+    /// Leaf slots, as bits.
+    pub slot: F8,
+}
+
+impl Nearest {
+    /// No hits yet, for rays ending at `t_max`.
+    pub fn new(t_max: F8) -> Nearest {
+        Nearest {
+            t: t_max,
+            b1: F8::splat(0.0),
+            b2: F8::splat(0.0),
+            slot: F8::splat(f32::from_bits(u32::MAX)),
+        }
+    }
+
+    /// Lane `i`'s hit: (leaf slot, distance, b1, b2), or `None`.
+    pub fn lane(&self, i: usize) -> Option<(u32, f32, f32, f32)> {
+        let slot = self.slot.0[i].to_bits();
+        (slot != u32::MAX).then(|| (slot, self.t.0[i], self.b1.0[i], self.b2.0[i]))
     }
 }
 

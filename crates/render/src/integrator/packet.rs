@@ -1,16 +1,19 @@
 //! Path tracing eight paths at a time: each lane follows one pixel sample, and a lane whose
 //! path ends takes the next sample at once, so the lanes stay busy. Rays are traced one lane
-//! after another (each through the BVH's own SIMD traversal); the scattering at diffuse
-//! surfaces lit by emitting triangles (light sampling with its MIS weight, the shadow ray, the
+//! after another through the BVH (its own SIMD traversal), or, in scenes of a few dozen
+//! triangles, all eight against every triangle at once; the scattering at diffuse surfaces
+//! lit by emitting triangles (light sampling with its MIS weight, the shadow ray's ends, the
 //! cosine-weighted BSDF sample) is computed for all eight lanes together in SIMD registers;
 //! any other material or light falls back to the scalar path code for that lane and bounce.
 //!
 //! Each lane computes exactly what [`PathIntegrator::li`] computes for its sample, to the bit
 //! (tested): the same random numbers in the same order, the same operations in the same
-//! order. Only the order in which the samples finish differs.
+//! order. Only the order in which the samples finish differs, and, where every triangle is
+//! tested, which of several triangles at exactly the same distance a ray is taken to hit.
 
 use super::path::{PathIntegrator, PathState};
 use super::{camera_ray, sample_light, PathStats, SampleRef};
+use crate::accel::RayLanes;
 use crate::bsdf::{Bxdf, Material};
 use crate::desc::Rgb;
 use crate::geometry::{Ray, RAY_EPSILON};
@@ -225,6 +228,8 @@ impl PathIntegrator {
         let mut a = ScatterIn::default();
         let mut b = ScatterOut::default();
         let mut more = true;
+        let all_triangles = scene.tests_all_triangles();
+        let mut rays = RayLanes::default();
         loop {
             // Idle lanes take the next samples.
             for (lane, smp) in lanes.iter_mut().zip(&mut samplers) {
@@ -244,6 +249,20 @@ impl PathIntegrator {
             if lanes.iter().all(Option::is_none) {
                 break;
             }
+            // Small scenes: every lane's ray against every triangle at once.
+            let nearest = all_triangles.then(|| {
+                let mut t_max = F8::splat(f32::NEG_INFINITY);
+                for (i, lane) in lanes.iter().enumerate() {
+                    if let Some(lane) = lane {
+                        let ray = &lane.st.ray;
+                        rays.o.set(i, ray.o);
+                        rays.d.set(i, ray.d);
+                        rays.t_min.0[i] = ray.t_min;
+                        t_max.0[i] = ray.t_max;
+                    }
+                }
+                scene.nearest_of_rays(&rays, t_max)
+            });
             // Trace every lane; scatter the ones at other materials now, and gather the
             // Lambertian ones' inputs.
             let mut gathered = M8::default();
@@ -256,8 +275,18 @@ impl PathIntegrator {
                 let st = &mut lane.st;
                 // The surface interaction is made in place and read a field at a time.
                 stats.rays += 1;
-                stats.nodes_visited +=
-                    scene.intersect_into(&st.ray, st.depth == 0, &mut hits[i]) as u64;
+                match &nearest {
+                    Some(nearest) => match nearest.lane(i) {
+                        Some((slot, t, b1, b2)) => {
+                            scene.interaction_into(&st.ray, slot, t, b1, b2, &mut hits[i])
+                        }
+                        None => hits[i] = None,
+                    },
+                    None => {
+                        stats.nodes_visited +=
+                            scene.intersect_into(&st.ray, st.depth == 0, &mut hits[i]) as u64
+                    }
+                }
                 let Some(si) = &hits[i] else {
                     self.arrive(scene, st, None);
                     out(lane.tag, st.l);
@@ -307,7 +336,8 @@ impl PathIntegrator {
                             let bsdf = scene.bsdf(si, wo);
                             let ld =
                                 sample_light(scene, si, &bsdf, wo, u_select, u_light, 1, 1, stats);
-                            st.l += st.beta * ld / 1.0;
+                            // (The scalar code divides by the one light sample: exact.)
+                            st.l += st.beta * ld;
                         }
                     }
                 }
@@ -342,7 +372,7 @@ impl PathIntegrator {
                         t_max: 1.0 - 1e-4,
                     };
                     if !scene.occluded(&shadow) {
-                        st.l += st.beta * b.ld.get(i) / 1.0;
+                        st.l += st.beta * b.ld.get(i);
                     }
                 }
                 let goes_on = b.sampled.get(i) && {

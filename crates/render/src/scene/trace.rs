@@ -3,9 +3,10 @@
 //! compiled twice, for AVX2 and for the target's baseline, the CPU choosing at run time.
 
 use super::{Prim, Scene};
-use crate::accel::{BoxTest, Bvh8, Portable, TriBlock, LANES};
+use crate::accel::{BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, LANES};
 use crate::desc::Visibility;
 use crate::geometry::Ray;
+use crate::lanes::F8;
 use crate::shape::{Sphere, Triangle};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::Avx2;
@@ -210,6 +211,48 @@ impl Scene {
         false
     }
 
+    /// Whether the scene is small enough to intersect rays by testing every triangle
+    /// ([`Scene::nearest_of_rays`]): at most [`SMALL_SCENE_BLOCKS`] blocks of triangles, seen
+    /// by every ray, and no spheres.
+    pub(crate) fn tests_all_triangles(&self) -> bool {
+        self.all_visible && self.spheres.is_empty() && self.blocks.len() <= SMALL_SCENE_BLOCKS
+    }
+
+    /// The nearest hits of eight rays ending at `t_max`, by testing every triangle against
+    /// all eight at once. For a few dozen triangles this costs a fraction of walking the BVH
+    /// with each ray, and finds the same distance (the same triangle test, to the bit); of
+    /// several triangles at exactly that distance (a ray through a shared edge) it may report
+    /// another than the BVH would. Only for scenes where [`Scene::tests_all_triangles`].
+    pub(crate) fn nearest_of_rays(&self, rays: &RayLanes, t_max: F8) -> Nearest {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx2) = Avx2::detect() {
+            // SAFETY: `nearest_of_rays_avx2` requires AVX2 and FMA, which `avx2` proves this
+            // CPU has. Its body is safe code.
+            return unsafe { self.nearest_of_rays_avx2(avx2, rays, t_max) };
+        }
+        self.nearest_of_rays_lanes(rays, t_max)
+    }
+
+    /// [`Scene::nearest_of_rays`] compiled for AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn nearest_of_rays_avx2(&self, _: Avx2, rays: &RayLanes, t_max: F8) -> Nearest {
+        self.nearest_of_rays_lanes(rays, t_max)
+    }
+
+    #[inline(always)]
+    fn nearest_of_rays_lanes(&self, rays: &RayLanes, t_max: F8) -> Nearest {
+        let mut nearest = Nearest::new(t_max);
+        for (block, info) in self.blocks.iter().zip(&self.block_info) {
+            for (lane, &slot) in info.slots.iter().enumerate() {
+                if slot != u32::MAX {
+                    block.nearest_for_rays(lane, slot, rays, &mut nearest);
+                }
+            }
+        }
+        nearest
+    }
+
     /// [`Scene::any_hit`] with the box test `boxes`.
     #[inline(always)]
     fn any_hit_with(&self, boxes: impl BoxTest<8>, ray: &Ray, camera: bool) -> bool {
@@ -223,6 +266,10 @@ impl Scene {
         })
     }
 }
+
+/// The most triangle blocks a scene may have for [`Scene::nearest_of_rays`] (64 triangles):
+/// beyond a few dozen triangles the BVH culls more than testing them all costs.
+const SMALL_SCENE_BLOCKS: usize = 16;
 
 /// Packs the primitives of each of `bvh`'s leaves into blocks of [`LANES`] and renames the
 /// leaves' ranges from leaf slots to blocks.
@@ -371,5 +418,112 @@ mod tests {
             hits += usize::from(expected.is_some());
         }
         assert!(hits > 300, "{hits} rays hit");
+    }
+
+    /// A closed box of two-triangle quads with a smaller box inside: few enough triangles to
+    /// test them all, with shared edges and corners for rays to hit.
+    fn boxes() -> SceneDesc {
+        let cube = |lo: Vec3, hi: Vec3| {
+            let c = |i: u32| {
+                Vec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            };
+            let quads = [
+                [0, 1, 3, 2],
+                [4, 6, 7, 5],
+                [0, 4, 5, 1],
+                [2, 3, 7, 6],
+                [0, 2, 6, 4],
+                [1, 5, 7, 3],
+            ];
+            MeshDesc {
+                name: "cube".into(),
+                positions: (0..8).map(c).collect(),
+                indices: quads
+                    .iter()
+                    .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+                    .collect(),
+                ..Default::default()
+            }
+        };
+        SceneDesc {
+            meshes: vec![
+                cube(Vec3::splat(-1.0), Vec3::splat(1.0)),
+                cube(Vec3::new(-0.5, -1.0, -0.3), Vec3::new(0.2, 0.1, 0.4)),
+            ],
+            materials: vec![diffuse(Vec3::ONE, true)],
+            resolution: [4, 4],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn testing_every_triangle_finds_what_the_bvh_finds() {
+        let scene = Scene::build(&boxes()).unwrap();
+        assert!(scene.tests_all_triangles());
+        let mut rng = pathlab_mc::rng::Pcg32::new(8, 1);
+        let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+        let (mut hits, mut ties) = (0, 0);
+        for k in 0..2000 {
+            let mut rays = RayLanes::default();
+            let mut t_max = F8::splat(f32::INFINITY);
+            let mut each = [Ray::new(Vec3::ZERO, Vec3::X); 8];
+            for (i, ray) in each.iter_mut().enumerate() {
+                // Origins inside and outside the boxes, some rays aimed at corners and edges
+                // (where triangles meet), some with a finite extent.
+                let o = point() * 3.0 - 1.5;
+                let target = match (k + i) % 3 {
+                    0 => point() * 2.0 - 1.0,
+                    1 => point().round() * 2.0 - 1.0,
+                    _ => Vec3::new(point().x * 2.0 - 1.0, 1.0, -1.0),
+                };
+                *ray = Ray::new(o, target - o);
+                if i % 4 == 3 {
+                    ray.t_max = 0.5;
+                }
+                rays.o.set(i, ray.o);
+                rays.d.set(i, ray.d);
+                rays.t_min.0[i] = ray.t_min;
+                t_max.0[i] = ray.t_max;
+            }
+            let all = [
+                scene.nearest_of_rays(&rays, t_max),
+                scene.nearest_of_rays_lanes(&rays, t_max),
+            ];
+            for (i, ray) in each.iter().enumerate() {
+                let mut r = *ray;
+                let bvh = scene.closest_hit(&mut r, false);
+                for nearest in &all {
+                    let lane = nearest.lane(i);
+                    assert_eq!(lane.map(|(_, t, _, _)| t), bvh.found().then_some(r.t_max));
+                    let Some((slot, t, b1, b2)) = lane else {
+                        continue;
+                    };
+                    if slot == bvh.slot() {
+                        assert_eq!((b1, b2), bvh.barycentrics());
+                    } else {
+                        // Another triangle at exactly the same distance (a shared edge).
+                        let Prim::Triangle(i) = scene.prims[slot as usize] else {
+                            panic!("only triangles")
+                        };
+                        assert_eq!(
+                            scene.triangles[i as usize].intersect(ray).map(|h| h.t),
+                            Some(t)
+                        );
+                        ties += 1;
+                    }
+                }
+                hits += usize::from(bvh.found());
+            }
+        }
+        // Rays through shared edges happen to find the same triangle here; `ties` counts
+        // where they would not.
+        assert!(
+            hits > 10_000 && ties < hits / 100,
+            "{hits} hits, {ties} ties"
+        );
     }
 }
