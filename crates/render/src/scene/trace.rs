@@ -237,7 +237,17 @@ impl Scene {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     fn nearest_of_rays_avx2(&self, _: Avx2, rays: &RayLanes, t_max: F8) -> Nearest {
-        self.nearest_of_rays_lanes(rays, t_max)
+        use crate::accel::{AvxNearest, AvxRays};
+        let rays = AvxRays::new(rays);
+        let mut nearest = AvxNearest::new(t_max);
+        for (block, info) in self.blocks.iter().zip(&self.block_info) {
+            for (lane, &slot) in info.slots.iter().enumerate() {
+                if slot != u32::MAX {
+                    block.nearest_for_rays_avx(lane, slot, &rays, &mut nearest);
+                }
+            }
+        }
+        nearest.lanes()
     }
 
     #[inline(always)]
