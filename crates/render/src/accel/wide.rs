@@ -21,7 +21,7 @@ use glam::Vec3;
 use std::mem::MaybeUninit;
 
 /// Number of SAH bins per axis (fixed, so that binning needs no allocation).
-const BINS: usize = 16;
+const BINS: usize = 32;
 /// Subtrees with more primitives than this are built in parallel.
 const PARALLEL_THRESHOLD: usize = 4096;
 /// Depth of the binary tree from which splits are at the median: below it, at most 32 more
@@ -376,7 +376,7 @@ fn order(a: u64, b: u64) -> (u64, u64) {
 impl<const W: usize> WideBvh<W> {
     /// Builds the tree over `bounds` (primitive `i` has box `bounds[i]`); primitives with an
     /// empty or non-finite box are left out. Uses `params.max_leaf_size` (at most 16),
-    /// `params.traversal_cost` (relative to one leaf block test), `params.leaf_block` and 16
+    /// `params.traversal_cost` (relative to one leaf block test), `params.leaf_block` and 32
     /// bins. At most
     /// [`MAX_PRIMITIVES`] primitives: the caller checks.
     pub fn build(bounds: &[Aabb], params: BvhParams) -> WideBvh<W> {
