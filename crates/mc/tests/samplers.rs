@@ -151,3 +151,47 @@ fn sampler_kind_parses() {
     assert_eq!("Sobol".parse::<SamplerKind>(), Ok(SamplerKind::Sobol));
     assert!("halton".parse::<SamplerKind>().is_err());
 }
+
+#[test]
+fn eight_samplers_drawing_together_draw_what_each_draws_alone() {
+    let mut rng = pathlab_mc::rng::Pcg32::new(3, 8);
+    let dims = [1, 2, 1, 2, 1];
+    for kind in kinds() {
+        for round in 0..200 {
+            let mut together: [AnySampler; LANES] = std::array::from_fn(|_| kind.build(64, 5));
+            for s in &mut together {
+                let pixel = [rng.next_u32() % 7, rng.next_u32() % 5];
+                let index = if round % 10 == 0 {
+                    rng.next_u32()
+                } else {
+                    rng.next_u32() % 64
+                };
+                s.start_pixel_sample(pixel, index, rng.next_u32() % 40);
+            }
+            let mut alone = together.clone();
+            let lanes = rng.next_u32() & 0xff;
+            let mut out = [[0.0; LANES]; 7];
+            AnySampler::next_lanes(&mut together, lanes, &dims, &mut out);
+            for (lane, s) in alone.iter_mut().enumerate() {
+                if lanes & (1 << lane) == 0 {
+                    continue;
+                }
+                let mut expected = Vec::new();
+                for &n in &dims {
+                    if n == 1 {
+                        expected.push(s.next_1d());
+                    } else {
+                        let v = s.next_2d();
+                        expected.extend([v.x, v.y]);
+                    }
+                }
+                let got: Vec<f32> = out.iter().map(|row| row[lane]).collect();
+                assert_eq!(got, expected, "{kind:?} lane {lane}");
+            }
+            // Every sampler stands where drawing alone left it (idle lanes where they were).
+            for (a, b) in together.iter_mut().zip(&mut alone) {
+                assert_eq!(a.next_2d(), b.next_2d(), "{kind:?}");
+            }
+        }
+    }
+}

@@ -27,7 +27,7 @@ mod sobol;
 mod stratified;
 
 pub use independent::IndependentSampler;
-pub use sobol::SobolSampler;
+pub use sobol::{SobolSampler, LANES};
 pub use stratified::{permutation_element, StratifiedSampler};
 
 use glam::Vec2;
@@ -146,5 +146,41 @@ impl Sampler for AnySampler {
     #[inline]
     fn next_pixel_2d(&mut self) -> Vec2 {
         dispatch!(self, s => s.next_pixel_2d())
+    }
+}
+
+impl AnySampler {
+    /// Draws for eight samplers at once what each would give for the requests `dims` (1 for
+    /// [`Sampler::next_1d`], 2 for [`Sampler::next_2d`]) made in order: a value per dimension,
+    /// lane by lane (`out[k][lane]`), for the lanes whose bit is set in `lanes`. The same
+    /// numbers as those calls; Sobol samplers compute their scrambles for all lanes together
+    /// ([`SobolSampler::next_lanes`]), the others draw one lane after another.
+    pub fn next_lanes(
+        samplers: &mut [AnySampler; LANES],
+        lanes: u32,
+        dims: &[u32],
+        out: &mut [[f32; LANES]],
+    ) {
+        if let [AnySampler::Sobol(a), AnySampler::Sobol(b), AnySampler::Sobol(c), AnySampler::Sobol(d), AnySampler::Sobol(e), AnySampler::Sobol(f), AnySampler::Sobol(g), AnySampler::Sobol(h)] =
+            samplers
+        {
+            return SobolSampler::next_lanes(&mut [a, b, c, d, e, f, g, h], lanes, dims, out);
+        }
+        for (lane, s) in samplers.iter_mut().enumerate() {
+            if lanes & (1 << lane) == 0 {
+                continue;
+            }
+            let mut k = 0;
+            for &n in dims {
+                if n == 1 {
+                    out[k][lane] = s.next_1d();
+                    k += 1;
+                } else {
+                    let v = s.next_2d();
+                    (out[k][lane], out[k + 1][lane]) = (v.x, v.y);
+                    k += 2;
+                }
+            }
+        }
     }
 }

@@ -20,7 +20,8 @@ use crate::geometry::{Ray, RAY_EPSILON};
 use crate::lanes::{F8, M8, V8, W};
 use crate::light::{AreaShape, Light};
 use crate::scene::{Scene, SurfaceInteraction};
-use pathlab_mc::sampler::{AnySampler, Sampler};
+use glam::Vec2;
+use pathlab_mc::sampler::AnySampler;
 use pathlab_mc::warp::sin_cos_quarter_turn;
 use std::f32::consts::FRAC_1_PI;
 
@@ -224,7 +225,7 @@ impl PathIntegrator {
         let mut samplers: [AnySampler; W] = std::array::from_fn(|_| sampler.clone());
         let mut lanes: [Option<Lane>; W] = [None; W];
         let mut hits: [Option<SurfaceInteraction>; W] = [None; W];
-        let mut u_rr = [0.0f32; W];
+        let mut u = [[0.0f32; W]; 7];
         let mut a = ScatterIn::default();
         let mut b = ScatterOut::default();
         let mut more = true;
@@ -265,7 +266,7 @@ impl PathIntegrator {
             });
             // Trace every lane; scatter the ones at other materials now, and gather the
             // Lambertian ones' inputs.
-            let mut gathered = M8::default();
+            let mut lambert_lanes = 0u32;
             for i in 0..W {
                 let Some(lane) = &mut lanes[i] else {
                     hits[i] = None;
@@ -308,14 +309,33 @@ impl PathIntegrator {
                     continue;
                 };
                 let wo = -st.ray.d;
-                // The scalar code's random numbers, in its order.
-                let u_select = smp.next_1d();
-                let u_light = smp.next_2d();
-                smp.next_1d(); // chooses a lobe; a Lambertian BSDF has one
-                let u_bsdf = smp.next_2d();
-                u_rr[i] = smp.next_1d();
+                a.p.set(i, si.p);
+                a.ng.set(i, si.ng);
+                a.ns.set(i, si.ns);
+                a.wo.set(i, wo);
+                a.reflectance.set(i, reflectance);
+                a.two_sided.set(i, two_sided);
+                lambert_lanes |= 1 << i;
+            }
+            if lambert_lanes == 0 {
+                continue;
+            }
+            // The scalar code's random numbers, in its order, for all Lambertian lanes at
+            // once: light choice (1D), light point (2D), lobe choice (1D, unused: a Lambertian
+            // BSDF has one), direction (2D), Russian roulette (1D).
+            AnySampler::next_lanes(&mut samplers, lambert_lanes, &[1, 2, 1, 2, 1], &mut u);
+            a.u_light = [F8(u[1]), F8(u[2])];
+            a.u_bsdf = [F8(u[4]), F8(u[5])];
+            for i in 0..W {
+                let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
+                    continue;
+                };
+                if lambert_lanes & (1 << i) == 0 {
+                    continue;
+                }
+                let st = &mut lane.st;
                 let mut triangle_light = false;
-                if let Some((index, pmf)) = scene.light_sampler().sample(u_select) {
+                if let Some((index, pmf)) = scene.light_sampler().sample(u[0][i]) {
                     match &scene.lights()[index] {
                         Light::Area {
                             shape: AreaShape::Triangle(t),
@@ -333,29 +353,17 @@ impl PathIntegrator {
                             a.light_pmf.0[i] = pmf;
                         }
                         _ => {
+                            let wo = -st.ray.d;
                             let bsdf = scene.bsdf(si, wo);
+                            let u_light = Vec2::new(u[1][i], u[2][i]);
                             let ld =
-                                sample_light(scene, si, &bsdf, wo, u_select, u_light, 1, 1, stats);
+                                sample_light(scene, si, &bsdf, wo, u[0][i], u_light, 1, 1, stats);
                             // (The scalar code divides by the one light sample: exact.)
                             st.l += st.beta * ld;
                         }
                     }
                 }
                 a.light.set(i, triangle_light);
-                a.p.set(i, si.p);
-                a.ng.set(i, si.ng);
-                a.ns.set(i, si.ns);
-                a.wo.set(i, wo);
-                a.reflectance.set(i, reflectance);
-                a.two_sided.set(i, two_sided);
-                a.u_light[0].0[i] = u_light.x;
-                a.u_light[1].0[i] = u_light.y;
-                a.u_bsdf[0].0[i] = u_bsdf.x;
-                a.u_bsdf[1].0[i] = u_bsdf.y;
-                gathered.set(i, true);
-            }
-            if !gathered.any() {
-                continue;
             }
             scatter(&a, &mut b);
             for i in 0..W {
@@ -379,7 +387,7 @@ impl PathIntegrator {
                     st.beta *= b.weight.get(i);
                     st.beta.max_element() > 0.0
                         && st.beta.is_finite()
-                        && self.survive(st, si, b.wi.get(i), b.pdf.0[i], u_rr[i])
+                        && self.survive(st, si, b.wi.get(i), b.pdf.0[i], u[6][i])
                 };
                 if !goes_on {
                     out(lane.tag, st.l);
