@@ -70,10 +70,22 @@ pub trait Integrator: Sync {
         out: &mut dyn FnMut(u32, Rgb),
         stats: &mut PathStats,
     ) {
-        for s in samples {
-            let ray = camera_ray(scene, sampler, s);
-            out(s.tag, self.li(scene, ray, sampler, stats));
-        }
+        li_one_at_a_time(self, scene, sampler, samples, out, stats);
+    }
+}
+
+/// [`Integrator::li_samples`] one sample after another with [`Integrator::li`] (the default).
+pub fn li_one_at_a_time<I: Integrator + ?Sized>(
+    integrator: &I,
+    scene: &Scene,
+    sampler: &mut AnySampler,
+    samples: &mut dyn Iterator<Item = SampleRef>,
+    out: &mut dyn FnMut(u32, Rgb),
+    stats: &mut PathStats,
+) {
+    for s in samples {
+        let ray = camera_ray(scene, sampler, s);
+        out(s.tag, integrator.li(scene, ray, sampler, stats));
     }
 }
 

@@ -1,6 +1,6 @@
 use super::{
-    camera_ray, emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats,
-    SampleRef,
+    emitted, escaped, li_one_at_a_time, power_heuristic, sample_light, trace, Integrator,
+    PathStats, SampleRef,
 };
 use crate::desc::Rgb;
 use crate::geometry::{spawn_ray, Ray};
@@ -259,10 +259,7 @@ impl Integrator for PathIntegrator {
         if self.packets_apply() {
             self.li_packets(scene, sampler, samples, out, stats);
         } else {
-            for s in samples {
-                let ray = camera_ray(scene, sampler, s);
-                out(s.tag, self.li(scene, ray, sampler, stats));
-            }
+            li_one_at_a_time(self, scene, sampler, samples, out, stats);
         }
     }
 }
