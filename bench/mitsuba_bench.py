@@ -10,10 +10,24 @@ it with a venv holding `mitsuba`):
 
 Mitsuba's variant is llvm_ad_rgb (vectorised, JIT-compiled; needs libLLVM, DRJIT_LIBLLVM_PATH),
 else scalar_rgb, which the output says. Its first render of each configuration compiles kernels
-and is not timed."""
-import argparse, json, subprocess, sys, time
+and is not timed. Each Mitsuba measurement runs in a process of its own that has exited before
+pathlab starts: after a render, Mitsuba's worker threads keep a core busy (measured: a whole
+core for seconds), which would slow whatever runs next."""
+import argparse, json, os, subprocess, sys, tempfile, time
 import numpy as np
 import mitsuba as mi
+
+if len(sys.argv) > 1 and sys.argv[1] == "--mitsuba-child":
+    # One timed Mitsuba render: VARIANT SCENE MAX_DEPTH SPP OUT.npy; prints the seconds.
+    _, _, variant, scene_path, max_depth, spp, out = sys.argv
+    mi.set_variant(variant)
+    scene = mi.load_file(scene_path, spp=int(spp), max_depth=int(max_depth))
+    mi.render(scene, spp=int(spp), seed=1)  # compiles the kernels
+    start = time.perf_counter()
+    img = np.array(mi.render(scene, spp=int(spp), seed=2))
+    print(time.perf_counter() - start)
+    np.save(out, img)
+    sys.exit(0)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--pathlab", required=True)
@@ -39,12 +53,12 @@ height, width = ref.shape[:2]
 pixels = width * height
 
 def mitsuba_render(max_depth, spp):
-    scene = mi.load_file(args.scene, spp=spp, max_depth=max_depth)
-    mi.render(scene, spp=spp, seed=1)  # compiles the kernels
-    start = time.perf_counter()
-    img = mi.render(scene, spp=spp, seed=2)
-    img = np.array(img)
-    return time.perf_counter() - start, img
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "img.npy")
+        cmd = [sys.executable, __file__, "--mitsuba-child", variant, args.scene, str(max_depth),
+               str(spp), out]
+        seconds = float(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+        return seconds, np.load(out)
 
 def pathlab_render(depth, extra, name):
     out = f"{args.work}/{name}.exr"
