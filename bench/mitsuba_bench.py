@@ -35,6 +35,7 @@ ap.add_argument("--scene", required=True)
 ap.add_argument("--reference", required=True)
 ap.add_argument("--work", required=True)
 ap.add_argument("--spp", type=int, default=64)
+ap.add_argument("--reps", type=int, default=3, help="speed runs per renderer, taken in turns")
 args = ap.parse_args()
 
 variant = "llvm_ad_rgb"
@@ -67,15 +68,22 @@ def pathlab_render(depth, extra, name):
     img = np.asarray(mi.Bitmap(out), dtype=np.float64)[..., :3]
     return stats, img
 
-print(f"Cornell box {width}x{height}, {args.spp} spp; Mitsuba 3 {mi.__version__} {variant}; pathlab, all threads")
+print(f"Cornell box {width}x{height}, {args.spp} spp; Mitsuba 3 {mi.__version__} {variant}; pathlab, all threads;"
+      f" medians of {args.reps} runs each")
 print(f"{'depth':<6} {'Mitsuba samples/s':>18} {'pathlab samples/s':>18} {'ratio':>7}")
 results = {"variant": variant, "spp": args.spp, "speed": {}, "equal_time": {}}
+# Each renderer's rate is the median of --reps runs, the two taking turns, so that one run
+# disturbed by the machine moves no ratio.
 for depth, mitsuba_depth in (("inf", -1), ("1", 2)):
-    t_m, _ = mitsuba_render(mitsuba_depth, args.spp)
-    rate_m = pixels * args.spp / t_m
-    stats, _ = pathlab_render(depth, ["-s", str(args.spp), "--sampler", "independent"], f"speed-{depth}")
-    rate_p = stats["samples_per_second"]
-    results["speed"][depth] = {"mitsuba": rate_m, "pathlab": rate_p, "ratio": rate_p / rate_m}
+    rates_m, rates_p = [], []
+    for _ in range(args.reps):
+        t_m, _ = mitsuba_render(mitsuba_depth, args.spp)
+        rates_m.append(pixels * args.spp / t_m)
+        stats, _ = pathlab_render(depth, ["-s", str(args.spp), "--sampler", "independent"], f"speed-{depth}")
+        rates_p.append(stats["samples_per_second"])
+    rate_m, rate_p = float(np.median(rates_m)), float(np.median(rates_p))
+    results["speed"][depth] = {"mitsuba": rate_m, "pathlab": rate_p, "ratio": rate_p / rate_m,
+                               "mitsuba_runs": rates_m, "pathlab_runs": rates_p}
     print(f"{depth:<6} {rate_m:18.3e} {rate_p:18.3e} {rate_p / rate_m:7.2f}")
 
 # Equal time at -m inf: Mitsuba at SPP sets the budget; each pathlab sampler gets the spp its

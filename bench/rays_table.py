@@ -1,20 +1,48 @@
 #!/usr/bin/env python3
-"""Table of pathlab / Embree ratios from the files bench/run.sh writes:
-MESH.embree.txt (embree_bench's output) and MESH.pathlab.json (`pathlab bench rays --json`)."""
-import json, re, sys
+"""Table of pathlab / Embree ratios from the files bench/run.sh writes: MESH.embree.K.txt
+(embree_bench's output) and MESH.pathlab.K.json (`pathlab bench rays --json`) for runs K = 1..N
+taken in turns; each rate is the median over the runs. Usage: rays_table.py WORK N MESH..."""
+import json, re, statistics, sys
 
-work, meshes = sys.argv[1], sys.argv[2:]
+work, reps, meshes = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
+
+
+def median_json(runs):
+    """The runs' JSON with every number replaced by its median over the runs."""
+    first = runs[0]
+    if isinstance(first, dict):
+        return {k: median_json([r[k] for r in runs]) for k in first}
+    if isinstance(first, list):
+        return [median_json(list(items)) for items in zip(*runs)]
+    if isinstance(first, (int, float)) and not isinstance(first, bool):
+        return statistics.median(runs)
+    return first
+
+
+def embree(m):
+    """(build seconds, {threads: (primary, bounce)}), medians over the runs."""
+    builds, rates = [], {}
+    for k in range(1, reps + 1):
+        text = open(f"{work}/{m}.embree.{k}.txt").read()
+        builds.append(float(re.search(r"build_s ([0-9.]+)", text).group(1)))
+        for t, p, b in re.findall(
+                r"threads (\d+) primary_Mrays_per_s ([0-9.]+) bounce_Mrays_per_s ([0-9.]+)", text):
+            rates.setdefault(int(t), []).append((float(p), float(b)))
+    return statistics.median(builds), {
+        t: (statistics.median(p for p, _ in v), statistics.median(b for _, b in v))
+        for t, v in rates.items()}
+
+
+ours_of = {m: median_json([json.load(open(f"{work}/{m}.pathlab.{k}.json"))
+                           for k in range(1, reps + 1)]) for m in meshes}
 rows = []
 print(f"{'mesh':<12} {'tris':>8} | {'build s':>16} {'ratio':>6} | "
       f"{'primary 1T Mrays/s':>19} {'ratio':>6} | {'bounce 1T Mrays/s':>18} {'ratio':>6} | "
       f"{'bounce NT':>13} {'ratio':>6} | {'B/tri':>6} {'agree %':>8}")
 for m in meshes:
-    text = open(f"{work}/{m}.embree.txt").read()
-    build = float(re.search(r"build_s ([0-9.]+)", text).group(1))
-    per_thread = {int(t): (float(p), float(b)) for t, p, b in re.findall(
-        r"threads (\d+) primary_Mrays_per_s ([0-9.]+) bounce_Mrays_per_s ([0-9.]+)", text)}
+    build, per_thread = embree(m)
     e1, en = per_thread[1], per_thread[max(per_thread)]
-    ours = json.load(open(f"{work}/{m}.pathlab.json"))
+    ours = ours_of[m]
     sets = {s["rays"]: s for s in ours["sets"]}
     p1 = sets["primary"]["mrays_per_s_1_thread"]
     b1 = sets["bounce"]["mrays_per_s_1_thread"]
@@ -24,11 +52,11 @@ for m in meshes:
           f"{ours['bvh_build_seconds'] / build:6.2f} | {p1:8.2f}/{e1[0]:<10.2f} {p1 / e1[0]:6.2f} | "
           f"{b1:7.2f}/{e1[1]:<10.2f} {b1 / e1[1]:6.2f} | {bn:5.2f}/{en[1]:<7.2f} {bn / en[1]:6.2f} | "
           f"{ours['bytes_per_triangle']:6.0f} {agree:8.4f}")
-print("(each cell: pathlab/Embree; ratio = pathlab / Embree, so > 1 is faster throughput, "
-      "< 1 is faster build)")
+print("(each cell: pathlab/Embree, medians of", reps, "runs taken in turns; ratio = pathlab / Embree,"
+      " so > 1 is faster throughput, < 1 is faster build)")
 
 # The obvhs crate's compressed wide BVH on the same rays, where pathlab was built with it.
-rows = [(m, json.load(open(f"{work}/{m}.pathlab.json"))) for m in meshes]
+rows = [(m, ours_of[m]) for m in meshes]
 rows = [(m, d) for m, d in rows if "obvhs" in d.get("binary_bvh_baseline", {})]
 if rows:
     print()

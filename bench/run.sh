@@ -41,11 +41,16 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
         meshes+=("$scene")
     done
     threads="$(nproc)"
+    # Embree and pathlab take turns, PATHLAB_BENCH_REPS times (default 3) per mesh; the table
+    # takes each rate's median, so that one disturbed run moves no ratio.
+    reps="${PATHLAB_BENCH_REPS:-3}"
     for m in "${meshes[@]}"; do
-        "$work/embree_bench" "$work/$m.obj" "$threads" "$work/$m.rays" > "$work/$m.embree.txt"
-        "$pathlab" bench rays "$work/$m.obj" "$work/$m.rays" --repeat 5 --json > "$work/$m.pathlab.json"
+        for rep in $(seq "$reps"); do
+            "$work/embree_bench" "$work/$m.obj" "$threads" "$work/$m.rays" > "$work/$m.embree.$rep.txt"
+            "$pathlab" bench rays "$work/$m.obj" "$work/$m.rays" --repeat 5 --json > "$work/$m.pathlab.$rep.json"
+        done
     done
-    python3 "$root/bench/rays_table.py" "$work" "${meshes[@]}"
+    python3 "$root/bench/rays_table.py" "$work" "$reps" "${meshes[@]}"
 fi
 
 if [ "$what" = all ] || [ "$what" = render ]; then
