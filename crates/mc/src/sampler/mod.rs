@@ -167,20 +167,26 @@ impl AnySampler {
             return SobolSampler::next_lanes(&mut [a, b, c, d, e, f, g, h], lanes, dims, out);
         }
         for (lane, s) in samplers.iter_mut().enumerate() {
-            if lanes & (1 << lane) == 0 {
-                continue;
+            if lanes & (1 << lane) != 0 {
+                // One match per lane, then the sampler's own calls, inlined.
+                dispatch!(s, s => draw_lane(s, lane, dims, out));
             }
-            let mut k = 0;
-            for &n in dims {
-                if n == 1 {
-                    out[k][lane] = s.next_1d();
-                    k += 1;
-                } else {
-                    let v = s.next_2d();
-                    (out[k][lane], out[k + 1][lane]) = (v.x, v.y);
-                    k += 2;
-                }
-            }
+        }
+    }
+}
+
+/// The requests `dims` of [`AnySampler::next_lanes`] for one sampler, into lane `lane` of `out`.
+#[inline]
+fn draw_lane<S: Sampler>(s: &mut S, lane: usize, dims: &[u32], out: &mut [[f32; LANES]]) {
+    let mut k = 0;
+    for &n in dims {
+        if n == 1 {
+            out[k][lane] = s.next_1d();
+            k += 1;
+        } else {
+            let v = s.next_2d();
+            (out[k][lane], out[k + 1][lane]) = (v.x, v.y);
+            k += 2;
         }
     }
 }
