@@ -333,36 +333,9 @@ impl PathIntegrator {
                 if lambert_lanes & (1 << i) == 0 {
                     continue;
                 }
-                let st = &mut lane.st;
-                let mut triangle_light = false;
-                if let Some((index, pmf)) = scene.light_sampler().sample(u[0][i]) {
-                    match &scene.lights()[index] {
-                        Light::Area {
-                            shape: AreaShape::Triangle(t),
-                            radiance,
-                            two_sided,
-                        } => {
-                            triangle_light = true;
-                            for (v, p) in a.light_vertices.iter_mut().zip(t.triangle.p) {
-                                v.set(i, p);
-                            }
-                            a.light_normal.set(i, t.normal);
-                            a.light_pdf_area.0[i] = t.pdf_area;
-                            a.light_radiance.set(i, *radiance);
-                            a.light_two_sided.set(i, *two_sided);
-                            a.light_pmf.0[i] = pmf;
-                        }
-                        _ => {
-                            let wo = -st.ray.d;
-                            let bsdf = scene.bsdf(si, wo);
-                            let u_light = Vec2::new(u[1][i], u[2][i]);
-                            let ld =
-                                sample_light(scene, si, &bsdf, wo, u[0][i], u_light, 1, 1, stats);
-                            // (The scalar code divides by the one light sample: exact.)
-                            st.l += st.beta * ld;
-                        }
-                    }
-                }
+                let u_light = Vec2::new(u[1][i], u[2][i]);
+                let triangle_light =
+                    gather_light(scene, i, si, &mut lane.st, u[0][i], u_light, &mut a, stats);
                 a.light.set(i, triangle_light);
             }
             scatter(&a, &mut b);
@@ -370,30 +343,92 @@ impl PathIntegrator {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
                     continue;
                 };
-                let st = &mut lane.st;
-                if b.shadow.get(i) {
-                    stats.rays += 1;
-                    let shadow = Ray {
-                        o: b.shadow_o.get(i),
-                        d: b.shadow_d.get(i),
-                        t_min: 0.0,
-                        t_max: 1.0 - 1e-4,
-                    };
-                    if !scene.occluded(&shadow) {
-                        st.l += st.beta * b.ld.get(i);
-                    }
-                }
-                let goes_on = b.sampled.get(i) && {
-                    st.beta *= b.weight.get(i);
-                    st.beta.max_element() > 0.0
-                        && st.beta.is_finite()
-                        && self.survive(st, si, b.wi.get(i), b.pdf.0[i], u[6][i])
-                };
+                let goes_on = self.finish_bounce(scene, i, &mut lane.st, si, &b, u[6][i], stats);
                 if !goes_on {
-                    out(lane.tag, st.l);
+                    out(lane.tag, lane.st.l);
                     lanes[i] = None;
                 }
             }
+        }
+    }
+
+    /// The end of lane `i`'s bounce after the SIMD scattering: the shadow ray (adding the light
+    /// sample's contribution where it is unblocked), the throughput times the BSDF sample's
+    /// weight, Russian roulette with `u_rr`. Returns whether the path goes on.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn finish_bounce(
+        &self,
+        scene: &Scene,
+        i: usize,
+        st: &mut PathState,
+        si: &SurfaceInteraction,
+        b: &ScatterOut,
+        u_rr: f32,
+        stats: &mut PathStats,
+    ) -> bool {
+        if b.shadow.get(i) {
+            stats.rays += 1;
+            let shadow = Ray {
+                o: b.shadow_o.get(i),
+                d: b.shadow_d.get(i),
+                t_min: 0.0,
+                t_max: 1.0 - 1e-4,
+            };
+            if !scene.occluded(&shadow) {
+                st.l += st.beta * b.ld.get(i);
+            }
+        }
+        b.sampled.get(i) && {
+            st.beta *= b.weight.get(i);
+            st.beta.max_element() > 0.0
+                && st.beta.is_finite()
+                && self.survive(st, si, b.wi.get(i), b.pdf.0[i], u_rr)
+        }
+    }
+}
+
+/// Lane `i`'s light choice from `u_select`: an emitting triangle's data go to the lane of `a`
+/// (returns true) for the SIMD light sample; any other light is sampled here with the scalar
+/// code, its contribution added to `st.l`. No light: nothing (as the scalar code).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn gather_light(
+    scene: &Scene,
+    i: usize,
+    si: &SurfaceInteraction,
+    st: &mut PathState,
+    u_select: f32,
+    u_light: Vec2,
+    a: &mut ScatterIn,
+    stats: &mut PathStats,
+) -> bool {
+    let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
+        return false;
+    };
+    match &scene.lights()[index] {
+        Light::Area {
+            shape: AreaShape::Triangle(t),
+            radiance,
+            two_sided,
+        } => {
+            for (v, p) in a.light_vertices.iter_mut().zip(t.triangle.p) {
+                v.set(i, p);
+            }
+            a.light_normal.set(i, t.normal);
+            a.light_pdf_area.0[i] = t.pdf_area;
+            a.light_radiance.set(i, *radiance);
+            a.light_two_sided.set(i, *two_sided);
+            a.light_pmf.0[i] = pmf;
+            true
+        }
+        _ => {
+            let wo = -st.ray.d;
+            let bsdf = scene.bsdf(si, wo);
+            let ld = sample_light(scene, si, &bsdf, wo, u_select, u_light, 1, 1, stats);
+            // (The scalar code divides by the one light sample: exact.)
+            st.l += st.beta * ld;
+            false
         }
     }
 }
