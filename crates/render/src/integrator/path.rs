@@ -131,26 +131,28 @@ impl PathIntegrator {
         hit: Option<&SurfaceInteraction>,
     ) -> bool {
         let Some(si) = hit else {
-            if let Some((le, pdf_light)) = escaped(scene, &st.ray) {
-                let w = st
-                    .prev
-                    .map_or(1.0, |(_, pdf_bsdf)| self.bsdf_weight(pdf_bsdf, pdf_light));
-                if self.wants(st.depth) {
-                    st.l += st.beta * w * le;
-                }
+            if let Some(found) = escaped(scene, &st.ray) {
+                self.add_found_light(st, found);
             }
             return false;
         };
         let p_prev = st.prev.map_or(st.ray.o, |(p, _)| p);
-        if let Some((le, pdf_light)) = emitted(scene, p_prev, &st.ray, si) {
-            let w = st
-                .prev
-                .map_or(1.0, |(_, pdf_bsdf)| self.bsdf_weight(pdf_bsdf, pdf_light));
-            if self.wants(st.depth) {
-                st.l += st.beta * w * le;
-            }
+        if let Some(found) = emitted(scene, p_prev, &st.ray, si) {
+            self.add_found_light(st, found);
         }
         st.depth < self.max_depth
+    }
+
+    /// Adds radiance `le` that the path's BSDF-sampled ray found, which light sampling would
+    /// have found with density `pdf_light`, weighted by MIS against it.
+    #[inline]
+    fn add_found_light(&self, st: &mut PathState, (le, pdf_light): (Rgb, f32)) {
+        let w = st
+            .prev
+            .map_or(1.0, |(_, pdf_bsdf)| self.bsdf_weight(pdf_bsdf, pdf_light));
+        if self.wants(st.depth) {
+            st.l += st.beta * w * le;
+        }
     }
 
     /// Scattering at `si`: light sampling, then a BSDF-sampled direction and Russian roulette.
