@@ -186,6 +186,10 @@ pub fn spawn_ray(p: Vec3, ng: Vec3, w: Vec3) -> Ray {
     Ray::new(offset_ray_origin(p, ng, w), w)
 }
 
+/// The far end of a shadow ray from [`spawn_ray_to`], whose direction spans the segment to its
+/// target: just short of it.
+pub const SHADOW_RAY_END: f32 = 1.0 - 1e-4;
+
 /// A shadow ray from surface point `p` towards point `target` (which lies on a surface with
 /// normal `ng_target`, or anywhere when `None`), stopping just short of it.
 #[inline]
@@ -200,6 +204,6 @@ pub fn spawn_ray_to(p: Vec3, ng: Vec3, target: Vec3, ng_target: Option<Vec3>) ->
         o,
         d,
         t_min: 0.0,
-        t_max: 1.0 - 1e-4,
+        t_max: SHADOW_RAY_END,
     }
 }

@@ -16,7 +16,7 @@ use super::{camera_ray, sample_light, PathStats, SampleRef};
 use crate::accel::RayLanes;
 use crate::bsdf::{Bxdf, Material};
 use crate::desc::Rgb;
-use crate::geometry::{Ray, RAY_EPSILON};
+use crate::geometry::{Ray, RAY_EPSILON, SHADOW_RAY_END};
 use crate::lanes::{F8, M8, V8, W};
 use crate::light::{AreaShape, Light};
 use crate::scene::{Scene, SurfaceInteraction};
@@ -288,18 +288,14 @@ impl PathIntegrator {
                             scene.intersect_into(&st.ray, st.depth == 0, &mut hits[i]) as u64
                     }
                 }
-                let Some(si) = &hits[i] else {
-                    self.arrive(scene, st, None);
-                    out(lane.tag, st.l);
-                    lanes[i] = None;
-                    continue;
-                };
-                if !self.arrive(scene, st, Some(si)) {
+                if !self.arrive(scene, st, hits[i].as_ref()) {
                     out(lane.tag, st.l);
                     lanes[i] = None;
                     hits[i] = None;
                     continue;
                 }
+                // `arrive` goes on only at a surface.
+                let Some(si) = &hits[i] else { continue };
                 let Some((reflectance, two_sided)) = lambertian(scene.material(si.material)) else {
                     if !self.scatter(scene, st, si, smp, stats) {
                         out(lane.tag, st.l);
@@ -326,13 +322,12 @@ impl PathIntegrator {
             AnySampler::next_lanes(&mut samplers, lambert_lanes, &[1, 2, 1, 2, 1], &mut u);
             a.u_light = [F8(u[1]), F8(u[2])];
             a.u_bsdf = [F8(u[4]), F8(u[5])];
+            // From here on, the lanes with a hit are the Lambertian ones (the others' hits
+            // were cleared above).
             for i in 0..W {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
                     continue;
                 };
-                if lambert_lanes & (1 << i) == 0 {
-                    continue;
-                }
                 let u_light = Vec2::new(u[1][i], u[2][i]);
                 let triangle_light =
                     gather_light(scene, i, si, &mut lane.st, u[0][i], u_light, &mut a, stats);
@@ -373,7 +368,7 @@ impl PathIntegrator {
                 o: b.shadow_o.get(i),
                 d: b.shadow_d.get(i),
                 t_min: 0.0,
-                t_max: 1.0 - 1e-4,
+                t_max: SHADOW_RAY_END,
             };
             if !scene.occluded(&shadow) {
                 st.l += st.beta * b.ld.get(i);
