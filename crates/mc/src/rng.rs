@@ -82,16 +82,6 @@ impl Pcg32 {
             .wrapping_add(plus.wrapping_mul(self.inc));
     }
 
-    /// Moves to the same dimension of the next pixel sample: [`Pcg32::advance`] by
-    /// [`DIMENSIONS_PER_SAMPLE`], in one multiply-add.
-    #[inline]
-    pub fn skip_pixel_sample(&mut self) {
-        let (mult, plus) = SAMPLE_JUMP;
-        self.state = mult
-            .wrapping_mul(self.state)
-            .wrapping_add(plus.wrapping_mul(self.inc));
-    }
-
     /// Moves to the same dimension `samples` pixel samples on: [`Pcg32::advance`] by
     /// `samples` times [`DIMENSIONS_PER_SAMPLE`], squaring the one-sample jump (a step per bit
     /// of `samples`, not per bit of the whole distance).
@@ -192,11 +182,6 @@ mod tests {
             b.advance(u64::from(k) * DIMENSIONS_PER_SAMPLE);
             assert_eq!(a, b, "{k}");
         }
-        let mut one = start.clone();
-        one.skip_pixel_samples(1);
-        let mut next = start;
-        next.skip_pixel_sample();
-        assert_eq!(one, next);
     }
 
     #[test]

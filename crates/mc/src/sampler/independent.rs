@@ -12,8 +12,9 @@ pub struct IndependentSampler {
     samples_per_pixel: u32,
     seed: u64,
     rng: Pcg32,
-    /// The pixel and sample index last started, and the generator at its dimension 0: the
-    /// next sample of the same pixel starts one jump from there instead of from the hash.
+    /// The pixel and sample index last started, and the generator at its dimension 0: a later
+    /// sample of the same pixel starts from there (by squaring the one-sample jump) instead of
+    /// from the hash.
     start: ([u32; 2], u32, Pcg32),
 }
 
@@ -37,14 +38,10 @@ impl Sampler for IndependentSampler {
 
     fn start_pixel_sample(&mut self, pixel: [u32; 2], sample_index: u32, dimension: u32) {
         // The same numbers as `Pcg32::for_pixel_sample(seed, pixel, sample_index, dimension)`
-        // (tested); renders ask for a pixel's samples in order, one jump apart (or a few, when
+        // (tested); renders ask for a pixel's samples in order, one apart (or a few, when
         // several paths are followed at once).
         let (last_pixel, last_index, ref last) = self.start;
-        let at_zero = if last_pixel == pixel && last_index.checked_add(1) == Some(sample_index) {
-            let mut rng = last.clone();
-            rng.skip_pixel_sample();
-            rng
-        } else if last_pixel == pixel && last_index <= sample_index {
+        let at_zero = if last_pixel == pixel && last_index <= sample_index {
             let mut rng = last.clone();
             rng.skip_pixel_samples(sample_index - last_index);
             rng
