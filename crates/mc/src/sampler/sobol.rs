@@ -163,13 +163,12 @@ impl SobolSampler {
         dims: &[u32],
         out: &mut [[f32; LANES]],
     ) {
-        let mut index = [0u32; LANES];
+        let index: [u32; LANES] = std::array::from_fn(|lane| samplers[lane].index());
         let mut k = 0;
         for &n in dims {
             let mut seed = [0u32; LANES];
             for (lane, s) in samplers.iter_mut().enumerate() {
                 if lanes & (1 << lane) != 0 {
-                    index[lane] = s.index();
                     seed[lane] = s.seed_for(s.dimension);
                     s.dimension += n;
                 }
@@ -221,7 +220,7 @@ fn padded_lanes_portable<const N: usize>(
         } else {
             let [x, y] = padded_2d(index[lane], seed[lane]);
             out[0][lane] = x;
-            out[N - 1][lane] = y;
+            out[N - 1][lane] = y; // N is 2 here
         }
     }
     out
