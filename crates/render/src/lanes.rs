@@ -147,12 +147,6 @@ impl M8 {
     pub fn set(&mut self, i: usize, on: bool) {
         self.0[i] = if on { !0 } else { 0 };
     }
-
-    /// Whether any lane is set.
-    #[inline(always)]
-    pub fn any(self) -> bool {
-        self.0.iter().any(|&m| m != 0)
-    }
 }
 
 macro_rules! lane_op {

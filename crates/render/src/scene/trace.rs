@@ -240,27 +240,31 @@ impl Scene {
         use crate::accel::{AvxNearest, AvxRays};
         let rays = AvxRays::new(rays);
         let mut nearest = AvxNearest::new(t_max);
-        for (block, info) in self.blocks.iter().zip(&self.block_info) {
-            for (lane, &slot) in info.slots.iter().enumerate() {
-                if slot != u32::MAX {
-                    block.nearest_for_rays_avx(lane, slot, &rays, &mut nearest);
-                }
-            }
-        }
+        self.for_each_triangle(|block, lane, slot| {
+            block.nearest_for_rays_avx(lane, slot, &rays, &mut nearest)
+        });
         nearest.lanes()
     }
 
     #[inline(always)]
     fn nearest_of_rays_lanes(&self, rays: &RayLanes, t_max: F8) -> Nearest {
         let mut nearest = Nearest::new(t_max);
+        self.for_each_triangle(|block, lane, slot| {
+            block.nearest_for_rays(lane, slot, rays, &mut nearest)
+        });
+        nearest
+    }
+
+    /// `f(block, lane, leaf slot)` for every used lane of every leaf block.
+    #[inline(always)]
+    fn for_each_triangle(&self, mut f: impl FnMut(&TriBlock, usize, u32)) {
         for (block, info) in self.blocks.iter().zip(&self.block_info) {
             for (lane, &slot) in info.slots.iter().enumerate() {
                 if slot != u32::MAX {
-                    block.nearest_for_rays(lane, slot, rays, &mut nearest);
+                    f(block, lane, slot);
                 }
             }
         }
-        nearest
     }
 
     /// [`Scene::any_hit`] with the box test `boxes`.
