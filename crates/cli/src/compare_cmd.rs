@@ -84,6 +84,7 @@ fn integrator(name: &str, max_depth: u32) -> Result<IntegratorKind> {
     Ok(IntegratorKind::Direct(DirectIntegrator {
         strategy,
         samples: 1,
+        ..Default::default()
     }))
 }
 

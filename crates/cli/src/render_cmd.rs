@@ -4,7 +4,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::desc::{FresnelModel, MaterialDesc, SceneDesc};
+use pathlab_render::desc::{FresnelModel, IntegratorHint, MaterialDesc, SceneDesc};
 use pathlab_render::film::Film;
 use pathlab_render::image_io::{write_exr, write_png_with, write_rgb8, ExtraChannel, ToneMap};
 use pathlab_render::integrator::{
@@ -98,9 +98,10 @@ pub struct RenderArgs {
     /// ..., inf = unbounded (with Russian roulette). Default: the scene file's, else inf.
     #[arg(short = 'm', long)]
     pub max_depth: Option<String>,
-    /// First bounce at which Russian roulette may end a path.
-    #[arg(long, default_value_t = 5)]
-    pub rr_depth: u32,
+    /// First bounce at which Russian roulette may end a path (default: the scene file's, else
+    /// 5).
+    #[arg(long)]
+    pub rr_depth: Option<u32>,
     /// Only the radiance of bounce K (0 = emission seen directly, 1 = direct, ...).
     #[arg(long, value_name = "K")]
     pub only_bounce: Option<u32>,
@@ -136,9 +137,13 @@ pub struct RenderArgs {
     /// Output image: .exr (linear) or .png (sRGB). Default: SCENE.png.
     #[arg(short = 'o', long, visible_short_alias = 'f', value_name = "FILE")]
     pub output: Option<PathBuf>,
-    /// The integrator.
-    #[arg(long, value_enum, default_value_t = IntegratorName::Path)]
-    pub integrator: IntegratorName,
+    /// The integrator (default: the one the scene file names, else path).
+    #[arg(long, value_enum)]
+    pub integrator: Option<IntegratorName>,
+    /// A scene parameter, NAME=VALUE, for the `$NAME` references of a Mitsuba scene (its
+    /// `<default>`s give the others). Repeat for several.
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
+    pub define: Vec<String>,
     /// How the path tracer finds light at each vertex: mis (light and BSDF sampling combined),
     /// bsdf (BSDF sampling only) or light (light sampling only).
     #[arg(long, value_enum, default_value_t = LightingName::Mis)]
@@ -280,7 +285,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         PathBuf::from(format!("{stem}.png"))
     });
     let format = output_format(&output)?;
-    let mut desc = pathlab_scene::load(&args.scene)?;
+    let params = args
+        .define
+        .iter()
+        .map(|d| match d.split_once('=') {
+            Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.to_string())),
+            _ => bail!("-D {d}: expected NAME=VALUE"),
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut desc = pathlab_scene::load_with(&args.scene, &params)?;
     if !args.quiet {
         for w in &desc.warnings {
             eprintln!("warning: {w}");
@@ -323,10 +336,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let max_depth = cli_depth.or(desc.hints.max_depth).unwrap_or(u32::MAX);
     apply_resolution(&mut desc, args.resolution.as_deref())?;
     let scene = Scene::build(&desc).context("cannot build the scene")?;
-    let integrator = match args.integrator {
+    let rr_depth = args.rr_depth.or(desc.hints.rr_depth).unwrap_or(5);
+    let integrator_name = args.integrator.unwrap_or(match desc.hints.integrator {
+        Some(IntegratorHint::Direct { .. }) => IntegratorName::Direct,
+        _ => IntegratorName::Path,
+    });
+    let integrator = match integrator_name {
+        IntegratorName::Direct if args.integrator.is_none() => {
+            IntegratorKind::from_hints(&desc.hints)
+        }
         IntegratorName::Path => IntegratorKind::Path(PathIntegrator {
             max_depth,
-            rr_depth: args.rr_depth,
+            rr_depth,
+            hide_emitters: desc.hints.hide_emitters,
             only_bounce: args.only_bounce,
             light_samples: args.light_samples,
             lighting: match args.lighting {
@@ -338,6 +360,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         IntegratorName::Direct => IntegratorKind::Direct(DirectIntegrator {
             strategy: args.direct,
             samples: args.light_samples,
+            hide_emitters: desc.hints.hide_emitters,
+            ..Default::default()
         }),
         IntegratorName::Normals => IntegratorKind::Debug(DebugView::Normals),
         IntegratorName::Depth => IntegratorKind::Debug(DebugView::Depth),
@@ -359,11 +383,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "--adaptive and --target-error/--time are different ways to place samples; choose one"
         );
     }
-    let sampler = args.sampler.unwrap_or(if progressive {
-        SamplerKind::Independent
-    } else {
-        SamplerKind::Sobol
-    });
+    let sampler = args
+        .sampler
+        .or(desc.hints.sampler)
+        .unwrap_or(if progressive {
+            SamplerKind::Independent
+        } else {
+            SamplerKind::Sobol
+        });
     let mut settings = RenderSettings::new(spp, args.seed, sampler);
     if let Some(a) = &args.adaptive {
         settings.adaptive = Some(parse_adaptive(a)?);
@@ -481,7 +508,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "output": output,
             "resolution": [w, h],
             "spp": spp,
-            "integrator": format!("{:?}", args.integrator).to_lowercase(),
+            "integrator": format!("{integrator_name:?}").to_lowercase(),
             "max_depth": if max_depth == u32::MAX { json!("inf") } else { json!(max_depth) },
             "threads": threads,
             "seconds": stats.seconds,

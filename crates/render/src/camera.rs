@@ -1,25 +1,33 @@
-//! The perspective camera: pinhole, or thin lens when it has an aperture.
+//! The camera: perspective (pinhole, or thin lens when it has an aperture) or orthographic,
+//! and the pixel filter that places each pixel's samples.
 
-use crate::desc::{CameraDesc, FovAxis};
+use crate::desc::{CameraDesc, FovAxis, PixelFilter, Projection};
 use crate::geometry::Ray;
 use glam::{Vec2, Vec3};
 use pathlab_mc::warp::sample_uniform_disk_concentric;
+use std::sync::Arc;
 
-/// A perspective camera generating rays through film positions.
+/// A camera generating rays through film positions.
 ///
 /// Film coordinates are in pixels, `(0, 0)` at the top-left corner of the image, x to the right
 /// and y down; the image's right is the camera's right (`forward × up`) and its top is `up`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
     origin: Vec3,
     right: Vec3,
     up: Vec3,
     forward: Vec3,
-    /// Half-extents of the image on the plane at distance 1.
+    /// Half-extents of the image on the plane at distance 1 (orthographic: in scene units).
     half: Vec2,
+    /// Shift of the image window in normalised device coordinates.
+    shift: Vec2,
+    orthographic: bool,
     resolution: [u32; 2],
     lens_radius: f32,
     focal_distance: f32,
+    near: f32,
+    far: f32,
+    filter: Option<Arc<FilterSampler>>,
 }
 
 impl Camera {
@@ -45,15 +53,57 @@ impl Camera {
                 },
             ),
         };
+        let (half, orthographic) = match desc.projection {
+            Projection::Perspective => (Vec2::new(tan * w / along, tan * h / along), false),
+            Projection::Orthographic { half_extent } => (half_extent, true),
+        };
         Camera {
             origin: desc.origin,
             right,
             up,
             forward,
-            half: Vec2::new(tan * w / along, tan * h / along),
+            half,
+            shift: Vec2::new(
+                2.0 * desc.principal_point_offset.x,
+                -2.0 * desc.principal_point_offset.y,
+            ),
+            orthographic,
             resolution,
             lens_radius: desc.lens_radius.max(0.0),
             focal_distance: desc.focal_distance,
+            near: desc.near_clip.max(0.0),
+            far: if desc.far_clip > desc.near_clip {
+                desc.far_clip
+            } else {
+                f32::INFINITY
+            },
+            filter: None,
+        }
+    }
+
+    /// The camera with pixel filter `filter` placing its samples.
+    pub fn with_filter(mut self, filter: PixelFilter) -> Self {
+        self.filter = FilterSampler::new(filter).map(Arc::new);
+        self
+    }
+
+    /// The film position of the sample `u` ∈ [0, 1)² of pixel `pixel`: uniform in the pixel
+    /// for a box filter, otherwise drawn from the filter around the pixel's centre, restricted
+    /// to the image (so that each pixel's expected value is the filter-weighted average of the
+    /// radiance over the image, as splatting samples into neighbouring pixels gives).
+    #[inline]
+    pub fn film_position(&self, pixel: [u32; 2], u: Vec2) -> Vec2 {
+        let p = Vec2::new(pixel[0] as f32, pixel[1] as f32);
+        match &self.filter {
+            None => p + u,
+            Some(f) => {
+                let c = p + 0.5;
+                let (w, h) = (self.resolution[0] as f32, self.resolution[1] as f32);
+                Vec2::new(
+                    c.x + f.sample(u.x, -c.x, w - c.x),
+                    c.y + f.sample(u.y, -c.y, h - c.y),
+                )
+            }
         }
     }
 
@@ -75,21 +125,132 @@ impl Camera {
     /// The ray through film position `film` (pixels), through the lens point chosen by
     /// `u_lens` when the camera has an aperture. The direction has unit length.
     pub fn generate_ray(&self, film: Vec2, u_lens: Vec2) -> Ray {
-        let ndc = Vec2::new(
+        let mut ndc = Vec2::new(
             2.0 * film.x / self.resolution[0] as f32 - 1.0,
             1.0 - 2.0 * film.y / self.resolution[1] as f32,
         );
+        if self.shift != Vec2::ZERO {
+            ndc += self.shift;
+        }
+        if self.orthographic {
+            let o = self.origin + ndc.x * self.half.x * self.right + ndc.y * self.half.y * self.up;
+            return self.clip(Ray::new(o, self.forward), 1.0);
+        }
         let d = (ndc.x * self.half.x * self.right + ndc.y * self.half.y * self.up + self.forward)
             .normalize();
         if self.lens_radius <= 0.0 {
-            return Ray::new(self.origin, d);
+            return self.clip(Ray::new(self.origin, d), d.dot(self.forward));
         }
         // Thin lens: every ray through the lens point meets the pinhole ray at the plane of
         // focus.
         let lens = self.lens_radius * sample_uniform_disk_concentric(u_lens);
         let o = self.origin + lens.x * self.right + lens.y * self.up;
         let focus = self.origin + d * (self.focal_distance / d.dot(self.forward));
-        Ray::new(o, (focus - o).normalize())
+        let d = (focus - o).normalize();
+        self.clip(Ray::new(o, d), d.dot(self.forward))
+    }
+
+    /// `ray` limited to the depths between the near and far clipping planes (`cos`: the cosine
+    /// between the ray and the viewing direction).
+    #[inline]
+    fn clip(&self, mut ray: Ray, cos: f32) -> Ray {
+        if self.near > 0.0 || self.far.is_finite() {
+            let inv = 1.0 / cos.max(1e-6);
+            ray.t_min = self.near * inv;
+            ray.t_max = self.far * inv;
+        }
+        ray
+    }
+}
+
+/// Draws pixel sample offsets from a filter's one-dimensional profile (the filters are
+/// separable): the inverse of its tabulated cumulative distribution, restricted to an interval
+/// (the part of the filter inside the image).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilterSampler {
+    radius: f32,
+    /// Cumulative weight at the edges of `BINS` equal bins over [-radius, radius], from 0 to 1.
+    cdf: Vec<f32>,
+}
+
+impl FilterSampler {
+    const BINS: usize = 1024;
+
+    /// The sampler for `filter` (`None` for the box filter, which needs none).
+    pub fn new(filter: PixelFilter) -> Option<Self> {
+        let (radius, weight): (f32, Box<dyn Fn(f32) -> f64>) = match filter {
+            PixelFilter::Box => return None,
+            PixelFilter::Tent { radius } => {
+                let r = radius.max(1e-3);
+                (
+                    r,
+                    Box::new(move |x: f32| (1.0 - (x / r).abs()).max(0.0) as f64),
+                )
+            }
+            PixelFilter::Gaussian { stddev } => {
+                let s = stddev.max(1e-3) as f64;
+                let r = 4.0 * s;
+                let cut = (-r * r / (2.0 * s * s)).exp();
+                (
+                    r as f32,
+                    Box::new(move |x: f32| {
+                        let x = x as f64;
+                        ((-x * x / (2.0 * s * s)).exp() - cut).max(0.0)
+                    }),
+                )
+            }
+        };
+        let n = Self::BINS;
+        let mut cdf = Vec::with_capacity(n + 1);
+        let mut sum = 0.0f64;
+        cdf.push(0.0);
+        let step = 2.0 * radius / n as f32;
+        for i in 0..n {
+            // Midpoint rule in each bin.
+            sum += weight(-radius + (i as f32 + 0.5) * step);
+            cdf.push(sum as f32);
+        }
+        for c in &mut cdf {
+            *c /= sum as f32;
+        }
+        Some(FilterSampler { radius, cdf })
+    }
+
+    /// The filter's radius in pixels.
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// The cumulative distribution at offset `x`.
+    fn cdf_at(&self, x: f32) -> f32 {
+        let t = ((x + self.radius) / (2.0 * self.radius) * Self::BINS as f32)
+            .clamp(0.0, Self::BINS as f32);
+        let i = (t as usize).min(Self::BINS - 1);
+        let f = t - i as f32;
+        self.cdf[i] + f * (self.cdf[i + 1] - self.cdf[i])
+    }
+
+    /// An offset in [lo, hi] ∩ [-radius, radius] drawn with density ∝ the filter, from `u`.
+    pub fn sample(&self, u: f32, lo: f32, hi: f32) -> f32 {
+        let (a, b) = (
+            self.cdf_at(lo.max(-self.radius)),
+            self.cdf_at(hi.min(self.radius)),
+        );
+        let target = a + u * (b - a);
+        // The bin holding `target`, then linear within it (the density is constant per bin).
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= target)
+            .clamp(1, Self::BINS)
+            - 1;
+        let (c0, c1) = (self.cdf[i], self.cdf[i + 1]);
+        let f = if c1 > c0 {
+            (target - c0) / (c1 - c0)
+        } else {
+            0.5
+        };
+        let step = 2.0 * self.radius / Self::BINS as f32;
+        (-self.radius + (i as f32 + f) * step).clamp(lo, hi)
     }
 }
 

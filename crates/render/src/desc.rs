@@ -1,6 +1,6 @@
 //! The plain scene description that loaders produce and [`crate::scene::Scene::build`] consumes.
 
-use glam::{Mat3, Vec2, Vec3};
+use glam::{Affine2, Mat3, Vec2, Vec3};
 use std::sync::Arc;
 
 pub use crate::bsdf::{FresnelModel, NormalDistribution};
@@ -32,6 +32,10 @@ pub struct SceneDesc {
     pub camera: CameraDesc,
     /// Image size in pixels `[width, height]`.
     pub resolution: [u32; 2],
+    /// The pixel reconstruction filter.
+    pub filter: PixelFilter,
+    /// Spot lights whose cone carries an image, and projectors (see [`ProjectorDesc`]).
+    pub projectors: Vec<ProjectorDesc>,
     /// What the loader noticed and worked around (unsupported features, missing textures).
     pub warnings: Vec<String>,
     /// Render settings the scene file asks for (command-line flags take precedence).
@@ -78,6 +82,158 @@ pub struct RenderHints {
     pub spp: Option<u32>,
     /// Largest bounce in pathlab's counting (`u32::MAX`: unbounded).
     pub max_depth: Option<u32>,
+    /// First bounce at which Russian roulette may end a path.
+    pub rr_depth: Option<u32>,
+    /// The integrator the file names.
+    pub integrator: Option<IntegratorHint>,
+    /// Whether camera rays should not see emitters.
+    pub hide_emitters: bool,
+    /// The sampler the file names.
+    pub sampler: Option<pathlab_mc::sampler::SamplerKind>,
+}
+
+/// An integrator a scene file asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorHint {
+    /// Path tracing (also what a particle tracer's image converges to).
+    Path,
+    /// Direct lighting with `emitter_samples` light samples and `bsdf_samples` BSDF samples
+    /// per pixel sample, combined by the power heuristic.
+    Direct {
+        /// Light samples.
+        emitter_samples: u32,
+        /// BSDF samples.
+        bsdf_samples: u32,
+    },
+}
+
+/// The pixel reconstruction filter: how much a sample at an offset from a pixel's centre
+/// counts towards that pixel. pathlab draws each pixel's sample positions from the filter
+/// (restricted to the image), which gives each pixel the filter-weighted average of radiance
+/// that splatting every sample into its neighbours converges to.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum PixelFilter {
+    /// The pixel's own square, uniformly.
+    #[default]
+    Box,
+    /// A tent 1 - |x|/radius in each axis.
+    Tent {
+        /// Radius in pixels.
+        radius: f32,
+    },
+    /// A Gaussian of standard deviation `stddev` pixels, cut at 4 standard deviations and
+    /// shifted down to zero there (Mitsuba's `gaussian`).
+    Gaussian {
+        /// Standard deviation in pixels.
+        stddev: f32,
+    },
+}
+
+/// How an image texture is read between texel centres.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TextureFilter {
+    /// The nearest texel.
+    Nearest,
+    /// Bilinear interpolation of the four nearest texels.
+    #[default]
+    Bilinear,
+}
+
+/// What an image texture shows outside [0, 1]².
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WrapMode {
+    /// The image repeats.
+    #[default]
+    Repeat,
+    /// The image repeats, every other copy mirrored.
+    Mirror,
+    /// The border texels extend.
+    Clamp,
+}
+
+/// A quantity that varies over a surface: a colour, or a number (read as the luminance of the
+/// colour, which for grey values is the value itself).
+///
+/// Surface coordinates are pathlab's (u, v), v growing upwards (OBJ, OpenGL); `to_uv` maps
+/// them to the texture's own coordinates: an image's are the same convention (its bottom-left
+/// corner at (0, 0)), a checkerboard's are Mitsuba's (v growing downwards).
+#[derive(Clone, Debug, PartialEq)]
+pub enum TextureDesc {
+    /// The same value everywhere.
+    Constant(Rgb),
+    /// An image.
+    Image {
+        /// The texels.
+        image: Arc<Texture>,
+        /// Interpolation.
+        filter: TextureFilter,
+        /// Outside [0, 1]².
+        wrap: WrapMode,
+        /// Surface (u, v) to image coordinates.
+        to_uv: Affine2,
+    },
+    /// Mitsuba's checkerboard: `color0` where the fractional parts of u and v are both below
+    /// or both above ½, `color1` elsewhere.
+    Checkerboard {
+        /// The first colour.
+        color0: Rgb,
+        /// The second colour.
+        color1: Rgb,
+        /// Surface (u, v) to checkerboard coordinates.
+        to_uv: Affine2,
+    },
+    /// A per-vertex (interpolated) or per-face attribute of the mesh, by name.
+    MeshAttribute {
+        /// The attribute's name (e.g. `vertex_color`, `face_weight`).
+        name: String,
+    },
+}
+
+impl TextureDesc {
+    /// The same number everywhere.
+    pub fn value(v: f32) -> Self {
+        TextureDesc::Constant(Rgb::splat(v))
+    }
+
+    /// An image, read bilinearly and repeating, in surface coordinates.
+    pub fn image(image: Arc<Texture>) -> Self {
+        TextureDesc::Image {
+            image,
+            filter: TextureFilter::Bilinear,
+            wrap: WrapMode::Repeat,
+            to_uv: Affine2::IDENTITY,
+        }
+    }
+
+    /// The constant value, if the texture is one.
+    pub fn as_constant(&self) -> Option<Rgb> {
+        match self {
+            TextureDesc::Constant(c) => Some(*c),
+            _ => None,
+        }
+    }
+
+    /// A summary value: the constant, the image's mean, the checkerboard's average colour.
+    pub fn mean(&self) -> Rgb {
+        match self {
+            TextureDesc::Constant(c) => *c,
+            TextureDesc::Image { image, .. } => image.mean(),
+            TextureDesc::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
+            TextureDesc::MeshAttribute { .. } => Rgb::splat(0.5),
+        }
+    }
+}
+
+/// A named attribute of a mesh's vertices or faces (Mitsuba's `vertex_*` / `face_*` PLY
+/// properties), up to three channels (one channel is stored in all three).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshAttribute {
+    /// Its name, with the `vertex_` or `face_` prefix.
+    pub name: String,
+    /// Whether there is one value per face (else one per vertex, interpolated).
+    pub per_face: bool,
+    /// The values.
+    pub values: Vec<Vec3>,
 }
 
 /// Which rays see a shape.
@@ -132,6 +288,13 @@ pub struct MeshDesc {
     pub uvs: Vec<Vec2>,
     /// Which rays see the mesh.
     pub visibility: Visibility,
+    /// A texture that multiplies the emitted radiance (its (u, v) are the mesh's).
+    pub emission_texture: Option<TextureDesc>,
+    /// Named vertex and face attributes (for [`TextureDesc::MeshAttribute`]).
+    pub attributes: Vec<MeshAttribute>,
+    /// Per-vertex tangents along increasing u (empty: derived from the texture coordinates,
+    /// or arbitrary without them), for anisotropic materials and normal maps.
+    pub tangents: Vec<Vec3>,
 }
 
 /// A sphere in world space.
@@ -145,6 +308,24 @@ pub struct SphereDesc {
     pub material: usize,
     /// Emitted radiance, if the sphere is an area light.
     pub emission: Option<Emission>,
+    /// Rotation from world to the sphere's own frame, in which its texture coordinates are
+    /// spherical angles about z: u = φ/2π, v = 1 - θ/π.
+    pub to_object: Mat3,
+    /// A texture that multiplies the emitted radiance.
+    pub emission_texture: Option<TextureDesc>,
+}
+
+impl Default for SphereDesc {
+    fn default() -> Self {
+        SphereDesc {
+            center: Vec3::ZERO,
+            radius: 1.0,
+            material: 0,
+            emission: None,
+            to_object: Mat3::IDENTITY,
+            emission_texture: None,
+        }
+    }
 }
 
 /// Emission of an area light.
@@ -166,10 +347,10 @@ pub enum MaterialDesc {
         /// Whether the back side reflects too (otherwise it is black, as Mitsuba's `diffuse`).
         two_sided: bool,
     },
-    /// Lambertian reflection whose albedo comes from an image texture (times `scale`).
+    /// Lambertian reflection whose albedo comes from a texture (times `scale`).
     TexturedDiffuse {
         /// The albedo texture (linear RGB).
-        texture: Arc<Texture>,
+        texture: TextureDesc,
         /// Factor applied to the texture.
         scale: Rgb,
         /// Whether the back side reflects too.
@@ -273,6 +454,66 @@ pub struct DirectionalLightDesc {
     pub irradiance: Rgb,
 }
 
+/// A point light that shines through an image plane at distance 1 along its axis: Mitsuba's
+/// `spot` (a cone with a smooth edge, optionally carrying an image) and `projector` (an image
+/// projected like a slide).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProjectorDesc {
+    /// Position.
+    pub position: Vec3,
+    /// The light's frame: columns are its local x, y and z axes in world space (orthonormal);
+    /// it shines along z.
+    pub frame: Mat3,
+    /// What the image plane shows, in image coordinates (u, v) with v growing upwards (see
+    /// [`ProjectorKind`] for where a direction lands).
+    pub texture: TextureDesc,
+    /// The emission profile.
+    pub kind: ProjectorKind,
+}
+
+/// How a [`ProjectorDesc`] emits. Directions are in the light's frame, (x, y, z) with z > 0;
+/// image coordinates (u, v) are pathlab's (v up): Mitsuba's with v flipped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ProjectorKind {
+    /// Mitsuba's `spot`: intensity × image(u, v) × falloff, the falloff 1 within
+    /// `beam_width` of the axis, falling linearly in angle to 0 at `cutoff`; the image spans
+    /// the cutoff cone, u = ½ + ½ x / (z tan cutoff), Mitsuba's v = ½ + ½ y / (z tan cutoff).
+    Spot {
+        /// Intensity on the axis.
+        intensity: Rgb,
+        /// Half-angle of the cone (radians).
+        cutoff: f32,
+        /// Half-angle of the full-intensity beam (radians).
+        beam_width: f32,
+    },
+    /// Mitsuba's `projector`: the image on the plane z = 1 spans a horizontal field of view
+    /// (u = ½ - ½ x / (z t), Mitsuba's v = ½ - ½ aspect y / (z t), t = tan(fov_x / 2)); the
+    /// intensity towards a direction is π · scale · image(u, v) / cos³θ, which gives a plane
+    /// facing the light at distance 1 the irradiance π · scale · image.
+    Projector {
+        /// Scale of the image's values.
+        scale: f32,
+        /// tan(fov_x / 2).
+        tan_half_fov_x: f32,
+        /// The image's width / height.
+        aspect: f32,
+    },
+}
+
+/// How a camera maps the image plane to rays.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Projection {
+    /// A pinhole (or thin lens) camera.
+    #[default]
+    Perspective,
+    /// Parallel rays along the viewing direction from a rectangle of half-extents
+    /// `half_extent` (right, up) centred on the camera's position.
+    Orthographic {
+        /// Half-width and half-height of the viewed rectangle, in scene units.
+        half_extent: Vec2,
+    },
+}
+
 /// Which image axis the field of view is measured along.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum FovAxis {
@@ -310,6 +551,14 @@ pub struct CameraDesc {
     /// from the resolution (a larger image shows more, at the same scale), as the CS184
     /// renderer does; `fov_degrees` is ignored.
     pub focal_pixels: Option<f32>,
+    /// Camera rays start this far along the viewing direction (Mitsuba's `near_clip`).
+    pub near_clip: f32,
+    /// ... and end this far (Mitsuba's `far_clip`).
+    pub far_clip: f32,
+    /// Shift of the image window, in fractions of the image's width and height (right, down).
+    pub principal_point_offset: Vec2,
+    /// Perspective or orthographic.
+    pub projection: Projection,
 }
 
 impl Default for CameraDesc {
@@ -323,6 +572,10 @@ impl Default for CameraDesc {
             lens_radius: 0.0,
             focal_distance: 1.0,
             focal_pixels: None,
+            near_clip: 0.0,
+            far_clip: f32::INFINITY,
+            principal_point_offset: Vec2::ZERO,
+            projection: Projection::Perspective,
         }
     }
 }

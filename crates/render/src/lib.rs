@@ -23,7 +23,7 @@
 //!
 //! // A grey sphere under a white sky: at one bounce it reflects its albedo.
 //! let desc = SceneDesc {
-//!     spheres: vec![SphereDesc { center: Vec3::ZERO, radius: 1.0, material: 0, emission: None }],
+//!     spheres: vec![SphereDesc { center: Vec3::ZERO, radius: 1.0, ..Default::default() }],
 //!     materials: vec![diffuse(Vec3::splat(0.5), false)],
 //!     environment: Some(Vec3::ONE),
 //!     camera: CameraDesc { origin: Vec3::new(0.0, 0.0, 5.0), fov_degrees: 5.0, ..Default::default() },

@@ -1,11 +1,13 @@
-//! Lights: area lights (emissive triangles and spheres), point lights and a uniform
-//! environment; and the choice of a light in proportion to its power.
+//! Lights: area lights (emissive triangles and spheres, optionally textured), point, spot and
+//! directional lights, projectors (Mitsuba's textured spot and projector), a uniform
+//! environment and environment maps; and the choice of a light in proportion to its power.
 
-use crate::desc::Rgb;
+use crate::desc::{ProjectorKind, Rgb};
 use crate::envmap::EnvironmentMap;
 use crate::geometry::Aabb;
 use crate::shape::{ShapeSample, Sphere, Triangle};
-use glam::{Vec2, Vec3};
+use crate::texture::{Tex, TexPoint};
+use glam::{Mat3, Vec2, Vec3};
 use pathlab_mc::distribution::AliasTable;
 use pathlab_mc::warp::{
     sample_uniform_sphere, sample_uniform_triangle, uniform_sphere_pdf, uniform_triangle_pdf,
@@ -47,24 +49,61 @@ impl AreaTriangle {
         }
     }
 
-    /// A point uniform over the triangle: [`Triangle::sample`] without recomputing the normal
-    /// and area (the same values to the bit).
+    /// A point uniform over the triangle and its barycentrics: [`Triangle::sample`] without
+    /// recomputing the normal and area (the same values to the bit).
     #[inline]
-    fn sample(&self, u: Vec2) -> ShapeSample {
+    fn sample_barycentric(&self, u: Vec2) -> (ShapeSample, [f32; 3]) {
         let b = sample_uniform_triangle(u);
         let p = &self.triangle.p;
-        ShapeSample {
-            p: b[0] * p[0] + b[1] * p[1] + b[2] * p[2],
-            n: self.normal,
-            pdf_area: self.pdf_area,
+        (
+            ShapeSample {
+                p: b[0] * p[0] + b[1] * p[1] + b[2] * p[2],
+                n: self.normal,
+                pdf_area: self.pdf_area,
+            },
+            b,
+        )
+    }
+}
+
+/// A texture over an area light's surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaTexture {
+    /// The texture, at the surface's (u, v).
+    pub tex: Tex,
+    /// A triangle's corner (u, v).
+    pub corner_uvs: [Vec2; 3],
+    /// A sphere's rotation from world to its own frame (its (u, v) are spherical angles).
+    pub to_object: Mat3,
+}
+
+impl AreaTexture {
+    /// (u, v) of the point `p` with barycentrics `b` on `shape`.
+    fn uv(&self, shape: &AreaShape, p: Vec3, b: [f32; 3]) -> Vec2 {
+        match shape {
+            AreaShape::Triangle(_) => {
+                let c = &self.corner_uvs;
+                b[0] * c[0] + b[1] * c[1] + b[2] * c[2]
+            }
+            AreaShape::Sphere(s) => sphere_uv(self.to_object * ((p - s.center) / s.radius)),
         }
     }
+}
+
+/// Texture coordinates of a point on a sphere, given its unit direction `d` from the centre
+/// in the sphere's own frame: u = φ / 2π, v = 1 - θ / π (Mitsuba's v = θ / π, flipped to
+/// pathlab's convention).
+#[inline]
+pub fn sphere_uv(d: Vec3) -> Vec2 {
+    let phi = d.y.atan2(d.x);
+    let u = phi / std::f32::consts::TAU + if phi < 0.0 { 1.0 } else { 0.0 };
+    Vec2::new(u, 1.0 - d.z.clamp(-1.0, 1.0).acos() / PI)
 }
 
 /// A light source.
 #[derive(Clone, Debug)]
 pub enum Light {
-    /// Uniform radiance from a surface.
+    /// Uniform radiance from a surface (times a texture, when it has one).
     Area {
         /// The emitting surface.
         shape: AreaShape,
@@ -72,6 +111,8 @@ pub enum Light {
         radiance: Rgb,
         /// Whether the back side emits too.
         two_sided: bool,
+        /// A texture multiplying the radiance.
+        texture: Option<Arc<AreaTexture>>,
     },
     /// Radiant intensity from a point (a delta light), divided by c + l d + q d².
     Point {
@@ -113,6 +154,8 @@ pub enum Light {
         /// Radius of a sphere bounding the scene (for the power estimate).
         scene_radius: f32,
     },
+    /// A point light shining through an image plane (see [`crate::desc::ProjectorDesc`]).
+    Projector(Arc<Projector>),
     /// Radiance at infinity from an image (sampled by luminance).
     EnvironmentMap {
         /// The map.
@@ -120,6 +163,88 @@ pub enum Light {
         /// Radius of a sphere bounding the scene (for the power estimate).
         scene_radius: f32,
     },
+}
+
+/// A point light shining through an image plane: Mitsuba's `spot` and `projector`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Projector {
+    /// Position.
+    pub position: Vec3,
+    /// Rotation from world to the light's frame (rows: its x, y, z axes).
+    pub to_local: Mat3,
+    /// The image.
+    pub texture: Tex,
+    /// The profile.
+    pub kind: ProjectorKind,
+}
+
+impl Projector {
+    /// Radiant intensity towards local direction `d` (unit).
+    pub fn intensity(&self, d: Vec3) -> Rgb {
+        if d.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        match self.kind {
+            ProjectorKind::Spot {
+                intensity,
+                cutoff,
+                beam_width,
+            } => {
+                let cos = d.z;
+                if cos <= cutoff.cos() {
+                    return Rgb::ZERO;
+                }
+                let falloff = if cos >= beam_width.cos() {
+                    1.0
+                } else {
+                    (cutoff - cos.clamp(-1.0, 1.0).acos()) / (cutoff - beam_width)
+                };
+                let k = 0.5 / (d.z * cutoff.tan());
+                let mut uv = Vec2::new(0.5 + d.x * k, 0.5 - d.y * k);
+                if let Ok(f) = std::env::var("PATHLAB_SPOT_FLIP") {
+                    if f.contains('u') {
+                        uv.x = 1.0 - uv.x;
+                    }
+                    if f.contains('v') {
+                        uv.y = 1.0 - uv.y;
+                    }
+                }
+                intensity * self.texture.eval(&TexPoint::uv(uv)) * falloff
+            }
+            ProjectorKind::Projector {
+                scale,
+                tan_half_fov_x,
+                aspect,
+            } => {
+                let x = d.x / (d.z * tan_half_fov_x);
+                let y = aspect * d.y / (d.z * tan_half_fov_x);
+                let uv = Vec2::new(0.5 - 0.5 * x, 0.5 + 0.5 * y);
+                if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
+                    return Rgb::ZERO;
+                }
+                let cos3 = d.z * d.z * d.z;
+                self.texture.eval(&TexPoint::uv(uv)) * (PI * scale / cos3)
+            }
+        }
+    }
+
+    /// The power it emits (luminance), for choosing lights: ∫ I dω over the image's cone,
+    /// estimated on a grid of directions.
+    fn phi(&self) -> f32 {
+        let n = 32;
+        let mut sum = 0.0f64;
+        // Directions over the hemisphere z > 0, equal-area in (cos θ, φ).
+        for i in 0..n {
+            for j in 0..n {
+                let z = (i as f32 + 0.5) / n as f32;
+                let phi = (j as f32 + 0.5) / n as f32 * std::f32::consts::TAU;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                sum += luminance(self.intensity(d)) as f64;
+            }
+        }
+        (sum * std::f64::consts::TAU / (n * n) as f64) as f32
+    }
 }
 
 /// Incident radiance sampled from a light.
@@ -177,35 +302,47 @@ impl Light {
         }
     }
 
-    /// Radiance leaving an area light at a point with normal `n` in direction `w` (away from
-    /// the light).
+    /// Radiance leaving an area light at a point with normal `n` and texture coordinates `uv`
+    /// in direction `w` (away from the light).
     #[inline]
-    pub fn le(&self, n: Vec3, w: Vec3) -> Rgb {
-        match *self {
+    pub fn le(&self, n: Vec3, w: Vec3, uv: Vec2) -> Rgb {
+        match self {
             Light::Area {
                 radiance,
                 two_sided,
+                texture,
                 ..
             } => {
                 let c = n.dot(w);
-                if c > 0.0 || (two_sided && c < 0.0) {
-                    radiance
+                if c > 0.0 || (*two_sided && c < 0.0) {
+                    match texture {
+                        None => *radiance,
+                        Some(t) => *radiance * t.tex.eval(&TexPoint::uv(uv)),
+                    }
                 } else {
                     Rgb::ZERO
                 }
             }
             Light::Environment { .. } | Light::EnvironmentMap { .. } => self.le_environment(w),
-            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => Rgb::ZERO,
+            Light::Point { .. }
+            | Light::Spot { .. }
+            | Light::Directional { .. }
+            | Light::Projector(_) => Rgb::ZERO,
         }
     }
 
     /// Samples incident radiance at `p`.
     pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightLiSample> {
         match *self {
-            Light::Area { shape, .. } => {
-                let s = match shape {
-                    AreaShape::Triangle(t) => t.sample(u),
-                    AreaShape::Sphere(sph) => sph.sample(u),
+            Light::Area {
+                shape,
+                ref texture,
+                radiance,
+                two_sided,
+            } => {
+                let (s, b) = match shape {
+                    AreaShape::Triangle(t) => t.sample_barycentric(u),
+                    AreaShape::Sphere(sph) => (sph.sample(u), [0.0; 3]),
                 };
                 let to_light = s.p - p;
                 let dist2 = to_light.length_squared();
@@ -217,7 +354,17 @@ impl Light {
                 if cos_l == 0.0 {
                     return None;
                 }
-                let li = self.le(s.n, -wi);
+                let li = match texture {
+                    None => self.le(s.n, -wi, Vec2::ZERO),
+                    Some(t) => {
+                        let c = s.n.dot(-wi);
+                        if c > 0.0 || (two_sided && c < 0.0) {
+                            radiance * t.tex.eval(&TexPoint::uv(t.uv(&shape, s.p, b)))
+                        } else {
+                            Rgb::ZERO
+                        }
+                    }
+                };
                 Some(LightLiSample {
                     li,
                     wi,
@@ -266,6 +413,23 @@ impl Light {
                     wi,
                     pdf: 1.0,
                     p_light: position,
+                    n_light: None,
+                    is_delta: true,
+                })
+            }
+            Light::Projector(ref pr) => {
+                let to_light = pr.position - p;
+                let dist2 = to_light.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let wi = to_light / dist2.sqrt();
+                let li = pr.intensity(pr.to_local * -wi) / dist2;
+                Some(LightLiSample {
+                    li,
+                    wi,
+                    pdf: 1.0,
+                    p_light: pr.position,
                     n_light: None,
                     is_delta: true,
                 })
@@ -332,7 +496,10 @@ impl Light {
             }
             Light::Environment { .. } => uniform_sphere_pdf(),
             Light::EnvironmentMap { ref map, .. } => map.pdf(wi),
-            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
+            Light::Point { .. }
+            | Light::Spot { .. }
+            | Light::Directional { .. }
+            | Light::Projector(_) => 0.0,
         }
     }
 
@@ -343,14 +510,20 @@ impl Light {
                 shape,
                 radiance,
                 two_sided,
+                ref texture,
             } => {
                 let area = match shape {
                     AreaShape::Triangle(t) => t.area,
                     AreaShape::Sphere(s) => s.area(),
                 };
                 let sides = if two_sided { 2.0 } else { 1.0 };
-                PI * area * sides * luminance(radiance)
+                let mean = texture.as_ref().map_or(Rgb::ONE, |t| match &t.tex {
+                    Tex::Image { image, .. } => image.mean(),
+                    other => other.eval(&TexPoint::uv(Vec2::splat(0.5))),
+                });
+                PI * area * sides * luminance(radiance * mean)
             }
+            Light::Projector(ref pr) => pr.phi(),
             Light::Point { intensity, .. } => 4.0 * PI * luminance(intensity),
             Light::Spot {
                 intensity,
@@ -375,27 +548,42 @@ impl Light {
     }
 }
 
-/// Chooses lights in proportion to their power (alias method). Lights that may be sampled but
-/// have zero power get a tiny share so that every one stays reachable; lights that must not be
-/// sampled (seen by camera rays only) get none.
+/// Chooses lights (alias method): every emitter equally likely, and among the lights of one
+/// emitter (the triangles of an emitting mesh) in proportion to their power, as Mitsuba
+/// chooses them (uniformly among emitters, a mesh's points by area). Lights that may be
+/// sampled but have zero power get a tiny share of their emitter's so that every one stays
+/// reachable; lights that must not be sampled (seen by camera rays only) get none.
 #[derive(Clone, Debug)]
 pub struct LightSampler {
     table: Option<AliasTable>,
 }
 
 impl LightSampler {
-    /// The sampler for `lights`, of which those with `sampleable[i] == false` are never chosen.
-    pub fn new(lights: &[Light], sampleable: &[bool]) -> Self {
+    /// The sampler for `lights`, light `i` belonging to emitter `groups[i]`; those with
+    /// `sampleable[i] == false` are never chosen.
+    pub fn new(lights: &[Light], sampleable: &[bool], groups: &[u32]) -> Self {
         let phi = |i: usize| (lights[i].phi() as f64).max(0.0);
-        let total: f64 = (0..lights.len()).filter(|&i| sampleable[i]).map(phi).sum();
-        let floor = if total > 0.0 { total * 1e-6 } else { 1.0 };
+        let mut totals: std::collections::HashMap<u32, f64> = std::collections::HashMap::new();
+        for i in (0..lights.len()).filter(|&i| sampleable[i]) {
+            *totals.entry(groups[i]).or_insert(0.0) += phi(i);
+        }
+        let emitters = totals.len().max(1) as f64;
+        let mut counts: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+        for i in (0..lights.len()).filter(|&i| sampleable[i]) {
+            *counts.entry(groups[i]).or_insert(0) += 1;
+        }
         let weights: Vec<f64> = (0..lights.len())
             .map(|i| {
-                if sampleable[i] {
-                    phi(i).max(floor)
-                } else {
-                    0.0
+                if !sampleable[i] {
+                    return 0.0;
                 }
+                let total = totals[&groups[i]];
+                let share = if total > 0.0 {
+                    phi(i).max(total * 1e-6) / total
+                } else {
+                    1.0 / counts[&groups[i]] as f64
+                };
+                share / emitters
             })
             .collect();
         LightSampler {
@@ -439,7 +627,7 @@ mod tests {
             };
             let light = AreaTriangle::new(triangle);
             let u = point().truncate();
-            assert_eq!(light.sample(u), triangle.sample(u));
+            assert_eq!(light.sample_barycentric(u).0, triangle.sample(u));
             assert_eq!(light.area, triangle.area());
         }
     }

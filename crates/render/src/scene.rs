@@ -6,9 +6,13 @@ use crate::camera::Camera;
 use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc, Visibility};
 use crate::envmap::EnvironmentMap;
 use crate::geometry::{Aabb, Ray};
-use crate::light::{bounding_radius, AreaShape, AreaTriangle, Light, LightSampler};
+use crate::light::{
+    bounding_radius, sphere_uv, AreaShape, AreaTexture, AreaTriangle, Light, LightSampler,
+    Projector,
+};
 use crate::shape::{Sphere, Triangle};
-use glam::{Vec2, Vec3};
+use crate::texture::{AttributeTable, Tex, TexPoint};
+use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;
 use std::time::Instant;
 use thiserror::Error;
@@ -76,6 +80,10 @@ pub struct SurfaceInteraction {
     pub light: Option<u32>,
     /// Texture coordinates (the mesh's, else barycentric; spherical on spheres).
     pub uv: Vec2,
+    /// The triangle hit, in the scene's order (`u32::MAX` on a sphere), for mesh attributes.
+    pub prim: u32,
+    /// Barycentrics of the triangle's vertices 1 and 2.
+    pub b: Vec2,
 }
 
 /// Build statistics.
@@ -109,6 +117,10 @@ pub struct Scene {
     spheres: Vec<Sphere>,
     sphere_material: Vec<u32>,
     sphere_light: Vec<u32>,
+    /// Each sphere's rotation from world to its own frame (for its texture coordinates).
+    sphere_to_object: Vec<Mat3>,
+    /// Mesh attributes read by textures, per triangle corner.
+    attributes: Vec<AttributeTable>,
     prims: Vec<Prim>,
     /// Whether every primitive is seen by every ray (the common case, checked once).
     all_visible: bool,
@@ -132,7 +144,25 @@ impl Scene {
         if w == 0 || h == 0 {
             return Err(SceneError::Invalid(format!("resolution {w}x{h} is empty")));
         }
-        let materials: Vec<Material> = desc.materials.iter().map(Material::from).collect();
+        // Mesh attributes the materials read: one table each, filled per triangle below.
+        let mut attribute_names: Vec<String> = Vec::new();
+        let materials: Vec<Material> = desc
+            .materials
+            .iter()
+            .map(|m| {
+                Material::from_desc(m, &mut |name| {
+                    let i = attribute_names
+                        .iter()
+                        .position(|n| n == name)
+                        .unwrap_or_else(|| {
+                            attribute_names.push(name.to_string());
+                            attribute_names.len() - 1
+                        });
+                    i as u32
+                })
+            })
+            .collect();
+        let mut attributes: Vec<AttributeTable> = vec![Vec::new(); attribute_names.len()];
         let check_material = |shape: &str, index: usize| {
             if index < materials.len() {
                 Ok(index as u32)
@@ -157,15 +187,26 @@ impl Scene {
             .any(|m| !m.normals.is_empty() && m.normals.len() == m.positions.len());
         let mut lights = Vec::new();
         let mut sampleable = Vec::new();
-        for mesh in &desc.meshes {
+        // The emitter each light belongs to (a mesh's triangles share one): emitters are chosen
+        // equally, a mesh's triangles in proportion to their power.
+        let mut light_group: Vec<u32> = Vec::new();
+        for (mesh_index, mesh) in desc.meshes.iter().enumerate() {
             let material = check_material(&mesh.name, mesh.material)?;
+            let mesh_attributes: Vec<Option<&crate::desc::MeshAttribute>> = attribute_names
+                .iter()
+                .map(|n| mesh.attributes.iter().find(|a| &a.name == n))
+                .collect();
+            let emission_texture = mesh
+                .emission_texture
+                .as_ref()
+                .map(|t| Tex::new(t, &mut |_| u32::MAX));
             if mesh.indices.len() % 3 != 0 {
                 return Err(SceneError::BadMesh {
                     mesh: mesh.name.clone(),
                     message: format!("{} indices is not a multiple of 3", mesh.indices.len()),
                 });
             }
-            for tri in mesh.indices.chunks_exact(3) {
+            for (face_index, tri) in mesh.indices.chunks_exact(3).enumerate() {
                 let mut p = [Vec3::ZERO; 3];
                 for (k, &i) in tri.iter().enumerate() {
                     p[k] = *mesh
@@ -211,11 +252,40 @@ impl Scene {
                 }
                 tri_material.push(material);
                 tri_visibility.push(mesh.visibility);
+                for (table, attribute) in attributes.iter_mut().zip(&mesh_attributes) {
+                    let corner = |k: usize| -> Vec3 {
+                        let Some(a) = attribute else {
+                            return Vec3::ZERO;
+                        };
+                        let i = if a.per_face {
+                            face_index
+                        } else {
+                            tri[k] as usize
+                        };
+                        a.values.get(i).copied().unwrap_or(Vec3::ZERO)
+                    };
+                    table.push([corner(0), corner(1), corner(2)]);
+                }
+                let texture = emission_texture.as_ref().map(|tex| {
+                    let uv = |k: usize| {
+                        mesh.uvs
+                            .get(tri[k] as usize)
+                            .copied()
+                            .unwrap_or([Vec2::ZERO, Vec2::X, Vec2::Y][k])
+                    };
+                    Arc::new(AreaTexture {
+                        tex: tex.clone(),
+                        corner_uvs: [uv(0), uv(1), uv(2)],
+                        to_object: Mat3::IDENTITY,
+                    })
+                });
                 tri_light.push(add_area_light(
                     &mut lights,
                     &mut sampleable,
+                    (&mut light_group, mesh_index as u32),
                     AreaShape::Triangle(AreaTriangle::new(t)),
                     mesh.emission,
+                    texture,
                     mesh.visibility,
                 ));
             }
@@ -223,6 +293,7 @@ impl Scene {
         let mut spheres = Vec::new();
         let mut sphere_material = Vec::new();
         let mut sphere_light = Vec::new();
+        let mut sphere_to_object = Vec::new();
         for (i, s) in desc.spheres.iter().enumerate() {
             let material = check_material(&format!("sphere {i}"), s.material)?;
             if !(s.radius > 0.0 && s.radius.is_finite() && s.center.is_finite()) {
@@ -237,11 +308,22 @@ impl Scene {
             };
             spheres.push(sphere);
             sphere_material.push(material);
+            sphere_to_object.push(s.to_object);
+            let texture = s.emission_texture.as_ref().map(|t| {
+                Arc::new(AreaTexture {
+                    tex: Tex::from_desc(t),
+                    corner_uvs: [Vec2::ZERO; 3],
+                    to_object: s.to_object,
+                })
+            });
+            let group = lights.len() as u32 + desc.meshes.len() as u32;
             sphere_light.push(add_area_light(
                 &mut lights,
                 &mut sampleable,
+                (&mut light_group, group),
                 AreaShape::Sphere(sphere),
                 s.emission,
+                texture,
                 Visibility::ALL,
             ));
         }
@@ -252,6 +334,17 @@ impl Scene {
                 attenuation: pl.attenuation,
             });
             sampleable.push(true);
+            light_group.push(lights.len() as u32 + desc.meshes.len() as u32);
+        }
+        for pr in &desc.projectors {
+            lights.push(Light::Projector(Arc::new(Projector {
+                position: pr.position,
+                to_local: pr.frame.transpose(),
+                texture: Tex::from_desc(&pr.texture),
+                kind: pr.kind,
+            })));
+            sampleable.push(true);
+            light_group.push(lights.len() as u32 + desc.meshes.len() as u32);
         }
         for sl in &desc.spot_lights {
             lights.push(Light::Spot {
@@ -263,6 +356,7 @@ impl Scene {
                 attenuation: sl.attenuation,
             });
             sampleable.push(true);
+            light_group.push(lights.len() as u32 + desc.meshes.len() as u32);
         }
         let prims: Vec<Prim> = (0..triangles.len() as u32)
             .map(Prim::Triangle)
@@ -330,6 +424,8 @@ impl Scene {
         } else {
             permute(&tri_normals, &tri_order)
         };
+        let attributes: Vec<AttributeTable> =
+            attributes.iter().map(|t| permute(t, &tri_order)).collect();
         let bvh_seconds = start.elapsed().as_secs_f64();
         let scene_radius = bounding_radius(&bvh.bounds());
         for dl in &desc.directional_lights {
@@ -339,6 +435,7 @@ impl Scene {
                 scene_radius,
             });
             sampleable.push(true);
+            light_group.push(lights.len() as u32 + desc.meshes.len() as u32);
         }
         let environment_light = match &desc.environment_map {
             Some(m) => Some(Light::EnvironmentMap {
@@ -359,9 +456,10 @@ impl Scene {
         let environment = environment_light.map(|light| {
             lights.push(light);
             sampleable.push(true);
+            light_group.push(lights.len() as u32 + desc.meshes.len() as u32);
             (lights.len() - 1) as u32
         });
-        let light_sampler = LightSampler::new(&lights, &sampleable);
+        let light_sampler = LightSampler::new(&lights, &sampleable, &light_group);
         let prim_visibility: Vec<Visibility> = prims
             .iter()
             .map(|p| match *p {
@@ -388,6 +486,8 @@ impl Scene {
             spheres,
             sphere_material,
             sphere_light,
+            sphere_to_object,
+            attributes,
             prims,
             all_visible,
             bvh,
@@ -397,7 +497,7 @@ impl Scene {
             lights,
             light_sampler,
             environment,
-            camera: Camera::new(&desc.camera, desc.resolution),
+            camera: Camera::new(&desc.camera, desc.resolution).with_filter(desc.filter),
             stats,
         })
     }
@@ -430,6 +530,12 @@ impl Scene {
             + size_of_val(self.spheres.as_slice())
             + size_of_val(self.sphere_material.as_slice())
             + size_of_val(self.sphere_light.as_slice())
+            + size_of_val(self.sphere_to_object.as_slice())
+            + self
+                .attributes
+                .iter()
+                .map(|t| size_of_val(t.as_slice()))
+                .sum::<usize>()
             + size_of_val(self.prims.as_slice())
             + size_of_val(self.blocks.as_slice())
             + size_of_val(self.block_info.as_slice())
@@ -439,7 +545,17 @@ impl Scene {
     /// The BSDF at a surface point seen from `wo`.
     #[inline]
     pub fn bsdf(&self, si: &SurfaceInteraction, wo: Vec3) -> crate::bsdf::Bsdf {
-        self.materials[si.material as usize].bsdf(si.ns, wo, si.uv)
+        self.materials[si.material as usize].bsdf(si.ns, wo, &self.tex_point(si))
+    }
+
+    /// Where textures are evaluated at `si`.
+    #[inline]
+    pub fn tex_point<'a>(&'a self, si: &SurfaceInteraction) -> TexPoint<'a> {
+        TexPoint {
+            uv: si.uv,
+            triangle: (si.prim != u32::MAX).then_some((si.prim, si.b)),
+            attributes: &self.attributes,
+        }
     }
 
     /// Material `i`.
@@ -563,6 +679,8 @@ impl Scene {
             material: self.tri_material[i as usize],
             light: (light != NO_LIGHT).then_some(light),
             uv,
+            prim: i,
+            b: Vec2::new(b1, b2),
         }
     }
 
@@ -576,12 +694,7 @@ impl Scene {
         // Project onto the surface to remove the rounding of the ray parameter.
         let p = s.center + ng * s.radius;
         let light = self.sphere_light[i as usize];
-        // Spherical coordinates about z: u = φ / 2π, v = θ / π.
-        let phi = ng.y.atan2(ng.x);
-        let uv = Vec2::new(
-            phi / std::f32::consts::TAU + if phi < 0.0 { 1.0 } else { 0.0 },
-            ng.z.clamp(-1.0, 1.0).acos() / std::f32::consts::PI,
-        );
+        let uv = sphere_uv(self.sphere_to_object[i as usize] * ng);
         SurfaceInteraction {
             p,
             t,
@@ -590,6 +703,8 @@ impl Scene {
             material: self.sphere_material[i as usize],
             light: (light != NO_LIGHT).then_some(light),
             uv,
+            prim: u32::MAX,
+            b: Vec2::ZERO,
         }
     }
 
@@ -604,8 +719,10 @@ impl Scene {
 fn add_area_light(
     lights: &mut Vec<Light>,
     sampleable: &mut Vec<bool>,
+    (groups, group): (&mut Vec<u32>, u32),
     shape: AreaShape,
     emission: Option<Emission>,
+    texture: Option<Arc<AreaTexture>>,
     visibility: Visibility,
 ) -> u32 {
     match emission {
@@ -614,8 +731,10 @@ fn add_area_light(
                 shape,
                 radiance: e.radiance,
                 two_sided: e.two_sided,
+                texture,
             });
             sampleable.push(visibility.indirect);
+            groups.push(group);
             (lights.len() - 1) as u32
         }
         _ => NO_LIGHT,

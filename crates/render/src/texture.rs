@@ -1,11 +1,14 @@
-//! Image textures: linear RGB texels looked up by bilinear interpolation at surface (u, v).
+//! Textures: image textures (linear RGB texels looked up at surface (u, v), bilinearly or
+//! nearest, repeating, mirrored or clamped), and [`Tex`], the evaluated form of a
+//! [`TextureDesc`]: a constant, an image, a checkerboard or a mesh attribute.
 //!
 //! Convention: (0, 0) is the image's bottom-left corner and v grows upwards (OBJ, COLLADA,
 //! OpenGL); loaders of formats with v growing downwards (glTF) flip v. Texel centres sit at
-//! ((i + ½) / W, (j + ½) / H); lookups wrap around (repeat).
+//! ((i + ½) / W, (j + ½) / H).
 
-use crate::desc::Rgb;
-use glam::Vec2;
+use crate::desc::{Rgb, TextureDesc, TextureFilter, WrapMode};
+use glam::{Affine2, Vec2, Vec3};
+use std::sync::Arc;
 
 /// An image texture (linear RGB).
 #[derive(Clone, Debug, PartialEq)]
@@ -38,6 +41,46 @@ impl Texture {
         (self.width, self.height)
     }
 
+    /// The mean of the texels.
+    pub fn mean(&self) -> Rgb {
+        let sum: glam::DVec3 = self.texels.iter().map(|t| t.as_dvec3()).sum();
+        (sum / self.texels.len() as f64).as_vec3()
+    }
+
+    /// The value at `uv` read with `filter`, `wrap` deciding what lies outside [0, 1]².
+    pub fn lookup(&self, uv: Vec2, filter: TextureFilter, wrap: WrapMode) -> Rgb {
+        if !uv.is_finite() {
+            return self.texels[0];
+        }
+        let (w, h) = (self.width as i64, self.height as i64);
+        let fix = |i: i64, n: i64| -> usize {
+            match wrap {
+                WrapMode::Repeat => i.rem_euclid(n) as usize,
+                WrapMode::Clamp => i.clamp(0, n - 1) as usize,
+                WrapMode::Mirror => {
+                    let m = i.rem_euclid(2 * n);
+                    (if m < n { m } else { 2 * n - 1 - m }) as usize
+                }
+            }
+        };
+        let at = |x: i64, y: i64| self.texels[fix(y, h) * self.width + fix(x, w)];
+        // Row 0 is the top of the image: v = 1.
+        let x = uv.x * self.width as f32;
+        let y = (1.0 - uv.y) * self.height as f32;
+        match filter {
+            TextureFilter::Nearest => at(x.floor() as i64, y.floor() as i64),
+            TextureFilter::Bilinear => {
+                let (x, y) = (x - 0.5, y - 0.5);
+                let (x0, y0) = (x.floor(), y.floor());
+                let (fx, fy) = (x - x0, y - y0);
+                let (xi, yi) = (x0 as i64, y0 as i64);
+                let top = at(xi, yi) * (1.0 - fx) + at(xi + 1, yi) * fx;
+                let bottom = at(xi, yi + 1) * (1.0 - fx) + at(xi + 1, yi + 1) * fx;
+                top * (1.0 - fy) + bottom * fy
+            }
+        }
+    }
+
     /// The bilinearly interpolated value at `uv` (repeating outside [0, 1]²).
     pub fn eval(&self, uv: Vec2) -> Rgb {
         if !uv.is_finite() {
@@ -54,6 +97,149 @@ impl Texture {
         let top = at(xa, ya) * (1.0 - fx) + at(xb, ya) * fx;
         let bottom = at(xa, yb) * (1.0 - fx) + at(xb, yb) * fx;
         top * (1.0 - fy) + bottom * fy
+    }
+}
+
+/// A mesh attribute's value at each corner of each triangle (in the scene's triangle order).
+pub type AttributeTable = Vec<[Vec3; 3]>;
+
+/// Where a texture is evaluated: surface coordinates, and the triangle and barycentrics (b1,
+/// b2) for mesh attributes.
+#[derive(Clone, Copy, Debug)]
+pub struct TexPoint<'a> {
+    /// Surface (u, v).
+    pub uv: Vec2,
+    /// The triangle and its barycentrics, when the point is on one.
+    pub triangle: Option<(u32, Vec2)>,
+    /// The scene's attribute tables.
+    pub attributes: &'a [AttributeTable],
+}
+
+impl TexPoint<'_> {
+    /// A point with (u, v) only.
+    pub fn uv(uv: Vec2) -> TexPoint<'static> {
+        TexPoint {
+            uv,
+            triangle: None,
+            attributes: &[],
+        }
+    }
+}
+
+/// A texture ready to evaluate (see [`TextureDesc`]); mesh attributes are resolved to the
+/// scene's tables.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Tex {
+    /// The same value everywhere.
+    Constant(Rgb),
+    /// An image.
+    Image {
+        /// The texels.
+        image: Arc<Texture>,
+        /// Interpolation.
+        filter: TextureFilter,
+        /// Outside [0, 1]².
+        wrap: WrapMode,
+        /// Surface (u, v) to image coordinates.
+        to_uv: Affine2,
+    },
+    /// A checkerboard.
+    Checkerboard {
+        /// Where the fractional parts of both coordinates are on the same side of ½.
+        color0: Rgb,
+        /// Elsewhere.
+        color1: Rgb,
+        /// Surface (u, v) to checkerboard coordinates.
+        to_uv: Affine2,
+    },
+    /// Attribute table `index` of the scene (zero where the point is not on a triangle).
+    Attribute(u32),
+}
+
+impl Tex {
+    /// The texture of `desc`; `attribute` gives the table index of a named mesh attribute.
+    pub fn new(desc: &TextureDesc, attribute: &mut dyn FnMut(&str) -> u32) -> Tex {
+        match desc {
+            TextureDesc::Constant(c) => Tex::Constant(*c),
+            TextureDesc::Image {
+                image,
+                filter,
+                wrap,
+                to_uv,
+            } => Tex::Image {
+                image: image.clone(),
+                filter: *filter,
+                wrap: *wrap,
+                to_uv: *to_uv,
+            },
+            TextureDesc::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => Tex::Checkerboard {
+                color0: *color0,
+                color1: *color1,
+                to_uv: *to_uv,
+            },
+            TextureDesc::MeshAttribute { name } => Tex::Attribute(attribute(name)),
+        }
+    }
+
+    /// A texture without mesh attributes (they read as zero).
+    pub fn from_desc(desc: &TextureDesc) -> Tex {
+        Tex::new(desc, &mut |_| u32::MAX)
+    }
+
+    /// The constant value, if the texture is one.
+    pub fn as_constant(&self) -> Option<Rgb> {
+        match self {
+            Tex::Constant(c) => Some(*c),
+            _ => None,
+        }
+    }
+
+    /// The value at `p`.
+    #[inline]
+    pub fn eval(&self, p: &TexPoint) -> Rgb {
+        match self {
+            Tex::Constant(c) => *c,
+            Tex::Image {
+                image,
+                filter,
+                wrap,
+                to_uv,
+            } => image.lookup(to_uv.transform_point2(p.uv), *filter, *wrap),
+            Tex::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => {
+                let q = to_uv.transform_point2(p.uv);
+                let (x, y) = (q.x - q.x.floor() > 0.5, q.y - q.y.floor() > 0.5);
+                if x == y {
+                    *color0
+                } else {
+                    *color1
+                }
+            }
+            Tex::Attribute(table) => {
+                let (Some((tri, b)), Some(t)) = (p.triangle, p.attributes.get(*table as usize))
+                else {
+                    return Rgb::ZERO;
+                };
+                let Some(c) = t.get(tri as usize) else {
+                    return Rgb::ZERO;
+                };
+                (1.0 - b.x - b.y) * c[0] + b.x * c[1] + b.y * c[2]
+            }
+        }
+    }
+
+    /// The value at `p` as a number: the luminance of the colour (the value itself for grey).
+    #[inline]
+    pub fn eval_float(&self, p: &TexPoint) -> f32 {
+        let c = self.eval(p);
+        0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
     }
 }
 
@@ -81,5 +267,54 @@ mod tests {
         // Repeat: one period away is the same value.
         assert!((t.eval(Vec2::new(1.25, -0.75)) - Vec3::Z).length() < 1e-6);
         assert!(Texture::new("bad".into(), 3, 1, vec![Vec3::ONE]).is_none());
+    }
+
+    #[test]
+    fn filters_and_wrap_modes() {
+        // 2 x 1: left red, right green.
+        let t = Texture::new("t".into(), 2, 1, vec![Vec3::X, Vec3::Y]).unwrap();
+        let near = |u: f32, wrap| t.lookup(Vec2::new(u, 0.5), TextureFilter::Nearest, wrap);
+        assert_eq!(near(0.2, WrapMode::Repeat), Vec3::X);
+        assert_eq!(near(0.7, WrapMode::Repeat), Vec3::Y);
+        assert_eq!(near(1.2, WrapMode::Repeat), Vec3::X);
+        assert_eq!(near(1.2, WrapMode::Mirror), Vec3::Y);
+        assert_eq!(near(1.7, WrapMode::Mirror), Vec3::X);
+        assert_eq!(near(1.7, WrapMode::Clamp), Vec3::Y);
+        assert_eq!(near(-0.3, WrapMode::Clamp), Vec3::X);
+        let bi = t.lookup(
+            Vec2::new(0.5, 0.5),
+            TextureFilter::Bilinear,
+            WrapMode::Clamp,
+        );
+        assert!((bi - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6);
+        // Clamped, the edge holds the border texel; repeated, it blends with the far side.
+        let edge = |wrap| t.lookup(Vec2::new(0.0, 0.5), TextureFilter::Bilinear, wrap);
+        assert_eq!(edge(WrapMode::Clamp), Vec3::X);
+        assert!((edge(WrapMode::Repeat) - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6);
+        assert!((t.mean() - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn checkerboard_and_attributes() {
+        let c = Tex::Checkerboard {
+            color0: Vec3::ONE,
+            color1: Vec3::ZERO,
+            to_uv: Affine2::IDENTITY,
+        };
+        let at = |u, v| c.eval(&TexPoint::uv(Vec2::new(u, v)));
+        assert_eq!(at(0.25, 0.25), Vec3::ONE);
+        assert_eq!(at(0.75, 0.75), Vec3::ONE);
+        assert_eq!(at(0.75, 0.25), Vec3::ZERO);
+        assert_eq!(at(1.25, 0.25), Vec3::ONE);
+        let tables = vec![vec![[Vec3::X, Vec3::Y, Vec3::Z]]];
+        let a = Tex::Attribute(0);
+        let p = TexPoint {
+            uv: Vec2::ZERO,
+            triangle: Some((0, Vec2::new(0.25, 0.5))),
+            attributes: &tables,
+        };
+        assert!((a.eval(&p) - Vec3::new(0.25, 0.25, 0.5)).length() < 1e-6);
+        assert_eq!(a.eval(&TexPoint::uv(Vec2::ZERO)), Vec3::ZERO);
+        assert!((Tex::Constant(Vec3::splat(0.3)).eval_float(&p) - 0.3).abs() < 1e-6);
     }
 }

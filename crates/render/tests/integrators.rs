@@ -54,6 +54,7 @@ fn closed_furnace(albedo: f32) -> SceneDesc {
                 radiance: Vec3::ONE,
                 two_sided: true,
             }),
+            ..Default::default()
         }],
         materials: vec![diffuse(Vec3::splat(albedo), true)],
         camera: CameraDesc {
@@ -104,6 +105,7 @@ fn sky_sphere() -> SceneDesc {
             radius: 1.0,
             material: 0,
             emission: None,
+            ..Default::default()
         }],
         materials: vec![diffuse(Vec3::splat(0.8), false)],
         environment: Some(Vec3::ONE),
@@ -127,18 +129,22 @@ fn white_sky_furnace_reflects_the_albedo() {
         IntegratorKind::Direct(DirectIntegrator {
             strategy: DirectStrategy::Hemisphere,
             samples: 4,
+            ..Default::default()
         }),
         IntegratorKind::Direct(DirectIntegrator {
             strategy: DirectStrategy::Cosine,
             samples: 1,
+            ..Default::default()
         }),
         IntegratorKind::Direct(DirectIntegrator {
             strategy: DirectStrategy::Light,
             samples: 4,
+            ..Default::default()
         }),
         IntegratorKind::Direct(DirectIntegrator {
             strategy: DirectStrategy::Mis,
             samples: 1,
+            ..Default::default()
         }),
     ] {
         let film = run(&sky_sphere(), integrator, 64, 5);
@@ -154,6 +160,7 @@ fn white_sky_furnace_reflects_the_albedo() {
         IntegratorKind::Direct(DirectIntegrator {
             strategy: DirectStrategy::Cosine,
             samples: 1,
+            ..Default::default()
         }),
         16,
         6,
@@ -233,6 +240,7 @@ fn direct_strategies_agree_and_match_the_path_tracer() {
             IntegratorKind::Direct(DirectIntegrator {
                 strategy,
                 samples: 1,
+                ..Default::default()
             }),
             256,
             11 + i as u64,
@@ -246,6 +254,7 @@ fn direct_strategies_agree_and_match_the_path_tracer() {
         IntegratorKind::Direct(DirectIntegrator {
             strategy: DirectStrategy::Mis,
             samples: 1,
+            ..Default::default()
         }),
         256,
         20,
@@ -256,6 +265,7 @@ fn direct_strategies_agree_and_match_the_path_tracer() {
             IntegratorKind::Direct(DirectIntegrator {
                 strategy,
                 samples: 4,
+                ..Default::default()
             }),
             256,
             21 + i as u64,
@@ -521,12 +531,14 @@ fn path_lighting_strategies_agree_under_an_environment_map() {
                 radius: 0.5,
                 material: 0,
                 emission: None,
+                ..Default::default()
             },
             SphereDesc {
                 center: Vec3::new(0.6, 0.0, 0.0),
                 radius: 0.5,
                 material: 1,
                 emission: None,
+                ..Default::default()
             },
         ],
         meshes: vec![MeshDesc {
@@ -625,6 +637,7 @@ fn mixed_scene() -> SceneDesc {
         radius: 0.25,
         material: 2,
         emission: None,
+        ..Default::default()
     });
     desc.spheres.push(SphereDesc {
         center: Vec3::new(-0.5, 0.15, 0.3),
@@ -634,6 +647,7 @@ fn mixed_scene() -> SceneDesc {
             radiance: Vec3::new(2.0, 2.0, 1.0),
             two_sided: false,
         }),
+        ..Default::default()
     });
     desc
 }

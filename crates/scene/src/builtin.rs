@@ -93,6 +93,7 @@ pub fn cornell_box() -> Result<SceneDesc, Error> {
             lens_radius: 0.0,
             focal_distance: 3.9,
             focal_pixels: None,
+            ..Default::default()
         },
         resolution: [256, 256],
         ..Default::default()

@@ -263,7 +263,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         let mut out = Effect {
             material: match texture {
                 Some(texture) => MaterialDesc::TexturedDiffuse {
-                    texture,
+                    texture: TextureDesc::image(texture),
                     scale: Vec3::ONE,
                     two_sided: true,
                 },
@@ -409,6 +409,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                     radiance,
                     two_sided: false,
                 }),
+                ..Default::default()
             });
             return Ok(());
         }
@@ -457,6 +458,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 normals,
                 uvs: tri.uvs,
                 visibility: Visibility::ALL,
+                ..Default::default()
             });
         }
         Ok(())
@@ -781,6 +783,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
                 normals: Vec::new(),
                 uvs: Vec::new(),
                 visibility: Visibility::INDIRECT_ONLY,
+                ..Default::default()
             });
         }
         let bright = |c: Vec3| c.max_element() > 0.0;
@@ -873,6 +876,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             lens_radius: 0.0,
             focal_distance: r,
             focal_pixels: Some(d),
+            ..Default::default()
         })
     }
 }

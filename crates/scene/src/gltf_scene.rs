@@ -128,7 +128,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
                     }
                 } else if let Some(texture) = texture {
                     MaterialDesc::TexturedDiffuse {
-                        texture,
+                        texture: TextureDesc::image(texture),
                         scale: base.clamp(Vec3::ZERO, Vec3::ONE),
                         two_sided: m.double_sided(),
                     }
@@ -153,6 +153,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
                     normals,
                     uvs,
                     visibility: Visibility::ALL,
+                    ..Default::default()
                 });
             }
         }
@@ -172,6 +173,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
                         lens_radius: 0.0,
                         focal_distance: 1.0,
                         focal_pixels: None,
+                        ..Default::default()
                     },
                     p.aspect_ratio(),
                 ));

@@ -20,6 +20,7 @@ pub mod gltf_scene;
 pub mod info;
 pub mod meshfile;
 pub mod mitsuba;
+pub mod spectrum;
 pub mod texture;
 mod xml;
 
@@ -82,16 +83,22 @@ impl Error {
 
 /// Loads a scene: a built-in scene's name, or a file whose extension picks the loader.
 pub fn load(source: &str) -> Result<SceneDesc, Error> {
+    load_with(source, &[])
+}
+
+/// [`load`] with scene parameters (`-D name=value`): Mitsuba XML files use them for their
+/// `$name` references; for other formats, which have none, they are reported as unused.
+pub fn load_with(source: &str, params: &[(String, String)]) -> Result<SceneDesc, Error> {
     let path = Path::new(source);
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase());
-    match ext.as_deref() {
+    let mut desc = match ext.as_deref() {
         Some("dae") => collada::load(path),
         Some("obj") => meshfile::load_obj(path),
         Some("ply") => meshfile::load_ply(path),
-        Some("xml") => mitsuba::load(path),
+        Some("xml") => return mitsuba::load_with(path, params),
         Some("gltf") | Some("glb") => gltf_scene::load(path),
         None if builtin::NAMES.contains(&source) => builtin::load(source),
         None if !path.exists() => builtin::load(source),
@@ -99,5 +106,11 @@ pub fn load(source: &str) -> Result<SceneDesc, Error> {
             path: source.to_string(),
             known: builtin::NAMES.join(", "),
         }),
+    }?;
+    for (name, _) in params {
+        desc.warnings.push(format!(
+            "{source}: parameter '{name}' is not used (only Mitsuba XML scenes take parameters)"
+        ));
     }
+    Ok(desc)
 }

@@ -51,7 +51,7 @@ pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
         desc.materials.push(match texture {
             // The map replaces Kd, as most OBJ readers do.
             Some(texture) => MaterialDesc::TexturedDiffuse {
-                texture,
+                texture: TextureDesc::image(texture),
                 scale: Vec3::ONE,
                 two_sided: true,
             },
@@ -79,20 +79,11 @@ pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
         two_sided: true,
     });
     for model in models {
-        let m = &model.mesh;
-        let positions = vec3s(path, &m.positions, "vertex")?;
-        check_indices(path, &model.name, &m.indices, positions.len())?;
-        let normals = if m.normals.len() == m.positions.len() {
-            vec3s(path, &m.normals, "normal")?
-        } else {
-            Vec::new()
-        };
-        let uvs = if m.texcoords.len() / 2 == positions.len() {
-            m.texcoords.chunks_exact(2).map(Vec2::from_slice).collect()
-        } else {
-            Vec::new()
-        };
-        let material = m.material_id.filter(|&i| i < mtl.len()).unwrap_or(default);
+        let material = model
+            .mesh
+            .material_id
+            .filter(|&i| i < mtl.len())
+            .unwrap_or(default);
         let emission = emissions
             .get(material)
             .copied()
@@ -101,18 +92,52 @@ pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
                 radiance,
                 two_sided: false,
             });
-        desc.meshes.push(MeshDesc {
-            name: model.name,
-            positions,
-            indices: m.indices.clone(),
-            material,
-            emission,
-            normals,
-            uvs,
-            visibility: Visibility::ALL,
-        });
+        let mut mesh = model_mesh(path, model)?;
+        mesh.material = material;
+        mesh.emission = emission;
+        desc.meshes.push(mesh);
     }
     standalone(path, desc)
+}
+
+/// The geometry of one OBJ model: positions, indices, and normals and texture coordinates
+/// where every vertex has them.
+fn model_mesh(path: &Path, model: tobj::Model) -> Result<MeshDesc, Error> {
+    let m = &model.mesh;
+    let positions = vec3s(path, &m.positions, "vertex")?;
+    check_indices(path, &model.name, &m.indices, positions.len())?;
+    let normals = if m.normals.len() == m.positions.len() {
+        vec3s(path, &m.normals, "normal")?
+    } else {
+        Vec::new()
+    };
+    let uvs = if m.texcoords.len() / 2 == positions.len() {
+        m.texcoords.chunks_exact(2).map(Vec2::from_slice).collect()
+    } else {
+        Vec::new()
+    };
+    Ok(MeshDesc {
+        name: model.name,
+        positions,
+        indices: model.mesh.indices,
+        normals,
+        uvs,
+        ..Default::default()
+    })
+}
+
+/// The meshes of an OBJ file, without its materials (for scene formats that bring their own).
+pub fn obj_meshes(path: &Path) -> Result<Vec<MeshDesc>, Error> {
+    let (models, _) = tobj::load_obj(
+        path,
+        &tobj::LoadOptions {
+            triangulate: true,
+            single_index: true,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| obj_error(path, e))?;
+    models.into_iter().map(|m| model_mesh(path, m)).collect()
 }
 
 fn obj_error(path: &Path, e: tobj::LoadError) -> Error {
@@ -164,9 +189,113 @@ fn check_indices(path: &Path, mesh: &str, indices: &[u32], vertices: usize) -> R
     }
 }
 
-/// Loads a PLY file (ASCII, binary little or big endian): vertex positions (and normals when
-/// present) and faces (polygons are fanned into triangles).
+/// Loads a PLY file (ASCII, binary little or big endian): vertex positions (and normals and
+/// texture coordinates when present) and faces (polygons are fanned into triangles).
 pub fn load_ply(path: &Path) -> Result<SceneDesc, Error> {
+    let mut mesh = ply_mesh(path)?;
+    mesh.attributes.clear();
+    let desc = SceneDesc {
+        meshes: vec![mesh],
+        materials: vec![MaterialDesc::Diffuse {
+            reflectance: Vec3::splat(0.8),
+            two_sided: true,
+        }],
+        ..Default::default()
+    };
+    standalone(path, desc)
+}
+
+/// Vertex properties that are geometry, not attributes.
+const PLY_GEOMETRY: &[&str] = &[
+    "x",
+    "y",
+    "z",
+    "nx",
+    "ny",
+    "nz",
+    "u",
+    "v",
+    "s",
+    "t",
+    "texture_u",
+    "texture_v",
+    "texture_s",
+    "texture_t",
+    "vertex_indices",
+    "vertex_index",
+];
+
+/// Groups a PLY element's extra scalar properties into named attributes as Mitsuba does:
+/// `name_0`, `name_1`, `name_2` (or `r`, `g`, `b` / `red`, `green`, `blue`, which make
+/// `color`) become one attribute `prefix` + name of up to three channels; any other property
+/// is an attribute of one channel.
+fn ply_attributes(
+    keys: &[String],
+    rows: &[DefaultElement],
+    prefix: &str,
+    scalar: &dyn Fn(&DefaultElement, &str) -> Option<f32>,
+) -> Vec<MeshAttribute> {
+    let mut groups: Vec<(String, Vec<String>)> = Vec::new();
+    for k in keys {
+        if PLY_GEOMETRY.contains(&k.as_str()) {
+            continue;
+        }
+        let base = match k.as_str() {
+            "r" | "g" | "b" | "red" | "green" | "blue" => "color".to_string(),
+            _ => match k.rsplit_once('_') {
+                Some((b, d))
+                    if !b.is_empty() && d.len() == 1 && d.as_bytes()[0].is_ascii_digit() =>
+                {
+                    b.to_string()
+                }
+                _ => k.clone(),
+            },
+        };
+        match groups.iter_mut().find(|g| g.0 == base) {
+            Some(g) => g.1.push(k.clone()),
+            None => groups.push((base, vec![k.clone()])),
+        }
+    }
+    let scale = |k: &str| {
+        if matches!(k, "r" | "g" | "b" | "red" | "green" | "blue") {
+            1.0 / 255.0
+        } else {
+            1.0
+        }
+    };
+    groups
+        .into_iter()
+        .filter(|(_, ks)| ks.len() <= 3)
+        .map(|(base, ks)| {
+            let values = rows
+                .iter()
+                .map(|row| {
+                    let c: Vec<f32> = ks
+                        .iter()
+                        .map(|k| scalar(row, k).unwrap_or(0.0) * scale(k))
+                        .collect();
+                    match c.as_slice() {
+                        [a] => Vec3::splat(*a),
+                        [a, b] => Vec3::new(*a, *b, 0.0),
+                        [a, b, cc] => Vec3::new(*a, *b, *cc),
+                        _ => Vec3::ZERO,
+                    }
+                })
+                .collect();
+            MeshAttribute {
+                name: format!("{prefix}{base}"),
+                per_face: prefix == "face_",
+                values,
+            }
+        })
+        .collect()
+}
+
+/// The mesh of a PLY file: positions, normals and texture coordinates where present, faces
+/// fanned into triangles, and the extra vertex and face properties as named attributes
+/// (`vertex_color`, `face_weight`, ...; a polygon's face attribute goes to each of its
+/// triangles).
+pub fn ply_mesh(path: &Path) -> Result<MeshDesc, Error> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let mut reader = std::io::BufReader::new(file);
     let ply = Parser::<DefaultElement>::new()
@@ -209,6 +338,7 @@ pub fn load_ply(path: &Path) -> Result<SceneDesc, Error> {
     };
     let mut positions = Vec::with_capacity(vertices.len());
     let mut normals = Vec::new();
+    let mut uvs = Vec::new();
     for (i, v) in vertices.iter().enumerate() {
         let p = match (scalar(v, "x"), scalar(v, "y"), scalar(v, "z")) {
             (Some(x), Some(y), Some(z)) => Vec3::new(x, y, z),
@@ -223,12 +353,36 @@ pub fn load_ply(path: &Path) -> Result<SceneDesc, Error> {
         if let (Some(x), Some(y), Some(z)) = (scalar(v, "nx"), scalar(v, "ny"), scalar(v, "nz")) {
             normals.push(Vec3::new(x, y, z));
         }
+        let uv = [
+            ("u", "v"),
+            ("s", "t"),
+            ("texture_u", "texture_v"),
+            ("texture_s", "texture_t"),
+        ]
+        .iter()
+        .find_map(|(a, b)| Some(Vec2::new(scalar(v, a)?, scalar(v, b)?)));
+        if let Some(uv) = uv {
+            uvs.push(uv);
+        }
     }
     if normals.len() != positions.len() {
         normals.clear();
     }
+    if uvs.len() != positions.len() {
+        uvs.clear();
+    }
+    let keys = |element: &str| -> Vec<String> {
+        ply.header
+            .elements
+            .get(element)
+            .map(|e| e.properties.keys().cloned().collect())
+            .unwrap_or_default()
+    };
+    let mut attributes = ply_attributes(&keys("vertex"), vertices, "vertex_", &scalar);
     let mut indices = Vec::new();
     if let Some(faces) = ply.payload.get("face") {
+        let mut face_attributes = ply_attributes(&keys("face"), faces, "face_", &scalar);
+        let mut triangle_values: Vec<Vec<Vec3>> = vec![Vec::new(); face_attributes.len()];
         for (f, face) in faces.iter().enumerate() {
             let list: Vec<i64> = match face
                 .get("vertex_indices")
@@ -253,32 +407,30 @@ pub fn load_ply(path: &Path) -> Result<SceneDesc, Error> {
             }
             for k in 1..list.len().saturating_sub(1) {
                 indices.extend([list[0] as u32, list[k] as u32, list[k + 1] as u32]);
+                for (a, values) in face_attributes.iter().zip(&mut triangle_values) {
+                    values.push(a.values[f]);
+                }
             }
         }
+        for (a, values) in face_attributes.iter_mut().zip(triangle_values) {
+            a.values = values;
+        }
+        attributes.extend(face_attributes);
     }
     let name = path
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("ply")
         .to_string();
-    let desc = SceneDesc {
-        meshes: vec![MeshDesc {
-            name,
-            positions,
-            indices,
-            material: 0,
-            emission: None,
-            normals,
-            uvs: Vec::new(),
-            visibility: Visibility::ALL,
-        }],
-        materials: vec![MaterialDesc::Diffuse {
-            reflectance: Vec3::splat(0.8),
-            two_sided: true,
-        }],
+    Ok(MeshDesc {
+        name,
+        positions,
+        indices,
+        normals,
+        uvs,
+        attributes,
         ..Default::default()
-    };
-    standalone(path, desc)
+    })
 }
 
 /// Adds the default camera, resolution and (when nothing emits) lights of a standalone mesh.
@@ -325,6 +477,6 @@ pub(crate) fn framing_camera(path: &Path, desc: &SceneDesc) -> Result<CameraDesc
         fov_axis: FovAxis::Y,
         lens_radius: 0.0,
         focal_distance: distance,
-        focal_pixels: None,
+        ..Default::default()
     })
 }

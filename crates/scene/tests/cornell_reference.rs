@@ -295,7 +295,11 @@ fn direct_strategies_match_mitsuba() {
         (DirectStrategy::Light, 512, 1, true),
         (DirectStrategy::Mis, 512, 1, true),
     ] {
-        let integrator = IntegratorKind::Direct(DirectIntegrator { strategy, samples });
+        let integrator = IntegratorKind::Direct(DirectIntegrator {
+            strategy,
+            samples,
+            ..Default::default()
+        });
         let film = render_cornell(integrator, spp, 5);
         let name = format!("direct {}", strategy.name());
         let c = compare(&film, &r);
@@ -333,6 +337,7 @@ fn direct_strategies_rank_by_variance() {
         let integrator = IntegratorKind::Direct(DirectIntegrator {
             strategy,
             samples: 4,
+            ..Default::default()
         });
         let film = render_cornell(integrator, 64, 9);
         let per: Vec<f64> = film

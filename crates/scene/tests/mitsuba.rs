@@ -118,7 +118,8 @@ fn defaults_includes_and_shapes() {
     assert_eq!(desc.resolution, [32, 32]);
     assert!((desc.camera.lens_radius - 0.1).abs() < 1e-6);
     let s = info::summarize(&desc);
-    assert_eq!((s.triangles, s.spheres), (12 + 64, 1));
+    // The disk is a fan of 256 triangles.
+    assert_eq!((s.triangles, s.spheres), (12 + 256, 1));
     let (lo, hi) = s.bounds.unwrap();
     assert!((hi.x - 1.5).abs() < 1e-5 && (lo.x + 1.0).abs() < 1e-5);
     assert_eq!(desc.point_lights.len(), 1);
@@ -132,7 +133,7 @@ fn malformed_xml_gives_located_errors() {
     let cases = [
         (
             r#"<scene><shape type="rectangle"><ref id="nope"/></shape></scene>"#,
-            "undefined BSDF id 'nope'",
+            "no object has id 'nope'",
         ),
         (
             r#"<scene><sensor type="perspective"><film type="hdrfilm"><integer name="width" value="$w"/></film></sensor></scene>"#,
@@ -140,7 +141,7 @@ fn malformed_xml_gives_located_errors() {
         ),
         (
             r#"<scene><shape type="rectangle"><transform name="to_world"><translate x="NaN"/></transform></shape></scene>"#,
-            "finite number",
+            "is not a number",
         ),
         (
             r#"<scene><shape type="rectangle"><transform name="to_world"><matrix value="1 2 3"/></transform></shape></scene>"#,
@@ -174,4 +175,45 @@ fn malformed_xml_gives_located_errors() {
         mitsuba::load(Path::new("/no/scene.xml")),
         Err(Error::Io { .. })
     ));
+}
+
+#[test]
+fn conductor_table_matches_mitsubas_spectral_files() {
+    use pathlab_scene::mitsuba::ior::{named_conductor, CONDUCTORS};
+    use pathlab_scene::spectrum::{parse_spd, sampled_to_rgb, SpectrumKind};
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/mitsuba-suite/ior");
+    let rgb = |file: &str| {
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        sampled_to_rgb(&parse_spd(&text).unwrap(), SpectrumKind::Unbounded)
+    };
+    let mut files = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        if let Some(material) = name.strip_suffix(".eta.spd") {
+            files += 1;
+            let (eta, k) = named_conductor(material)
+                .unwrap_or_else(|| panic!("{material} is missing from the table"));
+            let (e, kk) = (rgb(&name), rgb(&format!("{material}.k.spd")));
+            for c in 0..3 {
+                let close = |a: f32, b: f64| (a as f64 - b).abs() <= 1e-5 * b.abs().max(1.0);
+                assert!(
+                    close(eta[c], e[c]),
+                    "{material} eta[{c}]: {} vs {}",
+                    eta[c],
+                    e[c]
+                );
+                assert!(
+                    close(k[c], kk[c]),
+                    "{material} k[{c}]: {} vs {}",
+                    k[c],
+                    kk[c]
+                );
+            }
+        }
+    }
+    assert_eq!(files, CONDUCTORS.len());
+    // Mitsuba 3's RGB silver (its ior_from_file("Ag")).
+    let (eta, k) = named_conductor("Ag").unwrap();
+    assert!((eta[0] - 0.155_276).abs() < 1e-5 && (k[2] - 2.146_90).abs() < 1e-4);
+    assert_eq!(named_conductor("none"), Some(([0.0; 3], [1.0; 3])));
 }

@@ -3,7 +3,7 @@
 //! there.
 
 use glam::{Vec2, Vec3};
-use pathlab_render::desc::MaterialDesc;
+use pathlab_render::desc::{MaterialDesc, TextureDesc};
 use pathlab_render::geometry::Ray;
 use pathlab_render::image_io::{srgb_decode, write_rgb8};
 use pathlab_render::scene::Scene;
@@ -128,7 +128,10 @@ fn collada_texture_resolves_sampler_surface_and_image() {
         .materials
         .iter()
         .filter_map(|m| match m {
-            MaterialDesc::TexturedDiffuse { texture, .. } => Some(texture.clone()),
+            MaterialDesc::TexturedDiffuse {
+                texture: TextureDesc::Image { image, .. },
+                ..
+            } => Some(image.clone()),
             _ => None,
         })
         .collect();

@@ -26,9 +26,8 @@ pub use rough_dielectric::RoughDielectric;
 
 use crate::desc::{MaterialDesc, Rgb};
 use crate::geometry::Frame;
-use crate::texture::Texture;
+use crate::texture::{Tex, TexPoint};
 use glam::{Vec2, Vec3};
-use std::sync::Arc;
 
 /// A sampled direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,7 +141,7 @@ pub struct Material {
     /// Whether the back side of the surface reflects too.
     pub two_sided: bool,
     /// Albedo texture of a diffuse BxDF (its reflectance then scales the texture).
-    pub texture: Option<Arc<Texture>>,
+    pub texture: Option<Tex>,
 }
 
 impl Material {
@@ -155,16 +154,35 @@ impl Material {
         }
     }
 
-    /// The BSDF at a point with shading normal `n` and texture coordinates `uv`, seen from `wo`.
+    /// The BSDF at a point with shading normal `n` and texture point `p`, seen from `wo`.
     #[inline]
-    pub fn bsdf(&self, n: Vec3, wo: Vec3, uv: Vec2) -> Bsdf {
+    pub fn bsdf(&self, n: Vec3, wo: Vec3, p: &TexPoint) -> Bsdf {
         let bxdf = match (&self.texture, self.bxdf) {
             (Some(t), Bxdf::Diffuse(d)) => Bxdf::Diffuse(Diffuse {
-                reflectance: (d.reflectance * t.eval(uv)).clamp(Vec3::ZERO, Vec3::ONE),
+                reflectance: (d.reflectance * t.eval(p)).clamp(Vec3::ZERO, Vec3::ONE),
             }),
             _ => self.bxdf,
         };
         Bsdf::from_bxdf(bxdf, self.two_sided, n, wo)
+    }
+
+    /// The material of a description; `attribute` gives the scene's table index of a named
+    /// mesh attribute its textures read.
+    pub fn from_desc(d: &MaterialDesc, attribute: &mut dyn FnMut(&str) -> u32) -> Self {
+        match d {
+            MaterialDesc::TexturedDiffuse {
+                texture,
+                scale,
+                two_sided,
+            } => Material {
+                bxdf: Bxdf::Diffuse(Diffuse {
+                    reflectance: scale.max(Vec3::ZERO),
+                }),
+                two_sided: *two_sided,
+                texture: Some(Tex::new(texture, attribute)),
+            },
+            other => Material::from(other),
+        }
     }
 }
 
@@ -202,7 +220,7 @@ impl From<&MaterialDesc> for Material {
                     reflectance: scale.max(Vec3::ZERO),
                 }),
                 two_sided,
-                texture: Some(texture.clone()),
+                texture: Some(Tex::from_desc(texture)),
             },
             MaterialDesc::Mirror { reflectance } => {
                 Material::new(Bxdf::Mirror(Mirror { reflectance }), true)

@@ -54,12 +54,31 @@ impl std::str::FromStr for DirectStrategy {
 
 /// Direct lighting: the emission the camera sees plus light that reaches the first surface in
 /// one bounce, estimated with `samples` directions (or light points) per camera ray.
+///
+/// With MIS, `samples` light samples and `bsdf_samples` BSDF samples (default: as many) are
+/// combined by the power heuristic with their counts, m p_l and k p_b (Mitsuba's `direct`
+/// with `emitter_samples` and `bsdf_samples`); a count of zero drops that strategy.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DirectIntegrator {
     /// The sampling strategy.
     pub strategy: DirectStrategy,
-    /// Samples per camera ray (each of light and BSDF for MIS).
+    /// Samples per camera ray (light samples for MIS).
     pub samples: u32,
+    /// BSDF samples per camera ray for MIS (`None`: as many as `samples`).
+    pub bsdf_samples: Option<u32>,
+    /// Camera rays see no emitters.
+    pub hide_emitters: bool,
+}
+
+impl Default for DirectIntegrator {
+    fn default() -> Self {
+        DirectIntegrator {
+            strategy: DirectStrategy::Mis,
+            samples: 1,
+            bsdf_samples: None,
+            hide_emitters: false,
+        }
+    }
 }
 
 impl DirectIntegrator {
@@ -91,12 +110,19 @@ impl DirectIntegrator {
 
 impl Integrator for DirectIntegrator {
     fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
+        let seen = |found: Option<(Rgb, f32)>| match found {
+            Some((le, _)) if !self.hide_emitters => le,
+            _ => Rgb::ZERO,
+        };
         let Some(si) = trace(scene, &ray, true, stats) else {
-            return escaped(scene, &ray).map_or(Rgb::ZERO, |(le, _)| le);
+            return seen(escaped(scene, &ray));
         };
         let wo = -ray.d;
-        let mut l = emitted(scene, ray.o, &ray, &si).map_or(Rgb::ZERO, |(le, _)| le);
+        let mut l = seen(emitted(scene, ray.o, &ray, &si));
         let bsdf = scene.bsdf(&si, wo);
+        if self.strategy == DirectStrategy::Mis {
+            return l + self.mis(scene, &si, &bsdf, wo, sampler, stats);
+        }
         let n = self.samples.max(1);
         let frame = *bsdf.frame();
         let mut sum = Rgb::ZERO;
@@ -114,31 +140,66 @@ impl Integrator for DirectIntegrator {
                     let f_cos = bsdf.f(wo, wi) * wi.dot(si.ns).abs();
                     sum += Self::gather(scene, &si, wi, f_cos, pdf, stats).0;
                 }
-                DirectStrategy::Light => {
+                DirectStrategy::Light | DirectStrategy::Mis => {
                     let u_select = sampler.next_1d();
                     let u_light = sampler.next_2d();
                     sum += sample_light(scene, &si, &bsdf, wo, u_select, u_light, n, 0, stats);
                 }
-                DirectStrategy::Mis => {
-                    let u_select = sampler.next_1d();
-                    let u_light = sampler.next_2d();
-                    sum += sample_light(scene, &si, &bsdf, wo, u_select, u_light, n, n, stats);
-                    if let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) {
-                        let f_cos = bs.f * bs.wi.dot(si.ns).abs();
-                        let (c, pdf_light) = Self::gather(scene, &si, bs.wi, f_cos, bs.pdf, stats);
-                        if let Some(pdf_light) = pdf_light {
-                            let w = if bs.delta {
-                                1.0
-                            } else {
-                                power_heuristic(n, bs.pdf, n, pdf_light)
-                            };
-                            sum += c * w;
-                        }
+            }
+        }
+        l += sum / n as f32;
+        l
+    }
+}
+
+impl DirectIntegrator {
+    /// Light and BSDF samples combined by the power heuristic with their counts. With equal
+    /// counts the samples come in pairs (light, then BSDF), as the course's comparison draws
+    /// them.
+    fn mis(
+        &self,
+        scene: &Scene,
+        si: &SurfaceInteraction,
+        bsdf: &crate::bsdf::Bsdf,
+        wo: Vec3,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+    ) -> Rgb {
+        let m = self.samples;
+        let k = self.bsdf_samples.unwrap_or(m);
+        let mut light = Rgb::ZERO;
+        let mut from_bsdf = Rgb::ZERO;
+        for i in 0..m.max(k) {
+            if i < m && !bsdf.is_delta() {
+                let u_select = sampler.next_1d();
+                let u_light = sampler.next_2d();
+                light += sample_light(scene, si, bsdf, wo, u_select, u_light, m, k, stats);
+            } else if i < m {
+                sampler.next_1d();
+                sampler.next_2d();
+            }
+            if i < k {
+                if let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) {
+                    let f_cos = bs.f * bs.wi.dot(si.ns).abs();
+                    let (c, pdf_light) = Self::gather(scene, si, bs.wi, f_cos, bs.pdf, stats);
+                    if let Some(pdf_light) = pdf_light {
+                        let w = if bs.delta || m == 0 {
+                            1.0
+                        } else {
+                            power_heuristic(k, bs.pdf, m, pdf_light)
+                        };
+                        from_bsdf += c * w;
                     }
                 }
             }
         }
-        l += sum / n as f32;
+        let mut l = Rgb::ZERO;
+        if m > 0 {
+            l += light / m as f32;
+        }
+        if k > 0 {
+            l += from_bsdf / k as f32;
+        }
         l
     }
 }

@@ -94,7 +94,9 @@ pub fn li_one_at_a_time<I: Integrator + ?Sized>(
 #[inline]
 pub fn camera_ray(scene: &Scene, sampler: &mut AnySampler, s: SampleRef) -> Ray {
     sampler.start_pixel_sample(s.pixel, s.index, 0);
-    let film = Vec2::new(s.pixel[0] as f32, s.pixel[1] as f32) + sampler.next_pixel_2d();
+    let film = scene
+        .camera()
+        .film_position(s.pixel, sampler.next_pixel_2d());
     let u_lens = sampler.next_2d();
     scene.camera().generate_ray(film, u_lens)
 }
@@ -108,6 +110,34 @@ pub enum IntegratorKind {
     Direct(DirectIntegrator),
     /// A debug view.
     Debug(DebugView),
+}
+
+impl IntegratorKind {
+    /// The integrator a scene file asks for ([`crate::desc::RenderHints`]): its path tracer
+    /// with the file's depth, roulette and emitter visibility, or direct lighting with its
+    /// numbers of light and BSDF samples combined by MIS; the path tracer without a hint.
+    pub fn from_hints(hints: &crate::desc::RenderHints) -> IntegratorKind {
+        match hints.integrator {
+            Some(crate::desc::IntegratorHint::Direct {
+                emitter_samples,
+                bsdf_samples,
+            }) => IntegratorKind::Direct(DirectIntegrator {
+                strategy: DirectStrategy::Mis,
+                samples: emitter_samples,
+                bsdf_samples: Some(bsdf_samples),
+                hide_emitters: hints.hide_emitters,
+            }),
+            Some(crate::desc::IntegratorHint::Path) | None => {
+                let default = PathIntegrator::default();
+                IntegratorKind::Path(PathIntegrator {
+                    max_depth: hints.max_depth.unwrap_or(default.max_depth),
+                    rr_depth: hints.rr_depth.unwrap_or(default.rr_depth),
+                    hide_emitters: hints.hide_emitters,
+                    ..default
+                })
+            }
+        }
+    }
 }
 
 impl Integrator for IntegratorKind {
@@ -228,7 +258,7 @@ pub(crate) fn emitted(
 ) -> Option<(Rgb, f32)> {
     let index = si.light?;
     let light = &scene.lights()[index as usize];
-    let le = light.le(si.ng, -ray.d);
+    let le = light.le(si.ng, -ray.d, si.uv);
     if le.max_element() <= 0.0 {
         return None;
     }

@@ -209,6 +209,7 @@ impl PathIntegrator {
     /// for: MIS with one light sample and every bounce counted.
     pub(crate) fn packets_apply(&self) -> bool {
         self.only_bounce.is_none()
+            && !self.hide_emitters
             && self.light_samples <= 1
             && self.lighting == super::PathLighting::Mis
     }
@@ -406,6 +407,7 @@ fn gather_light(
             shape: AreaShape::Triangle(t),
             radiance,
             two_sided,
+            texture: None,
         } => {
             for (v, p) in a.light_vertices.iter_mut().zip(t.triangle.p) {
                 v.set(i, p);

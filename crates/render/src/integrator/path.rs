@@ -36,6 +36,8 @@ pub struct PathIntegrator {
     pub light_samples: u32,
     /// How light is found at each vertex.
     pub lighting: PathLighting,
+    /// Camera rays see no emitters (lights still light the scene).
+    pub hide_emitters: bool,
 }
 
 /// The strategies a path tracer uses to find light at each vertex.
@@ -59,6 +61,7 @@ impl Default for PathIntegrator {
             only_bounce: None,
             light_samples: 1,
             lighting: PathLighting::Mis,
+            hide_emitters: false,
         }
     }
 }
@@ -147,6 +150,9 @@ impl PathIntegrator {
     /// have found with density `pdf_light`, weighted by MIS against it.
     #[inline]
     fn add_found_light(&self, st: &mut PathState, (le, pdf_light): (Rgb, f32)) {
+        if self.hide_emitters && st.depth == 0 {
+            return;
+        }
         let w = st
             .prev
             .map_or(1.0, |(_, pdf_bsdf)| self.bsdf_weight(pdf_bsdf, pdf_light));

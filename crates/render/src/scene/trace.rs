@@ -400,6 +400,7 @@ mod tests {
                     radius: 0.2,
                     material: 0,
                     emission: None,
+                    ..Default::default()
                 })
                 .collect(),
             materials: vec![diffuse(Vec3::ONE, false)],
