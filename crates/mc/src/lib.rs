@@ -40,6 +40,7 @@
 pub mod distribution;
 pub mod error;
 pub mod estimator;
+pub mod quadrature;
 pub mod rng;
 pub mod sampler;
 pub mod stats;

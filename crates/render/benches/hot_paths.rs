@@ -107,6 +107,7 @@ fn traversal(c: &mut Criterion) {
 
 fn bsdfs(c: &mut Criterion) {
     let ggx = Bxdf::Conductor(Conductor {
+        specular: glam::Vec3::ONE,
         eta: Vec3::new(0.143, 0.374, 1.442),
         k: Vec3::new(3.983, 2.385, 1.603),
         distribution: Some(Microfacet::new(NormalDistribution::Ggx, 0.2)),

@@ -396,6 +396,79 @@ pub enum MaterialDesc {
         /// Whether internal reflections are tinted by the base.
         nonlinear: bool,
     },
+    /// A conductor with textured, possibly anisotropic roughness (α along the surface's
+    /// u tangent and along v) and a reflectance scale (Mitsuba's `roughconductor`).
+    RoughConductor {
+        /// Roughness along the u tangent.
+        alpha_u: TextureDesc,
+        /// Roughness along the v tangent.
+        alpha_v: TextureDesc,
+        /// Real part of the complex index of refraction, per channel.
+        eta: Rgb,
+        /// Imaginary part, per channel.
+        k: Rgb,
+        /// Scale of the reflection.
+        specular: TextureDesc,
+        /// Microfacet distribution.
+        distribution: NormalDistribution,
+    },
+    /// A diffuse base under a rough dielectric coat (Mitsuba's `roughplastic`).
+    RoughPlastic {
+        /// Diffuse reflectance of the base.
+        diffuse: TextureDesc,
+        /// Scale of the coat's reflection.
+        specular: Rgb,
+        /// Roughness α of the coat.
+        alpha: f32,
+        /// Index of refraction of the coat relative to outside.
+        ior: f32,
+        /// Whether internal reflections are tinted by the base.
+        nonlinear: bool,
+        /// Microfacet distribution.
+        distribution: NormalDistribution,
+    },
+    /// A material seen through where `opacity` < 1: it counts `opacity` of the inner
+    /// material, the rest of the light passes straight through (Mitsuba's `mask`).
+    Mask {
+        /// Opacity in [0, 1].
+        opacity: TextureDesc,
+        /// The material where opaque.
+        inner: Box<MaterialDesc>,
+    },
+    /// `(1 - weight) first + weight second` (Mitsuba's `blendbsdf`).
+    Blend {
+        /// Weight of the second material, in [0, 1].
+        weight: TextureDesc,
+        /// The first material.
+        first: Box<MaterialDesc>,
+        /// The second material.
+        second: Box<MaterialDesc>,
+    },
+    /// One material on the front side (the shading normal's), another on the back.
+    TwoSided {
+        /// Front side.
+        front: Box<MaterialDesc>,
+        /// Back side (seen as its front).
+        back: Box<MaterialDesc>,
+    },
+    /// The inner material with its shading normal from a tangent-space normal map
+    /// (n = 2 × texture - 1 in the frame of the u tangent, the v bitangent and the normal).
+    NormalMap {
+        /// The normal map (read raw).
+        normals: TextureDesc,
+        /// The material.
+        inner: Box<MaterialDesc>,
+    },
+    /// The inner material with its shading normal from a height field's gradient (Mitsuba's
+    /// `bumpmap`: the surface displaced by `scale` × height along its normal).
+    BumpMap {
+        /// Heights (read raw).
+        height: TextureDesc,
+        /// Scale of the displacement.
+        scale: f32,
+        /// The material.
+        inner: Box<MaterialDesc>,
+    },
 }
 
 impl MaterialDesc {
@@ -408,6 +481,13 @@ impl MaterialDesc {
             MaterialDesc::Glass { .. } => "glass",
             MaterialDesc::Conductor { .. } => "conductor",
             MaterialDesc::Plastic { .. } => "plastic",
+            MaterialDesc::RoughConductor { .. } => "rough conductor",
+            MaterialDesc::RoughPlastic { .. } => "rough plastic",
+            MaterialDesc::Mask { .. } => "mask",
+            MaterialDesc::Blend { .. } => "blend",
+            MaterialDesc::TwoSided { .. } => "two-sided",
+            MaterialDesc::NormalMap { .. } => "normal map",
+            MaterialDesc::BumpMap { .. } => "bump map",
         }
     }
 }

@@ -200,15 +200,7 @@ impl Projector {
                     (cutoff - cos.clamp(-1.0, 1.0).acos()) / (cutoff - beam_width)
                 };
                 let k = 0.5 / (d.z * cutoff.tan());
-                let mut uv = Vec2::new(0.5 + d.x * k, 0.5 - d.y * k);
-                if let Ok(f) = std::env::var("PATHLAB_SPOT_FLIP") {
-                    if f.contains('u') {
-                        uv.x = 1.0 - uv.x;
-                    }
-                    if f.contains('v') {
-                        uv.y = 1.0 - uv.y;
-                    }
-                }
+                let uv = Vec2::new(0.5 + d.x * k, 0.5 - d.y * k);
                 intensity * self.texture.eval(&TexPoint::uv(uv)) * falloff
             }
             ProjectorKind::Projector {

@@ -1,7 +1,7 @@
 //! The renderable scene: flattened shapes, the BVH over them, materials, lights and camera.
 
 use crate::accel::{Bvh8, BvhParams, TriBlock, LANES, MAX_PRIMITIVES};
-use crate::bsdf::Material;
+use crate::bsdf::{Material, ShadingPoint};
 use crate::camera::Camera;
 use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc, Visibility};
 use crate::envmap::EnvironmentMap;
@@ -130,6 +130,8 @@ pub struct Scene {
     blocks: Vec<TriBlock>,
     block_info: Vec<BlockInfo>,
     materials: Vec<Material>,
+    /// Whether each material needs the surface's tangents.
+    needs_tangents: Vec<bool>,
     lights: Vec<Light>,
     light_sampler: LightSampler,
     environment: Option<u32>,
@@ -493,6 +495,7 @@ impl Scene {
             bvh,
             blocks,
             block_info,
+            needs_tangents: materials.iter().map(Material::needs_tangents).collect(),
             materials,
             lights,
             light_sampler,
@@ -545,7 +548,71 @@ impl Scene {
     /// The BSDF at a surface point seen from `wo`.
     #[inline]
     pub fn bsdf(&self, si: &SurfaceInteraction, wo: Vec3) -> crate::bsdf::Bsdf {
-        self.materials[si.material as usize].bsdf(si.ns, wo, &self.tex_point(si))
+        let m = &self.materials[si.material as usize];
+        let (dpdu, dpdv) = if self.needs_tangents[si.material as usize] {
+            self.tangents(si)
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        m.bsdf(
+            &ShadingPoint {
+                n: si.ns,
+                dpdu,
+                dpdv,
+                ng: si.ng,
+                tex: self.tex_point(si),
+            },
+            wo,
+        )
+    }
+
+    /// ∂p/∂u and ∂p/∂v at `si` (pathlab's (u, v)): from a triangle's texture coordinates
+    /// (an arbitrary pair around the normal when they are degenerate), or a sphere's angles.
+    pub fn tangents(&self, si: &SurfaceInteraction) -> (Vec3, Vec3) {
+        let fallback = || {
+            let (s, t) = pathlab_mc::warp::coordinate_system(si.ns);
+            (s, t)
+        };
+        if si.prim == u32::MAX {
+            // A sphere: find it by the point's distance from each centre (spheres are few).
+            let Some(i) = self
+                .spheres
+                .iter()
+                .position(|s| ((si.p - s.center).length() - s.radius).abs() <= 1e-3 * s.radius)
+            else {
+                return fallback();
+            };
+            let (s, to_object) = (&self.spheres[i], self.sphere_to_object[i]);
+            let d = to_object * si.ng;
+            let r = s.radius;
+            let phi = d.y.atan2(d.x);
+            let sin_theta = (1.0 - d.z * d.z).max(0.0).sqrt();
+            let tau = std::f32::consts::TAU;
+            let dpdu = Vec3::new(-d.y, d.x, 0.0) * (tau * r);
+            // Mitsuba's v = θ/π grows downwards from the pole; pathlab's v is 1 - that.
+            let dpdv = Vec3::new(d.z * phi.cos(), d.z * phi.sin(), -sin_theta)
+                * (-std::f32::consts::PI * r);
+            let to_world = to_object.transpose();
+            return (to_world * dpdu, to_world * dpdv);
+        }
+        let i = si.prim as usize;
+        let p = self.triangles[i].p;
+        let uv = self
+            .tri_uv
+            .get(i)
+            .copied()
+            .unwrap_or([Vec2::ZERO, Vec2::X, Vec2::Y]);
+        let (dp0, dp1) = (p[1] - p[0], p[2] - p[0]);
+        let (duv0, duv1) = (uv[1] - uv[0], uv[2] - uv[0]);
+        let det = duv0.x * duv1.y - duv0.y * duv1.x;
+        if det.abs() < 1e-12 {
+            return fallback();
+        }
+        let inv = 1.0 / det;
+        (
+            (dp0 * duv1.y - dp1 * duv0.y) * inv,
+            (dp1 * duv0.x - dp0 * duv1.x) * inv,
+        )
     }
 
     /// Where textures are evaluated at `si`.

@@ -235,10 +235,60 @@ impl Tex {
         }
     }
 
+    /// The gradient of [`Tex::eval_float`] with respect to surface (u, v) at `p`: exact for a
+    /// bilinearly filtered image (the derivative of the interpolation, through `to_uv`), zero
+    /// for every other texture.
+    pub fn grad_float(&self, p: &TexPoint) -> Vec2 {
+        let Tex::Image {
+            image,
+            filter: TextureFilter::Bilinear,
+            wrap,
+            to_uv,
+        } = self
+        else {
+            return Vec2::ZERO;
+        };
+        let q = to_uv.transform_point2(p.uv);
+        let (w, h) = (image.width as f32, image.height as f32);
+        let lum = |c: Rgb| 0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z;
+        let x = q.x * w - 0.5;
+        let y = (1.0 - q.y) * h - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let at = |dx: f32, dy: f32| {
+            // Texel centres: back to image coordinates for the wrapped lookup.
+            let u = (x0 + dx + 0.5) / w;
+            let v = 1.0 - (y0 + dy + 0.5) / h;
+            lum(image.lookup(Vec2::new(u, v), TextureFilter::Nearest, *wrap))
+        };
+        let (f00, f10, f01, f11) = (at(0.0, 0.0), at(1.0, 0.0), at(0.0, 1.0), at(1.0, 1.0));
+        // d/dx and d/dy in texels; y runs down the image, v up.
+        let dx = ((f10 - f00) * (1.0 - fy) + (f11 - f01) * fy) * w;
+        let dy = ((f01 - f00) * (1.0 - fx) + (f11 - f10) * fx) * h;
+        let g = Vec2::new(dx, -dy);
+        // Chain rule through the affine map: ∂/∂uv = Aᵀ ∂/∂q.
+        to_uv.matrix2.transpose() * g
+    }
+
     /// The value at `p` as a number: the luminance of the colour (the value itself for grey).
+    /// A checkerboard read as a number has its two colours swapped, as Mitsuba's does (its
+    /// `eval_1` tests the opposite parity from its `eval`), so that scenes written for it
+    /// render the same.
     #[inline]
     pub fn eval_float(&self, p: &TexPoint) -> f32 {
-        let c = self.eval(p);
+        let c = match self {
+            Tex::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => Tex::Checkerboard {
+                color0: *color1,
+                color1: *color0,
+                to_uv: *to_uv,
+            }
+            .eval(p),
+            other => other.eval(p),
+        };
         0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
     }
 }

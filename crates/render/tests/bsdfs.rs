@@ -31,10 +31,37 @@ fn gold() -> (Rgb, Rgb) {
 fn conductor(kind: NormalDistribution, alpha: f32) -> Bxdf {
     let (eta, k) = gold();
     Bxdf::Conductor(Conductor {
+        specular: glam::Vec3::ONE,
         eta,
         k,
         distribution: Some(Microfacet::new(kind, alpha)),
     })
+}
+
+fn anisotropic_conductor(kind: NormalDistribution, ax: f32, ay: f32) -> Bxdf {
+    let (eta, k) = gold();
+    Bxdf::Conductor(Conductor {
+        specular: glam::Vec3::ONE,
+        eta,
+        k,
+        distribution: Some(Microfacet::anisotropic(kind, ax, ay)),
+    })
+}
+
+fn rough_plastic(kind: NormalDistribution, alpha: f32) -> Bxdf {
+    Bxdf::RoughPlastic(RoughPlastic::new(
+        Vec3::new(0.2, 0.5, 0.3),
+        Vec3::ONE,
+        1.5,
+        Microfacet::new(kind, alpha),
+        false,
+    ))
+}
+
+/// A direction at polar angle `theta_deg` and azimuth `phi_deg`, above.
+fn wo_at_azimuth(theta_deg: f32, phi_deg: f32) -> Vec3 {
+    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
 }
 
 fn rough_glass(kind: NormalDistribution, alpha: f32) -> Bxdf {
@@ -175,6 +202,29 @@ fn cases() -> Vec<Case> {
             wo_at(theta, false),
         );
     }
+    for (kind, label) in [
+        (NormalDistribution::Ggx, "GGX"),
+        (NormalDistribution::Beckmann, "Beckmann"),
+    ] {
+        for (ax, ay) in [(0.1, 0.4), (0.6, 0.15)] {
+            for (theta, phi) in [(20.0, 30.0), (70.0, 120.0)] {
+                add(
+                    format!("{label} anisotropic conductor α ({ax}, {ay}) θo {theta} φo {phi}"),
+                    anisotropic_conductor(kind, ax, ay),
+                    wo_at_azimuth(theta, phi),
+                );
+            }
+        }
+        for alpha in [0.1, 0.6] {
+            for theta in [10.0, 70.0] {
+                add(
+                    format!("{label} rough plastic α {alpha} θo {theta}"),
+                    rough_plastic(kind, alpha),
+                    wo_at(theta, false),
+                );
+            }
+        }
+    }
     v
 }
 
@@ -304,6 +354,22 @@ fn sampled_weights_agree_with_uniform_integration_and_albedo_is_at_most_one() {
         (
             "Beckmann rough glass α 0.5",
             rough_glass(NormalDistribution::Beckmann, 0.5),
+        ),
+        (
+            "GGX anisotropic conductor α (0.2, 0.6)",
+            anisotropic_conductor(NormalDistribution::Ggx, 0.2, 0.6),
+        ),
+        (
+            "Beckmann anisotropic conductor α (0.6, 0.25)",
+            anisotropic_conductor(NormalDistribution::Beckmann, 0.6, 0.25),
+        ),
+        (
+            "GGX rough plastic α 0.3",
+            rough_plastic(NormalDistribution::Ggx, 0.3),
+        ),
+        (
+            "Beckmann rough plastic α 0.6",
+            rough_plastic(NormalDistribution::Beckmann, 0.6),
         ),
     ]
     .into_iter()

@@ -50,7 +50,13 @@ fn check(folder: &str, file: &str) -> (f64, bool, Vec<String>) {
     assert_eq!(desc.resolution, [w, h], "{folder}/{file}: film size");
     let scene = Scene::build(&desc).unwrap();
     let integrator = IntegratorKind::from_hints(&desc.hints);
-    let settings = RenderSettings::new(spp, 0, SamplerKind::Independent);
+    // PATHLAB_SUITE_SPP_SCALE=K renders K times the samples (the rule keeps Mitsuba's spp):
+    // a failure that persists is bias, one that fades was noise.
+    let scale: u32 = std::env::var("PATHLAB_SUITE_SPP_SCALE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
+    let settings = RenderSettings::new(spp * scale, 0, SamplerKind::Independent);
     let (film, _) = render(&scene, &integrator, &settings, &|_| {}, &Default::default());
     let alpha = 1.0 - (1.0 - SIGNIFICANCE).powf(1.0 / pixels as f64);
     let mut passed = 0u64;
@@ -86,6 +92,29 @@ fn check(folder: &str, file: &str) -> (f64, bool, Vec<String>) {
     for w in &desc.warnings {
         println!("  warning: {w}");
     }
+    if std::env::var("PATHLAB_SUITE_WORST").is_ok() {
+        let mut all: Vec<(f64, usize, usize)> = Vec::new();
+        for (i, p) in film.pixels().iter().enumerate() {
+            let ours = srgb_to_xyz(p.mean());
+            for c in 0..3 {
+                let z =
+                    (ours[c] - reference[i][c]) * (spp as f64 / variance[i][c].max(1e-4)).sqrt();
+                all.push((z, i, c));
+            }
+        }
+        all.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
+        for &(z, i, c) in all.iter().take(12) {
+            let ours = srgb_to_xyz(film.pixels()[i].mean());
+            println!(
+                "  ({}, {}) [{c}] z {z:+.1}: ours {:.4} ref {:.4} ref sd {:.4}",
+                i as u32 % w,
+                i as u32 / w,
+                ours[c],
+                reference[i][c],
+                variance[i][c].sqrt()
+            );
+        }
+    }
     // For looking at a failure: PATHLAB_SUITE_DUMP=DIR writes ours, the reference and the
     // pixels that fail, side by side, as a PNG.
     if let Ok(dir) = std::env::var("PATHLAB_SUITE_DUMP") {
@@ -98,17 +127,12 @@ fn check(folder: &str, file: &str) -> (f64, bool, Vec<String>) {
                         0 => film.pixels()[i].mean().as_vec3(),
                         1 => pathlab_scene::spectrum::xyz_to_srgb(reference[i]).as_vec3(),
                         _ => {
+                            // z of Y: red where ours is higher, blue where lower, full at 6.
                             let ours = srgb_to_xyz(film.pixels()[i].mean());
-                            let bad = (0..3).any(|c| {
-                                let z = (ours[c] - reference[i][c]).abs()
-                                    * (spp as f64 / variance[i][c].max(1e-4)).sqrt();
-                                statrs::function::erf::erfc(z / std::f64::consts::SQRT_2) <= alpha
-                            });
-                            if bad {
-                                glam::Vec3::X
-                            } else {
-                                glam::Vec3::ZERO
-                            }
+                            let z = (ours.y - reference[i].y)
+                                * (spp as f64 / variance[i].y.max(1e-4)).sqrt();
+                            let z = (z / 6.0).clamp(-1.0, 1.0) as f32;
+                            glam::Vec3::new(z.max(0.0), 0.0, (-z).max(0.0))
                         }
                     });
                 }
@@ -148,50 +172,41 @@ macro_rules! scene {
 scene!(
     bsdf_spheres_arealight,
     "bsdf_spheres",
-    "test_arealight_path.xml",
-    ignore = "roughplastic and mask are not implemented yet"
+    "test_arealight_path.xml"
 );
 scene!(
     bsdf_spheres_bumpmap,
     "bsdf_spheres",
     "test_bumpmap_path.xml",
-    ignore = "bumpmap is not implemented yet"
+    ignore = "bumpmap: the silhouette pixels differ (98.6% pass)"
 );
 scene!(
     bsdf_spheres_constant,
     "bsdf_spheres",
-    "test_constant_path.xml",
-    ignore = "roughplastic and mask are not implemented yet"
+    "test_constant_path.xml"
 );
-scene!(
-    bsdf_spheres_envmap,
-    "bsdf_spheres",
-    "test_envmap_path.xml",
-    ignore = "roughplastic and mask are not implemented yet"
-);
+scene!(bsdf_spheres_envmap, "bsdf_spheres", "test_envmap_path.xml");
 scene!(
     bsdf_spheres_normalmap_identity_roughconductor,
     "bsdf_spheres",
-    "test_normalmap_identity_roughconductor_path.xml",
-    ignore = "normalmap and anisotropic roughconductor are not implemented yet"
+    "test_normalmap_identity_roughconductor_path.xml"
 );
 scene!(
     bsdf_spheres_normalmap,
     "bsdf_spheres",
     "test_normalmap_path.xml",
-    ignore = "normalmap is not implemented yet"
+    ignore = "normalmap: the silhouette pixels differ (98.2% pass)"
 );
 scene!(
     bsdf_spheres_normalmap_roughconductor,
     "bsdf_spheres",
     "test_normalmap_roughconductor_path.xml",
-    ignore = "normalmap and anisotropic roughconductor are not implemented yet"
+    ignore = "normalmap: the silhouette pixels differ (98.9% pass)"
 );
 scene!(
     bsdf_spheres_pointlight,
     "bsdf_spheres",
-    "test_pointlight_path.xml",
-    ignore = "roughplastic and mask are not implemented yet"
+    "test_pointlight_path.xml"
 );
 scene!(
     bsdf_spheres_roughdielectric,
@@ -201,14 +216,12 @@ scene!(
 scene!(
     bsdf_spheres_roughplastic_linear,
     "bsdf_spheres",
-    "test_roughplastic_linear_path.xml",
-    ignore = "roughplastic is not implemented yet"
+    "test_roughplastic_linear_path.xml"
 );
 scene!(
     bsdf_spheres_roughplastic_nonlinear,
     "bsdf_spheres",
-    "test_roughplastic_nonlinear_path.xml",
-    ignore = "roughplastic is not implemented yet"
+    "test_roughplastic_nonlinear_path.xml"
 );
 scene!(
     bsdf_spheres_textured_diffuse,
@@ -218,8 +231,7 @@ scene!(
 scene!(
     bsdf_spheres_textured_roughconductor,
     "bsdf_spheres",
-    "test_textured_roughconductor_path.xml",
-    ignore = "textured anisotropic roughconductor is not implemented yet"
+    "test_textured_roughconductor_path.xml"
 );
 scene!(
     bsdf_spheres_texturedprincipled1,
@@ -249,8 +261,7 @@ scene!(instancing, "instancing", "test_instancing_path.xml");
 scene!(
     mesh_attributes_1_face,
     "mesh_attributes",
-    "test_mesh_attributes_1_face_direct.xml",
-    ignore = "blendbsdf is not implemented yet"
+    "test_mesh_attributes_1_face_direct.xml"
 );
 scene!(
     mesh_attributes_3_face,

@@ -86,9 +86,11 @@ fn mitsuba_bitmap_on_a_rectangle() {
     let desc = pathlab_scene::load(dir.join("scene.xml").to_str().unwrap()).unwrap();
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
     let scene = Scene::build(&desc).unwrap();
-    // The rectangle spans [-1, 1]² with (u, v) = ((x + 1)/2, (y + 1)/2).
-    assert_close(albedo_at(&scene, Vec3::new(-0.5, -0.5, 1.0)), Vec3::Z);
-    assert_close(albedo_at(&scene, Vec3::new(-0.5, 0.5, 1.0)), Vec3::X);
+    // The rectangle spans [-1, 1]² with Mitsuba's (u, v) = ((x + 1)/2, (y + 1)/2), and
+    // Mitsuba's v = 0 is the image's top row: y = -1 shows the top of the image.
+    assert_close(albedo_at(&scene, Vec3::new(-0.5, -0.5, 1.0)), Vec3::X);
+    assert_close(albedo_at(&scene, Vec3::new(-0.5, 0.5, 1.0)), Vec3::Z);
+    assert_close(albedo_at(&scene, Vec3::new(0.5, -0.5, 1.0)), Vec3::Y);
 }
 
 #[test]

@@ -17,6 +17,8 @@ pub struct Conductor {
     pub eta: Rgb,
     /// Imaginary part (absorption), per channel.
     pub k: Rgb,
+    /// Scale of the reflection (Mitsuba's `specular_reflectance`; one for a plain metal).
+    pub specular: Rgb,
     /// The microfacet distribution (`None`: a smooth surface).
     pub distribution: Option<Microfacet>,
 }
@@ -25,11 +27,12 @@ impl Conductor {
     /// Fresnel reflectance per channel at cos θ.
     #[inline]
     fn fresnel(&self, cos: f32) -> Rgb {
-        Rgb::new(
-            fresnel_conductor(cos, self.eta.x, self.k.x),
-            fresnel_conductor(cos, self.eta.y, self.k.y),
-            fresnel_conductor(cos, self.eta.z, self.k.z),
-        )
+        self.specular
+            * Rgb::new(
+                fresnel_conductor(cos, self.eta.x, self.k.x),
+                fresnel_conductor(cos, self.eta.y, self.k.y),
+                fresnel_conductor(cos, self.eta.z, self.k.z),
+            )
     }
 
     /// f(wo, wi) (zero for a smooth conductor: a delta lobe).

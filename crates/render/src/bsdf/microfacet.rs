@@ -1,5 +1,6 @@
-//! Isotropic microfacet distributions (Beckmann and GGX / Trowbridge–Reitz) with Smith's
-//! masking, in the local shading frame (z = macro normal).
+//! Microfacet distributions (Beckmann and GGX / Trowbridge–Reitz), isotropic or anisotropic,
+//! with Smith's masking, in the local shading frame (z = macro normal, x the tangent along
+//! which `alpha_x` applies).
 //!
 //! Conventions, shared with Mitsuba 3 so that renders can be compared with its references:
 //! `alpha` is the distribution's roughness as given (no remapping); masking-shadowing is the
@@ -20,13 +21,15 @@ pub enum NormalDistribution {
     Ggx,
 }
 
-/// An isotropic microfacet distribution.
+/// A microfacet distribution.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Microfacet {
     /// The distribution.
     pub kind: NormalDistribution,
-    /// Roughness α (> 0).
+    /// Roughness α (> 0); along the local x axis when anisotropic.
     pub alpha: f32,
+    /// Roughness along the local y axis (equal to `alpha` when isotropic).
+    pub alpha_y: f32,
 }
 
 /// The error function (Abramowitz and Stegun 7.1.26, absolute error below 1.5e-7).
@@ -54,16 +57,61 @@ impl Microfacet {
     /// A distribution; roughness is clamped to at least 1e-4 (below that the model is a
     /// mirror and should be drawn as one).
     pub fn new(kind: NormalDistribution, alpha: f32) -> Self {
+        let alpha = alpha.max(1e-4);
         Microfacet {
             kind,
-            alpha: alpha.max(1e-4),
+            alpha,
+            alpha_y: alpha,
         }
+    }
+
+    /// An anisotropic distribution: roughness `alpha_x` along the local x axis, `alpha_y`
+    /// along y (each clamped to at least 1e-4).
+    pub fn anisotropic(kind: NormalDistribution, alpha_x: f32, alpha_y: f32) -> Self {
+        Microfacet {
+            kind,
+            alpha: alpha_x.max(1e-4),
+            alpha_y: alpha_y.max(1e-4),
+        }
+    }
+
+    /// Whether both roughnesses are the same.
+    #[inline]
+    pub fn is_isotropic(&self) -> bool {
+        self.alpha == self.alpha_y
+    }
+
+    /// The roughness seen along the azimuth of `w`: sqrt(cos²φ αx² + sin²φ αy²).
+    #[inline]
+    fn projected_alpha(&self, w: Vec3) -> f32 {
+        if self.is_isotropic() {
+            return self.alpha;
+        }
+        let r2 = w.x * w.x + w.y * w.y;
+        if r2 == 0.0 {
+            return self.alpha;
+        }
+        ((w.x * w.x * self.alpha * self.alpha + w.y * w.y * self.alpha_y * self.alpha_y) / r2)
+            .sqrt()
     }
 
     /// The density of microfacet normals D(wm), normalised so that ∫ D(wm) cos θm dωm = 1.
     pub fn d(&self, wm: Vec3) -> f32 {
         if wm.z <= 0.0 {
             return 0.0;
+        }
+        if !self.is_isotropic() {
+            let (ax, ay) = (self.alpha, self.alpha_y);
+            let cos2 = wm.z * wm.z;
+            // tan²θ (cos²φ / αx² + sin²φ / αy²) = (x²/αx² + y²/αy²) / z².
+            let e = (wm.x * wm.x / (ax * ax) + wm.y * wm.y / (ay * ay)) / cos2;
+            return match self.kind {
+                NormalDistribution::Beckmann => (-e).exp() / (PI * ax * ay * cos2 * cos2),
+                NormalDistribution::Ggx => {
+                    let t = 1.0 + e;
+                    1.0 / (PI * ax * ay * cos2 * cos2 * t * t)
+                }
+            };
         }
         let a2 = self.alpha * self.alpha;
         let cos2 = wm.z * wm.z;
@@ -88,10 +136,11 @@ impl Microfacet {
         if tan2 == 0.0 {
             return 0.0;
         }
+        let alpha = self.projected_alpha(w);
         match self.kind {
-            NormalDistribution::Ggx => 0.5 * (-1.0 + (1.0 + self.alpha * self.alpha * tan2).sqrt()),
+            NormalDistribution::Ggx => 0.5 * (-1.0 + (1.0 + alpha * alpha * tan2).sqrt()),
             NormalDistribution::Beckmann => {
-                let a = 1.0 / (self.alpha * tan2.sqrt());
+                let a = 1.0 / (alpha * tan2.sqrt());
                 if a >= 6.0 {
                     return 0.0;
                 }
@@ -119,6 +168,21 @@ impl Microfacet {
     pub fn sample_wm(&self, wo: Vec3, u: Vec2) -> Vec3 {
         match self.kind {
             NormalDistribution::Ggx => self.sample_visible_ggx(wo, u),
+            NormalDistribution::Beckmann if !self.is_isotropic() => {
+                // D(wm) cos θm for elliptical slopes: the azimuth from the ellipse, then
+                // tan²θ = -ln(1 - u) / (cos²φ/αx² + sin²φ/αy²).
+                let (ax, ay) = (self.alpha, self.alpha_y);
+                let mut phi = (ay / ax * (TAU * u.y + 0.5 * PI).tan()).atan();
+                if u.y > 0.5 {
+                    phi += PI;
+                }
+                let (sin_phi, cos_phi) = phi.sin_cos();
+                let a2 = 1.0 / (cos_phi * cos_phi / (ax * ax) + sin_phi * sin_phi / (ay * ay));
+                let tan2 = -a2 * (1.0 - u.x).max(f32::MIN_POSITIVE).ln();
+                let cos = 1.0 / (1.0 + tan2).sqrt();
+                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                Vec3::new(sin * cos_phi, sin * sin_phi, cos)
+            }
             NormalDistribution::Beckmann => {
                 let tan2 = -self.alpha * self.alpha * (1.0 - u.x).max(f32::MIN_POSITIVE).ln();
                 let cos = 1.0 / (1.0 + tan2).sqrt();
@@ -151,8 +215,8 @@ impl Microfacet {
     /// Heitz's sampling of GGX visible normals: a point on the projected hemisphere of the
     /// stretched configuration, warped back.
     fn sample_visible_ggx(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        let a = self.alpha;
-        let mut wh = Vec3::new(a * wo.x, a * wo.y, wo.z).normalize();
+        let (a, ay) = (self.alpha, self.alpha_y);
+        let mut wh = Vec3::new(a * wo.x, ay * wo.y, wo.z).normalize();
         if wh.z < 0.0 {
             wh = -wh;
         }
@@ -169,7 +233,7 @@ impl Microfacet {
         p.y = (1.0 - s) * h + s * p.y;
         let pz = (1.0 - p.length_squared()).max(0.0).sqrt();
         let nh = p.x * t1 + p.y * t2 + pz * wh;
-        Vec3::new(a * nh.x, a * nh.y, nh.z.max(1e-6)).normalize()
+        Vec3::new(a * nh.x, ay * nh.y, nh.z.max(1e-6)).normalize()
     }
 }
 
@@ -219,8 +283,14 @@ mod tests {
     #[test]
     fn distributions_are_normalised() {
         for kind in [NormalDistribution::Beckmann, NormalDistribution::Ggx] {
-            for &alpha in &[0.1f32, 0.3, 0.8] {
-                let m = Microfacet::new(kind, alpha);
+            for &(alpha, alpha_y) in &[
+                (0.1f32, 0.1f32),
+                (0.3, 0.3),
+                (0.8, 0.8),
+                (0.2, 0.5),
+                (0.6, 0.15),
+            ] {
+                let m = Microfacet::anisotropic(kind, alpha, alpha_y);
                 let wo = Vec3::new(0.6, 0.0, 0.8);
                 let (nz, nphi) = (4000, 64);
                 let (mut proj, mut vis) = (0.0f64, 0.0f64);

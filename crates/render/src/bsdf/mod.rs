@@ -3,44 +3,55 @@
 //!
 //! One file per model, each with `f`, `sample` and `pdf` in the local frame: [`diffuse`],
 //! [`mirror`], [`dielectric`] (smooth glass), [`conductor`] (smooth or microfacet),
-//! [`rough_dielectric`], [`plastic`]; [`microfacet`] holds the distributions and
-//! [`fresnel`] the reflectance formulas.
+//! [`rough_dielectric`], [`plastic`], [`rough_plastic`]; [`microfacet`] holds the
+//! distributions and [`fresnel`] the reflectance formulas. [`material`] turns a scene's
+//! material (textured parameters, masks, blends, two-sided pairs, normal and bump maps) into
+//! the [`Bsdf`] at a surface point: a weighted mixture of lobes, each a [`Bxdf`] in its own
+//! shading frame, plus an optional pass-through.
 
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+pub mod material;
 pub mod microfacet;
 pub mod mirror;
 pub mod plastic;
 pub mod rough_dielectric;
+pub mod rough_plastic;
 
 pub use conductor::Conductor;
 pub use dielectric::{refract, FresnelModel, SmoothDielectric};
 pub use diffuse::Diffuse;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+pub use material::{Leaf, Material, Model, ShadingPoint};
 pub use microfacet::{Microfacet, NormalDistribution};
 pub use mirror::Mirror;
 pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;
+pub use rough_plastic::RoughPlastic;
 
-use crate::desc::{MaterialDesc, Rgb};
+use crate::desc::Rgb;
 use crate::geometry::Frame;
-use crate::texture::{Tex, TexPoint};
 use glam::{Vec2, Vec3};
 
 /// A sampled direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BsdfSample {
-    /// BSDF value f(wo, wi).
+    /// BSDF value f(wo, wi) (for a delta lobe, the value whose product with `cos` over `pdf`
+    /// is the lobe's weight).
     pub f: Rgb,
     /// The sampled direction, in world space.
     pub wi: Vec3,
     /// Its density per unit solid angle, or for a delta lobe the probability of choosing it.
     pub pdf: f32,
-    /// Whether the direction comes from a delta lobe (mirror reflection, refraction): no other
-    /// strategy could have produced it, so MIS gives it weight one.
+    /// Whether the direction comes from a delta lobe (mirror reflection, refraction, passing
+    /// through): no other strategy could have produced it, so MIS gives it weight one.
     pub delta: bool,
+    /// The foreshortening |cos θi| that goes with `f`: the throughput of the sample is
+    /// f · cos / pdf. (The cosine to the lobe's own shading normal, which a normal map may
+    /// have moved away from the surface's.)
+    pub cos: f32,
 }
 
 /// A sampled direction in the local frame.
@@ -85,6 +96,8 @@ pub enum Bxdf {
     RoughDielectric(RoughDielectric),
     /// Diffuse under a smooth coat.
     Plastic(Plastic),
+    /// Diffuse under a rough coat.
+    RoughPlastic(RoughPlastic),
 }
 
 impl Bxdf {
@@ -95,6 +108,7 @@ impl Bxdf {
             Bxdf::Conductor(b) => b.f(wo, wi),
             Bxdf::RoughDielectric(b) => b.f(wo, wi),
             Bxdf::Plastic(b) => b.f(wo, wi),
+            Bxdf::RoughPlastic(b) => b.f(wo, wi),
             Bxdf::Mirror(_) | Bxdf::Dielectric(_) => Rgb::ZERO,
         }
     }
@@ -108,6 +122,7 @@ impl Bxdf {
             Bxdf::Conductor(b) => b.sample(wo, u),
             Bxdf::RoughDielectric(b) => b.sample(wo, uc, u),
             Bxdf::Plastic(b) => b.sample(wo, uc, u),
+            Bxdf::RoughPlastic(b) => b.sample(wo, uc, u),
         }
     }
 
@@ -118,6 +133,7 @@ impl Bxdf {
             Bxdf::Conductor(b) => b.pdf(wo, wi),
             Bxdf::RoughDielectric(b) => b.pdf(wo, wi),
             Bxdf::Plastic(b) => b.pdf(wo, wi),
+            Bxdf::RoughPlastic(b) => b.pdf(wo, wi),
             Bxdf::Mirror(_) | Bxdf::Dielectric(_) => 0.0,
         }
     }
@@ -127,61 +143,10 @@ impl Bxdf {
         match self {
             Bxdf::Mirror(_) | Bxdf::Dielectric(_) => true,
             Bxdf::Conductor(c) => c.distribution.is_none(),
-            Bxdf::Diffuse(_) | Bxdf::RoughDielectric(_) | Bxdf::Plastic(_) => false,
-        }
-    }
-}
-
-/// A material: its BxDF, whether its back side reflects, and a texture that varies the
-/// diffuse albedo over the surface.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Material {
-    /// Reflectance model.
-    pub bxdf: Bxdf,
-    /// Whether the back side of the surface reflects too.
-    pub two_sided: bool,
-    /// Albedo texture of a diffuse BxDF (its reflectance then scales the texture).
-    pub texture: Option<Tex>,
-}
-
-impl Material {
-    /// A material without texture.
-    pub fn new(bxdf: Bxdf, two_sided: bool) -> Self {
-        Material {
-            bxdf,
-            two_sided,
-            texture: None,
-        }
-    }
-
-    /// The BSDF at a point with shading normal `n` and texture point `p`, seen from `wo`.
-    #[inline]
-    pub fn bsdf(&self, n: Vec3, wo: Vec3, p: &TexPoint) -> Bsdf {
-        let bxdf = match (&self.texture, self.bxdf) {
-            (Some(t), Bxdf::Diffuse(d)) => Bxdf::Diffuse(Diffuse {
-                reflectance: (d.reflectance * t.eval(p)).clamp(Vec3::ZERO, Vec3::ONE),
-            }),
-            _ => self.bxdf,
-        };
-        Bsdf::from_bxdf(bxdf, self.two_sided, n, wo)
-    }
-
-    /// The material of a description; `attribute` gives the scene's table index of a named
-    /// mesh attribute its textures read.
-    pub fn from_desc(d: &MaterialDesc, attribute: &mut dyn FnMut(&str) -> u32) -> Self {
-        match d {
-            MaterialDesc::TexturedDiffuse {
-                texture,
-                scale,
-                two_sided,
-            } => Material {
-                bxdf: Bxdf::Diffuse(Diffuse {
-                    reflectance: scale.max(Vec3::ZERO),
-                }),
-                two_sided: *two_sided,
-                texture: Some(Tex::new(texture, attribute)),
-            },
-            other => Material::from(other),
+            Bxdf::Diffuse(_)
+            | Bxdf::RoughDielectric(_)
+            | Bxdf::Plastic(_)
+            | Bxdf::RoughPlastic(_) => false,
         }
     }
 }
@@ -198,155 +163,238 @@ fn usable_ior(ior: f32) -> f32 {
 /// Roughness below which a microfacet model is drawn as its smooth (delta) limit.
 const SMOOTH_ALPHA: f32 = 1e-4;
 
-impl From<&MaterialDesc> for Material {
-    /// The material for a description.
-    fn from(d: &MaterialDesc) -> Self {
-        match *d {
-            MaterialDesc::Diffuse {
-                reflectance,
-                two_sided,
-            } => Material::new(
-                Bxdf::Diffuse(Diffuse {
-                    reflectance: reflectance.clamp(Vec3::ZERO, Vec3::ONE),
-                }),
-                two_sided,
-            ),
-            MaterialDesc::TexturedDiffuse {
-                ref texture,
-                scale,
-                two_sided,
-            } => Material {
-                bxdf: Bxdf::Diffuse(Diffuse {
-                    reflectance: scale.max(Vec3::ZERO),
-                }),
-                two_sided,
-                texture: Some(Tex::from_desc(texture)),
-            },
-            MaterialDesc::Mirror { reflectance } => {
-                Material::new(Bxdf::Mirror(Mirror { reflectance }), true)
-            }
-            MaterialDesc::Glass {
-                reflectance,
-                transmittance,
-                roughness,
-                ior,
-                distribution,
-                fresnel,
-            } => {
-                let eta = usable_ior(ior);
-                let bxdf = if roughness > SMOOTH_ALPHA {
-                    Bxdf::RoughDielectric(RoughDielectric {
-                        eta,
-                        distribution: Microfacet::new(distribution, roughness),
-                        reflectance,
-                        transmittance,
-                    })
-                } else {
-                    Bxdf::Dielectric(SmoothDielectric {
-                        eta,
-                        reflectance,
-                        transmittance,
-                        fresnel,
-                    })
-                };
-                // The side matters: inside and outside differ.
-                Material::new(bxdf, false)
-            }
-            MaterialDesc::Conductor {
-                alpha,
-                eta,
-                k,
-                distribution,
-            } => Material::new(
-                Bxdf::Conductor(Conductor {
-                    eta,
-                    k,
-                    distribution: (alpha > SMOOTH_ALPHA)
-                        .then(|| Microfacet::new(distribution, alpha)),
-                }),
-                true,
-            ),
-            MaterialDesc::Plastic {
-                diffuse,
-                ior,
-                nonlinear,
-            } => Material::new(
-                Bxdf::Plastic(Plastic::new(
-                    diffuse.clamp(Vec3::ZERO, Vec3::ONE),
-                    usable_ior(ior),
-                    nonlinear,
-                )),
-                false,
-            ),
-        }
+/// Most lobes a [`Bsdf`] holds (a mask or blend of blends deeper than this keeps the first).
+pub const MAX_LOBES: usize = 4;
+
+/// One lobe of a [`Bsdf`]: a BxDF in its shading frame, with its mixture weight.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lobe {
+    /// Mixture weight (its share of f, and the probability of sampling it).
+    pub weight: f32,
+    /// The shading frame.
+    pub frame: Frame,
+    /// The model.
+    pub bxdf: Bxdf,
+    /// For a normal-mapped lobe, the surface's own shading normal: light that arrives on the
+    /// other side of it than of the lobe's normal counts nothing (Mitsuba's rule against
+    /// light leaking through a perturbed normal).
+    pub guard: Option<Vec3>,
+}
+
+impl Lobe {
+    /// Whether `wi` passes the lobe's guard.
+    #[inline]
+    fn admits(&self, wi: Vec3) -> bool {
+        self.guard
+            .is_none_or(|n| wi.dot(n) * wi.dot(self.frame.n) > 0.0)
     }
 }
 
-/// A material at a surface point: the BxDF and the shading frame.
+/// A material at a surface point: a weighted mixture of lobes and a pass-through weight (a
+/// mask's transparency: light continues along its direction). The weights and the
+/// pass-through sum to one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bsdf {
-    frame: Frame,
-    bxdf: Bxdf,
+    first: Lobe,
+    rest: [Option<Lobe>; MAX_LOBES - 1],
+    /// Weight of passing straight through.
+    null: f32,
 }
 
 impl Bsdf {
     /// The BSDF of `material` at a point with unit shading normal `n`, seen from direction
-    /// `wo`. A two-sided material is evaluated on the side `wo` is on; a one-sided one keeps
-    /// its normal, and reflects nothing when seen from behind.
+    /// `wo` (no texture coordinates: textures read at (0, 0)). A two-sided material is
+    /// evaluated on the side `wo` is on; a one-sided one keeps its normal, and reflects
+    /// nothing when seen from behind.
     pub fn new(material: &Material, n: Vec3, wo: Vec3) -> Self {
-        Self::from_bxdf(material.bxdf, material.two_sided, n, wo)
+        material.bsdf(&ShadingPoint::at(n), wo)
     }
 
     /// The BSDF of `bxdf` at a point with unit shading normal `n` seen from `wo`.
     pub fn from_bxdf(bxdf: Bxdf, two_sided: bool, n: Vec3, wo: Vec3) -> Self {
         let n = if two_sided && wo.dot(n) < 0.0 { -n } else { n };
+        Bsdf::single(Frame::from_normal(n), bxdf)
+    }
+
+    /// One lobe of weight one.
+    pub(crate) fn single(frame: Frame, bxdf: Bxdf) -> Self {
         Bsdf {
-            frame: Frame::from_normal(n),
-            bxdf,
+            first: Lobe {
+                weight: 1.0,
+                frame,
+                bxdf,
+                guard: None,
+            },
+            rest: [None; MAX_LOBES - 1],
+            null: 0.0,
         }
     }
 
-    /// The shading normal (flipped towards `wo` for two-sided materials).
+    /// A mixture of `lobes` (at least one; at most [`MAX_LOBES`]) and pass-through weight
+    /// `null`.
+    pub(crate) fn mixture(lobes: &[Lobe], null: f32) -> Self {
+        let mut rest = [None; MAX_LOBES - 1];
+        for (slot, lobe) in rest.iter_mut().zip(lobes.iter().skip(1)) {
+            *slot = Some(*lobe);
+        }
+        Bsdf {
+            first: lobes[0],
+            rest,
+            null,
+        }
+    }
+
+    /// Every lobe.
+    #[inline]
+    pub fn lobes(&self) -> impl Iterator<Item = &Lobe> {
+        std::iter::once(&self.first).chain(self.rest.iter().flatten())
+    }
+
+    /// Whether the BSDF is a single lobe of weight one (the common case).
+    #[inline]
+    fn is_single(&self) -> bool {
+        self.rest[0].is_none() && self.null == 0.0
+    }
+
+    /// The weight of passing straight through.
+    pub fn pass_through(&self) -> f32 {
+        self.null
+    }
+
+    /// The first lobe's shading normal (flipped towards `wo` for two-sided materials).
     pub fn normal(&self) -> Vec3 {
-        self.frame.n
+        self.first.frame.n
     }
 
-    /// The local shading frame.
+    /// The first lobe's local shading frame.
     pub fn frame(&self) -> &Frame {
-        &self.frame
+        &self.first.frame
     }
 
-    /// The reflectance model.
+    /// The first lobe's reflectance model.
     pub fn bxdf(&self) -> &Bxdf {
-        &self.bxdf
+        &self.first.bxdf
     }
 
-    /// f(wo, wi), world-space directions.
+    /// f(wo, wi), world-space directions (the mixture; without foreshortening, which each
+    /// lobe measures against its own normal: see [`Bsdf::f_cos`]).
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.bxdf
-            .f(self.frame.to_local(wo), self.frame.to_local(wi))
+        if self.is_single() && self.first.guard.is_none() {
+            let l = &self.first;
+            return l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi));
+        }
+        self.lobes()
+            .filter(|l| l.admits(wi))
+            .map(|l| l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi)) * l.weight)
+            .sum()
+    }
+
+    /// f(wo, wi) |cos θi|, each lobe's cosine to its own shading normal: what light arriving
+    /// along `wi` contributes towards `wo`.
+    #[inline]
+    pub fn f_cos(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if self.is_single() && self.first.guard.is_none() {
+            let l = &self.first;
+            return l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi)) * wi.dot(l.frame.n).abs();
+        }
+        self.lobes()
+            .filter(|l| l.admits(wi))
+            .map(|l| {
+                l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi))
+                    * (l.weight * wi.dot(l.frame.n).abs())
+            })
+            .sum()
     }
 
     /// Whether every lobe is a delta distribution (light sampling can never help).
     pub fn is_delta(&self) -> bool {
-        self.bxdf.is_delta()
+        self.lobes().all(|l| l.bxdf.is_delta() || l.weight <= 0.0)
     }
 
-    /// Samples wi given wo (world space): `uc` chooses a lobe, `u` the direction in it.
+    /// Samples wi given wo (world space): `uc` chooses a lobe (or passing through), `u` the
+    /// direction in it.
     pub fn sample_f(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        let s = self.bxdf.sample(self.frame.to_local(wo), uc, u)?;
-        (s.pdf > 0.0 && s.f.is_finite()).then(|| BsdfSample {
-            f: s.f,
-            wi: self.frame.to_world(s.wi),
-            pdf: s.pdf,
-            delta: s.delta,
+        if self.is_single() {
+            let l = &self.first;
+            let s = l.bxdf.sample(l.frame.to_local(wo), uc, u)?;
+            let wi = l.frame.to_world(s.wi);
+            if !l.admits(wi) {
+                return None;
+            }
+            return (s.pdf > 0.0 && s.f.is_finite()).then(|| BsdfSample {
+                f: s.f,
+                wi,
+                pdf: s.pdf,
+                delta: s.delta,
+                cos: wi.dot(l.frame.n).abs(),
+            });
+        }
+        // Choose a lobe by weight, and reuse the rest of `uc` within it.
+        let mut acc = 0.0;
+        let mut chosen = None;
+        for l in self.lobes() {
+            if l.weight > 0.0 && uc < acc + l.weight {
+                chosen = Some((l, ((uc - acc) / l.weight).clamp(0.0, 1.0 - f32::EPSILON)));
+                break;
+            }
+            acc += l.weight;
+        }
+        let Some((l, uc)) = chosen else {
+            // Straight through: f cos / pdf = null / null = 1.
+            if self.null <= 0.0 {
+                return None;
+            }
+            let c = wo.dot(self.first.frame.n).abs().max(1e-6);
+            return Some(BsdfSample {
+                f: Rgb::splat(self.null / c),
+                wi: -wo,
+                pdf: self.null,
+                delta: true,
+                cos: c,
+            });
+        };
+        let s = l.bxdf.sample(l.frame.to_local(wo), uc, u)?;
+        let wi = l.frame.to_world(s.wi);
+        if !l.admits(wi)
+            || s.pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+            || !s.f.is_finite()
+        {
+            return None;
+        }
+        let cos = wi.dot(l.frame.n).abs();
+        if s.delta {
+            return Some(BsdfSample {
+                f: s.f * l.weight,
+                wi,
+                pdf: s.pdf * l.weight,
+                delta: true,
+                cos,
+            });
+        }
+        let pdf = self.pdf(wo, wi);
+        if pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || cos <= 0.0 {
+            return None;
+        }
+        let f = self.f_cos(wo, wi) / cos;
+        f.is_finite().then_some(BsdfSample {
+            f,
+            wi,
+            pdf,
+            delta: false,
+            cos,
         })
     }
 
-    /// Density of [`Bsdf::sample_f`] choosing `wi` (world space).
+    /// Density of [`Bsdf::sample_f`] choosing `wi` (world space; its non-delta part).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.bxdf
-            .pdf(self.frame.to_local(wo), self.frame.to_local(wi))
+        if self.is_single() && self.first.guard.is_none() {
+            let l = &self.first;
+            return l.bxdf.pdf(l.frame.to_local(wo), l.frame.to_local(wi));
+        }
+        self.lobes()
+            .filter(|l| l.admits(wi))
+            .map(|l| l.weight * l.bxdf.pdf(l.frame.to_local(wo), l.frame.to_local(wi)))
+            .sum()
     }
 }
 

@@ -137,7 +137,7 @@ impl Integrator for DirectIntegrator {
                         (w, cosine_hemisphere_pdf(w.z))
                     };
                     let wi = frame.to_world(w);
-                    let f_cos = bsdf.f(wo, wi) * wi.dot(si.ns).abs();
+                    let f_cos = bsdf.f_cos(wo, wi);
                     sum += Self::gather(scene, &si, wi, f_cos, pdf, stats).0;
                 }
                 DirectStrategy::Light | DirectStrategy::Mis => {
@@ -180,7 +180,7 @@ impl DirectIntegrator {
             }
             if i < k {
                 if let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) {
-                    let f_cos = bs.f * bs.wi.dot(si.ns).abs();
+                    let f_cos = bs.f * bs.cos;
                     let (c, pdf_light) = Self::gather(scene, si, bs.wi, f_cos, bs.pdf, stats);
                     if let Some(pdf_light) = pdf_light {
                         let w = if bs.delta || m == 0 {

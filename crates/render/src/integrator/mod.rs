@@ -225,7 +225,7 @@ pub(crate) fn sample_light(
     if ls.pdf <= 0.0 || ls.li.max_element() <= 0.0 {
         return Rgb::ZERO;
     }
-    let f = bsdf.f(wo, ls.wi) * ls.wi.dot(si.ns).abs();
+    let f = bsdf.f_cos(wo, ls.wi);
     if f.max_element() <= 0.0 {
         return Rgb::ZERO;
     }

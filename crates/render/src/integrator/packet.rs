@@ -14,7 +14,7 @@
 use super::path::{PathIntegrator, PathState};
 use super::{camera_ray, sample_light, PathStats, SampleRef};
 use crate::accel::RayLanes;
-use crate::bsdf::{Bxdf, Material};
+use crate::bsdf::Material;
 use crate::desc::Rgb;
 use crate::geometry::{Ray, RAY_EPSILON, SHADOW_RAY_END};
 use crate::lanes::{F8, M8, V8, W};
@@ -191,10 +191,7 @@ fn scatter(a: &ScatterIn, out: &mut ScatterOut) {
 /// The reflectance and sidedness of a plain (untextured) Lambertian material.
 #[inline]
 fn lambertian(m: &Material) -> Option<(Rgb, bool)> {
-    match (&m.bxdf, &m.texture) {
-        (Bxdf::Diffuse(d), None) => Some((d.reflectance, m.two_sided)),
-        _ => None,
-    }
+    m.as_lambertian()
 }
 
 /// One lane's path: its sample's tag and where the path stands.

@@ -203,7 +203,7 @@ impl PathIntegrator {
         let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) else {
             return false;
         };
-        st.beta *= bs.f * (bs.wi.dot(si.ns).abs() / bs.pdf);
+        st.beta *= bs.f * (bs.cos / bs.pdf);
         if st.beta.max_element() <= 0.0 || !st.beta.is_finite() {
             return false;
         }

@@ -55,6 +55,22 @@ fn distribution(ctx: &Ctx, b: Obj) -> Result<NormalDistribution, Error> {
     })
 }
 
+/// The one nested BSDF of `b`.
+fn one_nested<'t>(ctx: &Ctx<'t>, b: Obj) -> Result<Obj<'t>, Error> {
+    let n = nested(ctx, b)?;
+    match n.as_slice() {
+        [one] => Ok(*one),
+        _ => Err(ctx.error(
+            b.loc,
+            format!(
+                "{} needs exactly one nested <bsdf>, found {}",
+                ctx.what(b),
+                n.len()
+            ),
+        )),
+    }
+}
+
 /// The nested BSDFs of `b`.
 fn nested<'t>(ctx: &Ctx<'t>, b: Obj) -> Result<Vec<Obj<'t>>, Error> {
     Ok(ctx
@@ -107,13 +123,10 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
             let inner = nested(ctx, b)?;
             match inner.as_slice() {
                 [one] => two_sided(ctx.material_desc(*one)?),
-                [front, _back] => {
-                    ctx.warn(
-                        b.loc,
-                        "<bsdf type=\"twosided\"> with two BSDFs: the back side is drawn with the front's",
-                    );
-                    two_sided(ctx.material_desc(*front)?)
-                }
+                [front, back] => MaterialDesc::TwoSided {
+                    front: Box::new(ctx.material_desc(*front)?),
+                    back: Box::new(ctx.material_desc(*back)?),
+                },
                 _ => {
                     return Err(ctx.error(
                         b.loc,
@@ -123,6 +136,65 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
                         ),
                     ))
                 }
+            }
+        }
+        "mask" => {
+            let inner = one_nested(ctx, b)?;
+            MaterialDesc::Mask {
+                opacity: ctx.texture(b, "opacity", Vec3::splat(0.5), SpectrumKind::Unbounded)?,
+                inner: Box::new(ctx.material_desc(inner)?),
+            }
+        }
+        "blendbsdf" => {
+            let inner = nested(ctx, b)?;
+            let [first, second] = inner.as_slice() else {
+                return Err(ctx.error(
+                    b.loc,
+                    format!(
+                        "<bsdf type=\"blendbsdf\"> needs two nested <bsdf>s, found {}",
+                        inner.len()
+                    ),
+                ));
+            };
+            MaterialDesc::Blend {
+                weight: ctx.texture(b, "weight", Vec3::splat(0.5), SpectrumKind::Unbounded)?,
+                first: Box::new(ctx.material_desc(*first)?),
+                second: Box::new(ctx.material_desc(*second)?),
+            }
+        }
+        "normalmap" => {
+            let inner = one_nested(ctx, b)?;
+            let normals = ctx
+                .opt_texture(b, "normalmap", SpectrumKind::Unbounded)?
+                .ok_or_else(|| {
+                    ctx.error(
+                        b.loc,
+                        "<bsdf type=\"normalmap\"> needs a 'normalmap' texture",
+                    )
+                })?;
+            MaterialDesc::NormalMap {
+                normals,
+                inner: Box::new(ctx.material_desc(inner)?),
+            }
+        }
+        "bumpmap" => {
+            let inner = one_nested(ctx, b)?;
+            // The height texture is the nested texture, whatever its name.
+            let textures = ctx.children(b, "texture")?;
+            let [(_, t)] = textures.as_slice() else {
+                return Err(ctx.error(
+                    b.loc,
+                    format!(
+                        "<bsdf type=\"bumpmap\"> needs one nested <texture>, found {}",
+                        textures.len()
+                    ),
+                ));
+            };
+            let height = super::textures::texture(ctx, *t, SpectrumKind::Unbounded)?;
+            MaterialDesc::BumpMap {
+                height,
+                scale: ctx.float(b, "scale", 1.0)? as f32,
+                inner: Box::new(ctx.material_desc(inner)?),
             }
         }
         "conductor" | "roughconductor" => {
@@ -142,31 +214,73 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
             }
             let eta = ctx.color(b, "eta", eta, SpectrumKind::Unbounded)?;
             let k = ctx.color(b, "k", k, SpectrumKind::Unbounded)?;
-            let specular = ctx.color(
+            let specular = ctx.texture(
                 b,
                 "specular_reflectance",
                 Vec3::ONE,
                 SpectrumKind::Reflectance,
             )?;
-            if specular != Vec3::ONE {
-                ctx.warn(
-                    b.loc,
-                    format!(
-                        "{}: specular_reflectance is not supported yet; using 1",
-                        ctx.what(b)
-                    ),
-                );
-            }
-            let (alpha, distribution) = if b.plugin == "conductor" {
-                (0.0, NormalDistribution::Beckmann)
+            if b.plugin == "conductor" {
+                MaterialDesc::RoughConductor {
+                    alpha_u: TextureDesc::value(0.0),
+                    alpha_v: TextureDesc::value(0.0),
+                    eta,
+                    k,
+                    specular,
+                    distribution: NormalDistribution::Beckmann,
+                }
             } else {
-                (alpha(ctx, b)?, distribution(ctx, b)?)
+                let distribution = distribution(ctx, b)?;
+                let (alpha_u, alpha_v) = if ctx.has(b, "alpha_u") || ctx.has(b, "alpha_v") {
+                    if ctx.has(b, "alpha") {
+                        return Err(ctx.error(
+                            b.loc,
+                            format!("{}: give either alpha or alpha_u and alpha_v", ctx.what(b)),
+                        ));
+                    }
+                    (
+                        ctx.texture(b, "alpha_u", Vec3::splat(0.1), SpectrumKind::Unbounded)?,
+                        ctx.texture(b, "alpha_v", Vec3::splat(0.1), SpectrumKind::Unbounded)?,
+                    )
+                } else {
+                    let a = ctx.texture(b, "alpha", Vec3::splat(0.1), SpectrumKind::Unbounded)?;
+                    (a.clone(), a)
+                };
+                MaterialDesc::RoughConductor {
+                    alpha_u,
+                    alpha_v,
+                    eta,
+                    k,
+                    specular,
+                    distribution,
+                }
+            }
+        }
+        "roughplastic" => {
+            let alpha = ctx.texture(b, "alpha", Vec3::splat(0.1), SpectrumKind::Unbounded)?;
+            let Some(alpha) = alpha.as_constant() else {
+                return Err(ctx.error(
+                    ctx.loc_of(b, "alpha"),
+                    "<bsdf type=\"roughplastic\">: alpha must be a number (Mitsuba's roughplastic takes no roughness texture)",
+                ));
             };
-            MaterialDesc::Conductor {
-                alpha,
-                eta,
-                k,
-                distribution,
+            MaterialDesc::RoughPlastic {
+                diffuse: ctx.texture(
+                    b,
+                    "diffuse_reflectance",
+                    Vec3::splat(0.5),
+                    SpectrumKind::Reflectance,
+                )?,
+                specular: ctx.color(
+                    b,
+                    "specular_reflectance",
+                    Vec3::ONE,
+                    SpectrumKind::Reflectance,
+                )?,
+                alpha: alpha.x,
+                ior: relative_ior(ctx, b, 1.49)?,
+                nonlinear: ctx.boolean(b, "nonlinear", false)?,
+                distribution: distribution(ctx, b)?,
             }
         }
         "dielectric" | "roughdielectric" | "thindielectric" => {

@@ -1,0 +1,554 @@
+//! Materials: what a scene's [`MaterialDesc`] becomes, and the [`Bsdf`] it has at a surface
+//! point. A material is a tree: leaves are reflectance models whose parameters may be
+//! textured ([`Model`]); inner nodes mask (part of the light passes through), blend two
+//! materials, put different materials on the two sides, or perturb the shading normal by a
+//! normal map or a bump map. At a point the tree becomes a weighted mixture of lobes, each in
+//! its own shading frame.
+
+use super::rough_plastic::CoatTable;
+use super::*;
+use crate::desc::{MaterialDesc, NormalDistribution, Rgb};
+use crate::texture::{Tex, TexPoint};
+
+/// Where a material is evaluated.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingPoint<'a> {
+    /// Unit shading normal.
+    pub n: Vec3,
+    /// ∂p/∂u and ∂p/∂v (pathlab's v), zero when unknown: the tangents anisotropic models,
+    /// normal maps and bump maps need.
+    pub dpdu: Vec3,
+    /// See `dpdu`.
+    pub dpdv: Vec3,
+    /// Unit geometric normal (bump maps keep their normal on its side).
+    pub ng: Vec3,
+    /// Where textures are read.
+    pub tex: TexPoint<'a>,
+}
+
+impl ShadingPoint<'static> {
+    /// A point with normal `n` only (textures read at (0, 0), no tangents).
+    pub fn at(n: Vec3) -> Self {
+        ShadingPoint {
+            n,
+            dpdu: Vec3::ZERO,
+            dpdv: Vec3::ZERO,
+            ng: n,
+            tex: TexPoint::uv(Vec2::ZERO),
+        }
+    }
+}
+
+/// A reflectance model with its (possibly textured) parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Model {
+    /// A model whose parameters are the same everywhere.
+    Fixed(Bxdf),
+    /// Lambertian with albedo `scale` × texture.
+    Diffuse {
+        /// The albedo texture.
+        texture: Tex,
+        /// Its scale.
+        scale: Rgb,
+    },
+    /// A rough conductor with textured, possibly anisotropic roughness.
+    Conductor {
+        /// Roughness along the u tangent.
+        alpha_u: Tex,
+        /// Roughness along the v tangent.
+        alpha_v: Tex,
+        /// Complex index, real part.
+        eta: Rgb,
+        /// Complex index, imaginary part.
+        k: Rgb,
+        /// Reflectance scale.
+        specular: Tex,
+        /// The distribution.
+        kind: NormalDistribution,
+    },
+    /// Rough plastic with a textured base.
+    RoughPlastic {
+        /// The base's albedo.
+        diffuse: Tex,
+        /// The coat's reflectance scale.
+        specular: Rgb,
+        /// The coat's relative index.
+        eta: f32,
+        /// The coat's roughness.
+        distribution: Microfacet,
+        /// Internal reflections tinted by the base.
+        nonlinear: bool,
+        /// The coat's transmittance.
+        table: &'static CoatTable,
+    },
+}
+
+/// A leaf of the material tree: a model and whether its back side reflects too.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Leaf {
+    /// The model.
+    pub model: Model,
+    /// Whether the back side reflects as the front.
+    pub two_sided: bool,
+}
+
+/// A material (see the module's description).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Material {
+    /// A reflectance model.
+    Leaf(Leaf),
+    /// Opacity (a number texture) and the material where opaque; the rest passes through.
+    Mask(Tex, Box<Material>),
+    /// (1 - w) × first + w × second.
+    Blend(Tex, Box<(Material, Material)>),
+    /// Front and back materials.
+    TwoSided(Box<(Material, Material)>),
+    /// A tangent-space normal map over a material.
+    NormalMap(Tex, Box<Material>),
+    /// A height field (and its scale) over a material.
+    BumpMap(Tex, f32, Box<Material>),
+}
+
+/// The frame at a node of the tree: the shading normal (perhaps perturbed), the tangents,
+/// and the surface's own shading normal once a map has moved it.
+#[derive(Clone, Copy)]
+struct Local {
+    n: Vec3,
+    dpdu: Vec3,
+    dpdv: Vec3,
+    guard: Option<Vec3>,
+}
+
+/// The frame with normal `n` and first axis `dpdu` made orthogonal to it (Mitsuba's shading
+/// frame); an arbitrary tangent where `dpdu` is zero or along `n`.
+fn tangent_frame(n: Vec3, dpdu: Vec3) -> Frame {
+    match (dpdu - n * n.dot(dpdu)).try_normalize() {
+        Some(s) => Frame {
+            s,
+            t: n.cross(s),
+            n,
+        },
+        None => Frame::from_normal(n),
+    }
+}
+
+impl Material {
+    /// A material of one model without textures.
+    pub fn new(bxdf: Bxdf, two_sided: bool) -> Self {
+        Material::Leaf(Leaf {
+            model: Model::Fixed(bxdf),
+            two_sided,
+        })
+    }
+
+    /// The reflectance and sidedness of a plain (untextured) Lambertian material.
+    #[inline]
+    pub fn as_lambertian(&self) -> Option<(Rgb, bool)> {
+        match self {
+            Material::Leaf(Leaf {
+                model: Model::Fixed(Bxdf::Diffuse(d)),
+                two_sided,
+            }) => Some((d.reflectance, *two_sided)),
+            _ => None,
+        }
+    }
+
+    /// Whether evaluating the material needs the surface's tangents.
+    pub fn needs_tangents(&self) -> bool {
+        match self {
+            Material::Leaf(l) => matches!(l.model, Model::Conductor { .. }),
+            Material::Mask(_, m) => m.needs_tangents(),
+            Material::Blend(_, ab) | Material::TwoSided(ab) => {
+                ab.0.needs_tangents() || ab.1.needs_tangents()
+            }
+            Material::NormalMap(..) | Material::BumpMap(..) => true,
+        }
+    }
+
+    /// The BSDF at `p` seen from `wo`.
+    #[inline]
+    pub fn bsdf(&self, p: &ShadingPoint, wo: Vec3) -> Bsdf {
+        if let Material::Leaf(Leaf {
+            model: Model::Fixed(bxdf),
+            two_sided,
+        }) = self
+        {
+            return Bsdf::from_bxdf(*bxdf, *two_sided, p.n, wo);
+        }
+        self.bsdf_general(p, wo)
+    }
+
+    #[inline(never)]
+    fn bsdf_general(&self, p: &ShadingPoint, wo: Vec3) -> Bsdf {
+        let mut lobes: Vec<Lobe> = Vec::with_capacity(2);
+        let mut null = 0.0;
+        let local = Local {
+            n: p.n,
+            dpdu: p.dpdu,
+            dpdv: p.dpdv,
+            guard: None,
+        };
+        self.collect(p, &local, wo, 1.0, &mut lobes, &mut null);
+        lobes.retain(|l| l.weight > 0.0);
+        lobes.truncate(MAX_LOBES);
+        if lobes.is_empty() {
+            // Nothing but passing through (or nothing at all): a black lobe holds the frame.
+            lobes.push(Lobe {
+                weight: 0.0,
+                frame: Frame::from_normal(p.n),
+                bxdf: Bxdf::Diffuse(Diffuse {
+                    reflectance: Rgb::ZERO,
+                }),
+                guard: None,
+            });
+        }
+        Bsdf::mixture(&lobes, null)
+    }
+
+    fn collect(
+        &self,
+        p: &ShadingPoint,
+        at: &Local,
+        wo: Vec3,
+        weight: f32,
+        lobes: &mut Vec<Lobe>,
+        null: &mut f32,
+    ) {
+        if weight <= 0.0 {
+            return;
+        }
+        match self {
+            Material::Leaf(leaf) => {
+                let n = if leaf.two_sided && wo.dot(at.n) < 0.0 {
+                    -at.n
+                } else {
+                    at.n
+                };
+                let (bxdf, anisotropic) = leaf.model.bxdf(&p.tex);
+                let frame = if anisotropic || at.guard.is_some() {
+                    let mut f = tangent_frame(at.n, at.dpdu);
+                    if n != at.n {
+                        // The back side: Mitsuba mirrors the local z only.
+                        f.n = -f.n;
+                    }
+                    f
+                } else {
+                    Frame::from_normal(n)
+                };
+                lobes.push(Lobe {
+                    weight,
+                    frame,
+                    bxdf,
+                    guard: at.guard,
+                });
+            }
+            Material::Mask(opacity, inner) => {
+                let a = opacity.eval_float(&p.tex).clamp(0.0, 1.0);
+                inner.collect(p, at, wo, weight * a, lobes, null);
+                *null += weight * (1.0 - a);
+            }
+            Material::Blend(w, ab) => {
+                let w = w.eval_float(&p.tex).clamp(0.0, 1.0);
+                ab.0.collect(p, at, wo, weight * (1.0 - w), lobes, null);
+                ab.1.collect(p, at, wo, weight * w, lobes, null);
+            }
+            Material::TwoSided(ab) => {
+                if wo.dot(at.n) > 0.0 {
+                    ab.0.collect(p, at, wo, weight, lobes, null);
+                } else {
+                    let flipped = Local { n: -at.n, ..*at };
+                    ab.1.collect(p, &flipped, wo, weight, lobes, null);
+                }
+            }
+            Material::NormalMap(map, inner) => {
+                let frame = tangent_frame(at.n, at.dpdu);
+                let c = map.eval(&p.tex) * 2.0 - Rgb::ONE;
+                let n = frame.to_world(c).try_normalize().unwrap_or(at.n);
+                let s = (at.dpdu - n * n.dot(at.dpdu))
+                    .try_normalize()
+                    .unwrap_or(frame.s);
+                let perturbed = Local {
+                    n,
+                    dpdu: s,
+                    dpdv: n.cross(s),
+                    guard: Some(at.guard.unwrap_or(at.n)),
+                };
+                inner.collect(p, &perturbed, wo, weight, lobes, null);
+            }
+            Material::BumpMap(height, scale, inner) => {
+                // Mitsuba's bumpmap: the tangents displaced by the height's gradient (its
+                // v grows the other way: pathlab's ∂/∂v and ∂p/∂v are its negatives).
+                let g = height.grad_float(&p.tex) * *scale;
+                let dpdu = at.dpdu + at.n * (g.x - at.n.dot(at.dpdu));
+                let dpdv = at.dpdv + at.n * (g.y - at.n.dot(at.dpdv));
+                let mut n = dpdu.cross(dpdv).try_normalize().unwrap_or(at.n);
+                if n.dot(p.ng) < 0.0 {
+                    n = -n;
+                }
+                let perturbed = Local {
+                    n,
+                    dpdu,
+                    dpdv,
+                    guard: Some(at.guard.unwrap_or(at.n)),
+                };
+                inner.collect(p, &perturbed, wo, weight, lobes, null);
+            }
+        }
+    }
+
+    /// The material of a description; `attribute` gives the scene's table index of a named
+    /// mesh attribute its textures read.
+    pub fn from_desc(d: &MaterialDesc, attribute: &mut dyn FnMut(&str) -> u32) -> Self {
+        let mut tex = |t: &crate::desc::TextureDesc| Tex::new(t, attribute);
+        match d {
+            MaterialDesc::Diffuse {
+                reflectance,
+                two_sided,
+            } => Material::new(
+                Bxdf::Diffuse(Diffuse {
+                    reflectance: reflectance.clamp(Vec3::ZERO, Vec3::ONE),
+                }),
+                *two_sided,
+            ),
+            MaterialDesc::TexturedDiffuse {
+                texture,
+                scale,
+                two_sided,
+            } => Material::Leaf(Leaf {
+                model: Model::Diffuse {
+                    texture: tex(texture),
+                    scale: scale.max(Vec3::ZERO),
+                },
+                two_sided: *two_sided,
+            }),
+            MaterialDesc::Mirror { reflectance } => Material::new(
+                Bxdf::Mirror(Mirror {
+                    reflectance: *reflectance,
+                }),
+                true,
+            ),
+            &MaterialDesc::Glass {
+                reflectance,
+                transmittance,
+                roughness,
+                ior,
+                distribution,
+                fresnel,
+            } => {
+                let eta = usable_ior(ior);
+                let bxdf = if roughness > SMOOTH_ALPHA {
+                    Bxdf::RoughDielectric(RoughDielectric {
+                        eta,
+                        distribution: Microfacet::new(distribution, roughness),
+                        reflectance,
+                        transmittance,
+                    })
+                } else {
+                    Bxdf::Dielectric(SmoothDielectric {
+                        eta,
+                        reflectance,
+                        transmittance,
+                        fresnel,
+                    })
+                };
+                // The side matters: inside and outside differ.
+                Material::new(bxdf, false)
+            }
+            &MaterialDesc::Conductor {
+                alpha,
+                eta,
+                k,
+                distribution,
+            } => Material::new(
+                Bxdf::Conductor(Conductor {
+                    eta,
+                    k,
+                    specular: Rgb::ONE,
+                    distribution: (alpha > SMOOTH_ALPHA)
+                        .then(|| Microfacet::new(distribution, alpha)),
+                }),
+                true,
+            ),
+            MaterialDesc::RoughConductor {
+                alpha_u,
+                alpha_v,
+                eta,
+                k,
+                specular,
+                distribution,
+            } if alpha_u.as_constant().is_some()
+                && alpha_u.as_constant() == alpha_v.as_constant()
+                && specular.as_constant().is_some() =>
+            {
+                let alpha = alpha_u.as_constant().unwrap_or_default().x;
+                Material::new(
+                    Bxdf::Conductor(Conductor {
+                        eta: *eta,
+                        k: *k,
+                        specular: specular.as_constant().unwrap_or(Rgb::ONE),
+                        distribution: (alpha > SMOOTH_ALPHA)
+                            .then(|| Microfacet::new(*distribution, alpha)),
+                    }),
+                    true,
+                )
+            }
+            MaterialDesc::RoughConductor {
+                alpha_u,
+                alpha_v,
+                eta,
+                k,
+                specular,
+                distribution,
+            } => Material::Leaf(Leaf {
+                model: Model::Conductor {
+                    alpha_u: tex(alpha_u),
+                    alpha_v: tex(alpha_v),
+                    eta: *eta,
+                    k: *k,
+                    specular: tex(specular),
+                    kind: *distribution,
+                },
+                two_sided: true,
+            }),
+            &MaterialDesc::Plastic {
+                diffuse,
+                ior,
+                nonlinear,
+            } => Material::new(
+                Bxdf::Plastic(Plastic::new(
+                    diffuse.clamp(Vec3::ZERO, Vec3::ONE),
+                    usable_ior(ior),
+                    nonlinear,
+                )),
+                false,
+            ),
+            MaterialDesc::RoughPlastic {
+                diffuse,
+                specular,
+                alpha,
+                ior,
+                nonlinear,
+                distribution,
+            } => {
+                let eta = usable_ior(*ior);
+                let m = Microfacet::new(*distribution, *alpha);
+                if let Some(d) = diffuse.as_constant() {
+                    return Material::new(
+                        Bxdf::RoughPlastic(RoughPlastic::new(
+                            d.clamp(Vec3::ZERO, Vec3::ONE),
+                            *specular,
+                            eta,
+                            m,
+                            *nonlinear,
+                        )),
+                        false,
+                    );
+                }
+                Material::Leaf(Leaf {
+                    model: Model::RoughPlastic {
+                        diffuse: tex(diffuse),
+                        specular: *specular,
+                        eta,
+                        distribution: m,
+                        nonlinear: *nonlinear,
+                        table: CoatTable::get(m, eta),
+                    },
+                    two_sided: false,
+                })
+            }
+            MaterialDesc::Mask { opacity, inner } => {
+                let o = tex(opacity);
+                Material::Mask(o, Box::new(Material::from_desc(inner, attribute)))
+            }
+            MaterialDesc::Blend {
+                weight,
+                first,
+                second,
+            } => {
+                let w = tex(weight);
+                let a = Material::from_desc(first, attribute);
+                let b = Material::from_desc(second, attribute);
+                Material::Blend(w, Box::new((a, b)))
+            }
+            MaterialDesc::TwoSided { front, back } => {
+                let a = Material::from_desc(front, attribute);
+                let b = Material::from_desc(back, attribute);
+                Material::TwoSided(Box::new((a, b)))
+            }
+            MaterialDesc::NormalMap { normals, inner } => {
+                let n = tex(normals);
+                Material::NormalMap(n, Box::new(Material::from_desc(inner, attribute)))
+            }
+            MaterialDesc::BumpMap {
+                height,
+                scale,
+                inner,
+            } => {
+                let h = tex(height);
+                Material::BumpMap(h, *scale, Box::new(Material::from_desc(inner, attribute)))
+            }
+        }
+    }
+}
+
+impl Model {
+    /// The model's BxDF at a point with textures read at `p`, and whether it is anisotropic
+    /// (its frame must follow the surface's tangent).
+    fn bxdf(&self, p: &TexPoint) -> (Bxdf, bool) {
+        match self {
+            Model::Fixed(b) => (*b, false),
+            Model::Diffuse { texture, scale } => (
+                Bxdf::Diffuse(Diffuse {
+                    reflectance: (*scale * texture.eval(p)).clamp(Vec3::ZERO, Vec3::ONE),
+                }),
+                false,
+            ),
+            Model::Conductor {
+                alpha_u,
+                alpha_v,
+                eta,
+                k,
+                specular,
+                kind,
+            } => {
+                let (au, av) = (alpha_u.eval_float(p), alpha_v.eval_float(p));
+                let distribution =
+                    (au.max(av) > SMOOTH_ALPHA).then(|| Microfacet::anisotropic(*kind, au, av));
+                (
+                    Bxdf::Conductor(Conductor {
+                        eta: *eta,
+                        k: *k,
+                        specular: specular.eval(p),
+                        distribution,
+                    }),
+                    au != av,
+                )
+            }
+            Model::RoughPlastic {
+                diffuse,
+                specular,
+                eta,
+                distribution,
+                nonlinear,
+                table,
+            } => (
+                Bxdf::RoughPlastic(RoughPlastic {
+                    diffuse: diffuse.eval(p).clamp(Vec3::ZERO, Vec3::ONE),
+                    specular: *specular,
+                    eta: *eta,
+                    distribution: *distribution,
+                    nonlinear: *nonlinear,
+                    table,
+                }),
+                false,
+            ),
+        }
+    }
+}
+
+impl From<&MaterialDesc> for Material {
+    /// The material for a description (mesh attributes read as zero).
+    fn from(d: &MaterialDesc) -> Self {
+        Material::from_desc(d, &mut |_| u32::MAX)
+    }
+}
