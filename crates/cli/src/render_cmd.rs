@@ -84,7 +84,7 @@ pub enum FresnelName {
 /// Raw command-line arguments of `pathlab render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The scene: a file (.dae, .obj, .ply) or a built-in scene's name (cornell-box).
+    /// The scene: a file (.xml Mitsuba 3, .dae, .obj, .ply) or a built-in scene's name (cornell-box).
     #[arg(default_value = "cornell-box")]
     pub scene: String,
     /// Samples per pixel (default: the scene file's, else 64).

@@ -279,6 +279,32 @@ mod tests {
     }
 
     #[test]
+    fn principal_point_offset_moves_the_window_as_mitsuba_does() {
+        // Mitsuba adds offset × film size to the film position before projecting: with an
+        // offset of (0.25, 0.1), pixel (x, y) sees what the centred camera sees at
+        // (x + 0.25 W, y + 0.1 H).
+        let desc = CameraDesc {
+            fov_degrees: 50.0,
+            ..Default::default()
+        };
+        let shifted = Camera::new(
+            &CameraDesc {
+                principal_point_offset: Vec2::new(0.25, 0.1),
+                ..desc
+            },
+            [200, 100],
+        );
+        let centred = Camera::new(&desc, [200, 100]);
+        for film in [Vec2::new(100.0, 50.0), Vec2::new(30.0, 80.0)] {
+            let a = shifted.generate_ray(film, Vec2::ZERO).d;
+            let b = centred
+                .generate_ray(film + Vec2::new(50.0, 10.0), Vec2::ZERO)
+                .d;
+            assert!((a - b).length() < 1e-5, "{a} vs {b}");
+        }
+    }
+
+    #[test]
     fn thin_lens_focuses() {
         let desc = CameraDesc {
             lens_radius: 0.5,

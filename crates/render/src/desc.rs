@@ -376,6 +376,16 @@ pub enum MaterialDesc {
         /// Fresnel reflectance of the smooth interface.
         fresnel: FresnelModel,
     },
+    /// A thin sheet of glass: reflection and straight-through transmission (Mitsuba's
+    /// `thindielectric`).
+    ThinGlass {
+        /// Reflectance scale.
+        reflectance: Rgb,
+        /// Transmittance scale.
+        transmittance: Rgb,
+        /// Index of refraction of the sheet relative to its surroundings.
+        ior: f32,
+    },
     /// A conductor: smooth (α = 0) or rough (microfacet model).
     Conductor {
         /// Roughness α of the normal distribution.
@@ -391,6 +401,8 @@ pub enum MaterialDesc {
     Plastic {
         /// Diffuse reflectance of the base.
         diffuse: Rgb,
+        /// Scale of the coat's reflection (1 is physical).
+        specular: Rgb,
         /// Index of refraction of the coat relative to outside.
         ior: f32,
         /// Whether internal reflections are tinted by the base.
@@ -444,6 +456,9 @@ pub enum MaterialDesc {
         /// The second material.
         second: Box<MaterialDesc>,
     },
+    /// Disney's principled BSDF (Mitsuba's `principled`, or `principledthin` for a thin
+    /// sheet).
+    Principled(Box<PrincipledDesc>),
     /// One material on the front side (the shading normal's), another on the back.
     TwoSided {
         /// Front side.
@@ -479,10 +494,13 @@ impl MaterialDesc {
             MaterialDesc::TexturedDiffuse { .. } => "textured diffuse",
             MaterialDesc::Mirror { .. } => "mirror",
             MaterialDesc::Glass { .. } => "glass",
+            MaterialDesc::ThinGlass { .. } => "thin glass",
             MaterialDesc::Conductor { .. } => "conductor",
             MaterialDesc::Plastic { .. } => "plastic",
             MaterialDesc::RoughConductor { .. } => "rough conductor",
             MaterialDesc::RoughPlastic { .. } => "rough plastic",
+            MaterialDesc::Principled(p) if p.thin => "principled thin",
+            MaterialDesc::Principled(_) => "principled",
             MaterialDesc::Mask { .. } => "mask",
             MaterialDesc::Blend { .. } => "blend",
             MaterialDesc::TwoSided { .. } => "two-sided",
@@ -490,6 +508,40 @@ impl MaterialDesc {
             MaterialDesc::BumpMap { .. } => "bump map",
         }
     }
+}
+
+/// The parameters of a principled material, each a texture (numbers read as luminance), with
+/// `Some` for the optional ones the scene gives (Mitsuba switches lobes on that way).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrincipledDesc {
+    /// Base colour.
+    pub base_color: TextureDesc,
+    /// Roughness.
+    pub roughness: TextureDesc,
+    /// Anisotropy.
+    pub anisotropic: Option<TextureDesc>,
+    /// Specular transmission.
+    pub spec_trans: Option<TextureDesc>,
+    /// Metalness (solid only).
+    pub metallic: Option<TextureDesc>,
+    /// Clear coat (solid only).
+    pub clearcoat: Option<TextureDesc>,
+    /// Clear coat glossiness (solid only).
+    pub clearcoat_gloss: TextureDesc,
+    /// Sheen.
+    pub sheen: Option<TextureDesc>,
+    /// Sheen tint.
+    pub sheen_tint: Option<TextureDesc>,
+    /// Specular tint.
+    pub spec_tint: Option<TextureDesc>,
+    /// Flatness.
+    pub flatness: Option<TextureDesc>,
+    /// Diffuse transmission, 0 to 2 (thin only).
+    pub diff_trans: Option<TextureDesc>,
+    /// Relative index of refraction (a texture for the thin sheet, a number for a solid).
+    pub eta: TextureDesc,
+    /// A thin sheet.
+    pub thin: bool,
 }
 
 /// A point light: radiance arriving from it at distance d is

@@ -224,3 +224,110 @@ proptest! {
         exercise_file("case.xml", &corrupt(xml, cut, &flips));
     }
 }
+
+/// A Mitsuba scene around one `.serialized` mesh, `case.serialized` next to it.
+const SERIALIZED_SCENE: &str = r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+    </sensor>
+    <emitter type="constant"/>
+    <shape type="serialized"><string name="filename" value="case.serialized"/></shape>
+</scene>"#;
+
+/// Mitsuba's `.serialized` rectangle from its test suite.
+fn serialized_rectangle() -> Vec<u8> {
+    std::fs::read(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/mitsuba-suite/tests/serialized/rectangle_normals_uv.serialized"),
+    )
+    .unwrap()
+}
+
+/// Loads the scene above with `mesh` as its serialized file, in a folder of its own for
+/// each test (`tag`): tests run in parallel.
+fn exercise_serialized(tag: &str, mesh: &[u8]) {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("corruption-{tag}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("case.serialized"), mesh).unwrap();
+    let scene = dir.join("scene.xml");
+    std::fs::write(&scene, SERIALIZED_SCENE).unwrap();
+    match pathlab_scene::load(scene.to_str().unwrap()) {
+        Ok(desc) => render_tiny(desc),
+        Err(e) => {
+            let message = e.to_string();
+            assert!(
+                message.contains("case.serialized"),
+                "the error does not name the mesh file: {message}"
+            );
+        }
+    }
+    assert_memory_bound();
+}
+
+/// The uncompressed body of a one-shape `.serialized` file (after its 4-byte header).
+fn inflate(bytes: &[u8]) -> Vec<u8> {
+    let mut body = Vec::new();
+    std::io::Read::read_to_end(&mut flate2::read::ZlibDecoder::new(&bytes[4..]), &mut body)
+        .unwrap();
+    body
+}
+
+fn deflate(header: &[u8], body: &[u8]) -> Vec<u8> {
+    let mut enc = flate2::write::ZlibEncoder::new(header.to_vec(), flate2::Compression::default());
+    std::io::Write::write_all(&mut enc, body).unwrap();
+    enc.finish().unwrap()
+}
+
+#[test]
+fn the_serialized_rectangle_loads_and_renders() {
+    let bytes = serialized_rectangle();
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption-serialized-ok");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("case.serialized"), &bytes).unwrap();
+    std::fs::write(dir.join("scene.xml"), SERIALIZED_SCENE).unwrap();
+    let desc = pathlab_scene::load(dir.join("scene.xml").to_str().unwrap()).unwrap();
+    assert_eq!(desc.meshes.len(), 1);
+    assert_eq!(desc.meshes[0].indices.len(), 6);
+    // Inflating and deflating again keeps the mesh: the body-corruption cases start from it.
+    let again = deflate(&bytes[..4], &inflate(&bytes));
+    std::fs::write(dir.join("case.serialized"), &again).unwrap();
+    let desc2 = pathlab_scene::load(dir.join("scene.xml").to_str().unwrap()).unwrap();
+    assert_eq!(desc2.meshes[0].positions, desc.meshes[0].positions);
+}
+
+#[test]
+fn serialized_counts_are_not_trusted() {
+    // Version 4 body: flags (u32), the shape's name ending in a zero byte, then the vertex and
+    // triangle counts (u64 each).
+    let bytes = serialized_rectangle();
+    let body = inflate(&bytes);
+    let name_end = 4 + body[4..].iter().position(|&b| b == 0).unwrap();
+    let counts = name_end + 1;
+    for field in [0, 8] {
+        for count in [0u64, 5, 1 << 20, 1 << 26, 1 << 28, 1 << 40, u64::MAX] {
+            let mut b = body.clone();
+            b[counts + field..counts + field + 8].copy_from_slice(&count.to_le_bytes());
+            exercise_serialized("serialized-counts", &deflate(&bytes[..4], &b));
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 100, failure_persistence: None, rng_seed: RngSeed::Fixed(0x5eed_0003), ..ProptestConfig::default() })]
+
+    /// The file as stored, truncated or bit-flipped (mostly caught by zlib's checksum).
+    #[test]
+    fn serialized_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6)) {
+        exercise_serialized("serialized-file", &corrupt(serialized_rectangle(), cut, &flips));
+    }
+
+    /// The mesh data itself corrupted (counts, flags, indices, numbers) and compressed again,
+    /// so that the reader, not zlib, meets the damage.
+    #[test]
+    fn serialized_body_corrupted(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 1..8)) {
+        let bytes = serialized_rectangle();
+        let body = corrupt(inflate(&bytes), cut, &flips);
+        exercise_serialized("serialized-body", &deflate(&bytes[..4], &body));
+    }
+}

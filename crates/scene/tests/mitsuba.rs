@@ -217,3 +217,24 @@ fn conductor_table_matches_mitsubas_spectral_files() {
     assert!((eta[0] - 0.155_276).abs() < 1e-5 && (k[2] - 2.146_90).abs() < 1e-4);
     assert_eq!(named_conductor("none"), Some(([0.0; 3], [1.0; 3])));
 }
+
+#[test]
+fn thin_dielectric_and_plastic_specular_are_read() {
+    let main = write(
+        "thin.xml",
+        r#"<scene version="3.0.0">
+  <shape type="sphere"><bsdf type="thindielectric"><float name="int_ior" value="1.33"/>
+    <float name="ext_ior" value="1"/><rgb name="specular_transmittance" value="0.5"/></bsdf></shape>
+  <shape type="rectangle"><bsdf type="plastic"><rgb name="specular_reflectance" value="0.25"/>
+    <rgb name="diffuse_reflectance" value="0.1 0.2 0.3"/></bsdf></shape>
+</scene>"#,
+    );
+    let desc = mitsuba::load(&main).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    use pathlab_render::desc::MaterialDesc;
+    assert!(desc.materials.iter().any(|m| matches!(m,
+        MaterialDesc::ThinGlass { ior, transmittance, .. }
+            if (*ior - 1.33).abs() < 1e-6 && *transmittance == glam::Vec3::splat(0.5))));
+    assert!(desc.materials.iter().any(|m| matches!(m,
+        MaterialDesc::Plastic { specular, .. } if *specular == glam::Vec3::splat(0.25))));
+}

@@ -177,8 +177,7 @@ scene!(
 scene!(
     bsdf_spheres_bumpmap,
     "bsdf_spheres",
-    "test_bumpmap_path.xml",
-    ignore = "bumpmap: the silhouette pixels differ (98.6% pass)"
+    "test_bumpmap_path.xml"
 );
 scene!(
     bsdf_spheres_constant,
@@ -194,14 +193,12 @@ scene!(
 scene!(
     bsdf_spheres_normalmap,
     "bsdf_spheres",
-    "test_normalmap_path.xml",
-    ignore = "normalmap: the silhouette pixels differ (98.2% pass)"
+    "test_normalmap_path.xml"
 );
 scene!(
     bsdf_spheres_normalmap_roughconductor,
     "bsdf_spheres",
-    "test_normalmap_roughconductor_path.xml",
-    ignore = "normalmap: the silhouette pixels differ (98.9% pass)"
+    "test_normalmap_roughconductor_path.xml"
 );
 scene!(
     bsdf_spheres_pointlight,
@@ -236,20 +233,17 @@ scene!(
 scene!(
     bsdf_spheres_texturedprincipled1,
     "bsdf_spheres",
-    "test_texturedprincipled1_path.xml",
-    ignore = "principled is not implemented yet"
+    "test_texturedprincipled1_path.xml"
 );
 scene!(
     bsdf_spheres_texturedprincipled2,
     "bsdf_spheres",
-    "test_texturedprincipled2_path.xml",
-    ignore = "principled is not implemented yet"
+    "test_texturedprincipled2_path.xml"
 );
 scene!(
     bsdf_spheres_texturedprincipledthin,
     "bsdf_spheres",
-    "test_texturedprincipledthin_path.xml",
-    ignore = "principledthin is not implemented yet"
+    "test_texturedprincipledthin_path.xml"
 );
 scene!(
     floating_sphere_directional,

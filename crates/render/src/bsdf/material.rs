@@ -81,6 +81,66 @@ pub enum Model {
         /// The coat's transmittance.
         table: &'static CoatTable,
     },
+    /// Disney's principled BSDF.
+    Principled(Box<PrincipledModel>),
+}
+
+/// A principled material's textured parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrincipledModel {
+    base_color: Tex,
+    roughness: Tex,
+    anisotropic: Option<Tex>,
+    spec_trans: Option<Tex>,
+    metallic: Option<Tex>,
+    clearcoat: Option<Tex>,
+    clearcoat_gloss: Tex,
+    sheen: Option<Tex>,
+    sheen_tint: Option<Tex>,
+    spec_tint: Option<Tex>,
+    flatness: Option<Tex>,
+    diff_trans: Option<Tex>,
+    eta: Tex,
+    thin: bool,
+}
+
+impl PrincipledModel {
+    fn at(&self, p: &TexPoint) -> Principled {
+        let opt = |t: &Option<Tex>| t.as_ref().map_or(0.0, |t| t.eval_float(p));
+        let flags = PrincipledFlags {
+            anisotropic: self.anisotropic.is_some(),
+            spec_trans: self.spec_trans.is_some(),
+            metallic: self.metallic.is_some(),
+            clearcoat: self.clearcoat.is_some(),
+            sheen: self.sheen.is_some(),
+            sheen_tint: self.sheen_tint.is_some(),
+            spec_tint: self.spec_tint.is_some(),
+            flatness: self.flatness.is_some(),
+            diff_trans: self.diff_trans.is_some(),
+        };
+        let mut eta = self.eta.eval_float(p);
+        if (self.thin || flags.spec_trans) && eta == 1.0 {
+            // Mitsuba: η = 1 is not plausible for transmission.
+            eta = 1.001;
+        }
+        Principled {
+            base_color: self.base_color.eval(p),
+            roughness: self.roughness.eval_float(p),
+            anisotropic: opt(&self.anisotropic),
+            spec_trans: opt(&self.spec_trans),
+            metallic: opt(&self.metallic),
+            clearcoat: opt(&self.clearcoat),
+            clearcoat_gloss: self.clearcoat_gloss.eval_float(p),
+            sheen: opt(&self.sheen),
+            sheen_tint: opt(&self.sheen_tint),
+            spec_tint: opt(&self.spec_tint),
+            flatness: opt(&self.flatness),
+            diff_trans: opt(&self.diff_trans),
+            eta,
+            flags,
+            thin: self.thin,
+        }
+    }
 }
 
 /// A leaf of the material tree: a model and whether its back side reflects too.
@@ -116,7 +176,38 @@ struct Local {
     n: Vec3,
     dpdu: Vec3,
     dpdv: Vec3,
-    guard: Option<Vec3>,
+    guard: Option<Guard>,
+}
+
+impl Local {
+    /// The frame a normal or bump map makes from `n_local`, the perturbed normal in this
+    /// frame's tangent coordinates (unnormalised), as Mitsuba's perturbed BSDFs make it: a
+    /// normal that `wo` sees from behind is mirrored about this normal (Schüssler et al.
+    /// 2017); the tangent is this frame's, made orthogonal to the new normal.
+    fn perturbed(&self, mut n_local: Vec3, wo: Vec3) -> Local {
+        let base = tangent_frame(self.n, self.dpdu);
+        let wo_local = base.to_local(wo);
+        if wo_local.z * wo_local.dot(n_local) <= 0.0 {
+            n_local = Vec3::new(-n_local.x, -n_local.y, n_local.z);
+        }
+        let n_local = n_local.try_normalize().unwrap_or(Vec3::Z);
+        let s_local = (Vec3::X - n_local * n_local.x)
+            .try_normalize()
+            .unwrap_or(Vec3::Y);
+        let cos2 = n_local.z * n_local.z;
+        let tan2 = (1.0 - cos2).max(0.0) / cos2;
+        let n = base.to_world(n_local);
+        let s = base.to_world(s_local);
+        Local {
+            n,
+            dpdu: s,
+            dpdv: n.cross(s),
+            guard: Some(Guard {
+                n: self.n,
+                alpha2: (0.125 * tan2).min(1.0),
+            }),
+        }
+    }
 }
 
 /// The frame with normal `n` and first axis `dpdu` made orthogonal to it (Mitsuba's shading
@@ -156,7 +247,11 @@ impl Material {
     /// Whether evaluating the material needs the surface's tangents.
     pub fn needs_tangents(&self) -> bool {
         match self {
-            Material::Leaf(l) => matches!(l.model, Model::Conductor { .. }),
+            Material::Leaf(l) => match &l.model {
+                Model::Conductor { .. } => true,
+                Model::Principled(p) => p.anisotropic.is_some(),
+                _ => false,
+            },
             Material::Mask(_, m) => m.needs_tangents(),
             Material::Blend(_, ab) | Material::TwoSided(ab) => {
                 ab.0.needs_tangents() || ab.1.needs_tangents()
@@ -261,19 +356,8 @@ impl Material {
                 }
             }
             Material::NormalMap(map, inner) => {
-                let frame = tangent_frame(at.n, at.dpdu);
-                let c = map.eval(&p.tex) * 2.0 - Rgb::ONE;
-                let n = frame.to_world(c).try_normalize().unwrap_or(at.n);
-                let s = (at.dpdu - n * n.dot(at.dpdu))
-                    .try_normalize()
-                    .unwrap_or(frame.s);
-                let perturbed = Local {
-                    n,
-                    dpdu: s,
-                    dpdv: n.cross(s),
-                    guard: Some(at.guard.unwrap_or(at.n)),
-                };
-                inner.collect(p, &perturbed, wo, weight, lobes, null);
+                let n_local = map.eval(&p.tex) * 2.0 - Rgb::ONE;
+                inner.collect(p, &at.perturbed(n_local, wo), wo, weight, lobes, null);
             }
             Material::BumpMap(height, scale, inner) => {
                 // Mitsuba's bumpmap: the tangents displaced by the height's gradient (its
@@ -281,17 +365,12 @@ impl Material {
                 let g = height.grad_float(&p.tex) * *scale;
                 let dpdu = at.dpdu + at.n * (g.x - at.n.dot(at.dpdu));
                 let dpdv = at.dpdv + at.n * (g.y - at.n.dot(at.dpdv));
-                let mut n = dpdu.cross(dpdv).try_normalize().unwrap_or(at.n);
+                let mut n = dpdu.cross(dpdv);
                 if n.dot(p.ng) < 0.0 {
                     n = -n;
                 }
-                let perturbed = Local {
-                    n,
-                    dpdu,
-                    dpdv,
-                    guard: Some(at.guard.unwrap_or(at.n)),
-                };
-                inner.collect(p, &perturbed, wo, weight, lobes, null);
+                let n_local = tangent_frame(at.n, at.dpdu).to_local(n);
+                inner.collect(p, &at.perturbed(n_local, wo), wo, weight, lobes, null);
             }
         }
     }
@@ -354,6 +433,18 @@ impl Material {
                 // The side matters: inside and outside differ.
                 Material::new(bxdf, false)
             }
+            &MaterialDesc::ThinGlass {
+                reflectance,
+                transmittance,
+                ior,
+            } => Material::new(
+                Bxdf::ThinDielectric(ThinDielectric {
+                    eta: usable_ior(ior),
+                    reflectance,
+                    transmittance,
+                }),
+                false,
+            ),
             &MaterialDesc::Conductor {
                 alpha,
                 eta,
@@ -412,14 +503,18 @@ impl Material {
             }),
             &MaterialDesc::Plastic {
                 diffuse,
+                specular,
                 ior,
                 nonlinear,
             } => Material::new(
-                Bxdf::Plastic(Plastic::new(
-                    diffuse.clamp(Vec3::ZERO, Vec3::ONE),
-                    usable_ior(ior),
-                    nonlinear,
-                )),
+                Bxdf::Plastic(
+                    Plastic::new(
+                        diffuse.clamp(Vec3::ZERO, Vec3::ONE),
+                        usable_ior(ior),
+                        nonlinear,
+                    )
+                    .with_specular(specular.max(Vec3::ZERO)),
+                ),
                 false,
             ),
             MaterialDesc::RoughPlastic {
@@ -453,6 +548,29 @@ impl Material {
                         nonlinear: *nonlinear,
                         table: CoatTable::get(m, eta),
                     },
+                    two_sided: false,
+                })
+            }
+            MaterialDesc::Principled(d) => {
+                let mut opt = |t: &Option<crate::desc::TextureDesc>| t.as_ref().map(&mut tex);
+                let model = PrincipledModel {
+                    anisotropic: opt(&d.anisotropic),
+                    spec_trans: opt(&d.spec_trans),
+                    metallic: opt(&d.metallic),
+                    clearcoat: opt(&d.clearcoat),
+                    sheen: opt(&d.sheen),
+                    sheen_tint: opt(&d.sheen_tint),
+                    spec_tint: opt(&d.spec_tint),
+                    flatness: opt(&d.flatness),
+                    diff_trans: opt(&d.diff_trans),
+                    base_color: tex(&d.base_color),
+                    roughness: tex(&d.roughness),
+                    clearcoat_gloss: tex(&d.clearcoat_gloss),
+                    eta: tex(&d.eta),
+                    thin: d.thin,
+                };
+                Material::Leaf(Leaf {
+                    model: Model::Principled(Box::new(model)),
                     two_sided: false,
                 })
             }
@@ -542,6 +660,7 @@ impl Model {
                 }),
                 false,
             ),
+            Model::Principled(m) => (Bxdf::Principled(m.at(p)), m.anisotropic.is_some()),
         }
     }
 }

@@ -17,8 +17,10 @@ pub mod material;
 pub mod microfacet;
 pub mod mirror;
 pub mod plastic;
+pub mod principled;
 pub mod rough_dielectric;
 pub mod rough_plastic;
+pub mod thin_dielectric;
 
 pub use conductor::Conductor;
 pub use dielectric::{refract, FresnelModel, SmoothDielectric};
@@ -28,8 +30,10 @@ pub use material::{Leaf, Material, Model, ShadingPoint};
 pub use microfacet::{Microfacet, NormalDistribution};
 pub use mirror::Mirror;
 pub use plastic::Plastic;
+pub use principled::{Principled, PrincipledFlags};
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
+pub use thin_dielectric::ThinDielectric;
 
 use crate::desc::Rgb;
 use crate::geometry::Frame;
@@ -90,6 +94,8 @@ pub enum Bxdf {
     Mirror(Mirror),
     /// Smooth glass.
     Dielectric(SmoothDielectric),
+    /// A thin sheet of glass.
+    ThinDielectric(ThinDielectric),
     /// A smooth or rough conductor.
     Conductor(Conductor),
     /// Rough glass.
@@ -98,6 +104,8 @@ pub enum Bxdf {
     Plastic(Plastic),
     /// Diffuse under a rough coat.
     RoughPlastic(RoughPlastic),
+    /// Disney's principled BSDF (Mitsuba's `principled` and `principledthin`).
+    Principled(Principled),
 }
 
 impl Bxdf {
@@ -109,7 +117,8 @@ impl Bxdf {
             Bxdf::RoughDielectric(b) => b.f(wo, wi),
             Bxdf::Plastic(b) => b.f(wo, wi),
             Bxdf::RoughPlastic(b) => b.f(wo, wi),
-            Bxdf::Mirror(_) | Bxdf::Dielectric(_) => Rgb::ZERO,
+            Bxdf::Principled(b) => b.f(wo, wi),
+            Bxdf::Mirror(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => Rgb::ZERO,
         }
     }
 
@@ -119,10 +128,12 @@ impl Bxdf {
             Bxdf::Diffuse(b) => b.sample(wo, u),
             Bxdf::Mirror(b) => b.sample(wo),
             Bxdf::Dielectric(b) => b.sample(wo, uc),
+            Bxdf::ThinDielectric(b) => b.sample(wo, uc),
             Bxdf::Conductor(b) => b.sample(wo, u),
             Bxdf::RoughDielectric(b) => b.sample(wo, uc, u),
             Bxdf::Plastic(b) => b.sample(wo, uc, u),
             Bxdf::RoughPlastic(b) => b.sample(wo, uc, u),
+            Bxdf::Principled(b) => b.sample(wo, uc, u),
         }
     }
 
@@ -134,19 +145,21 @@ impl Bxdf {
             Bxdf::RoughDielectric(b) => b.pdf(wo, wi),
             Bxdf::Plastic(b) => b.pdf(wo, wi),
             Bxdf::RoughPlastic(b) => b.pdf(wo, wi),
-            Bxdf::Mirror(_) | Bxdf::Dielectric(_) => 0.0,
+            Bxdf::Principled(b) => b.pdf(wo, wi),
+            Bxdf::Mirror(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => 0.0,
         }
     }
 
     /// Whether every lobe is a delta distribution (light sampling can never help).
     pub fn is_delta(&self) -> bool {
         match self {
-            Bxdf::Mirror(_) | Bxdf::Dielectric(_) => true,
+            Bxdf::Mirror(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => true,
             Bxdf::Conductor(c) => c.distribution.is_none(),
             Bxdf::Diffuse(_)
             | Bxdf::RoughDielectric(_)
             | Bxdf::Plastic(_)
-            | Bxdf::RoughPlastic(_) => false,
+            | Bxdf::RoughPlastic(_)
+            | Bxdf::Principled(_) => false,
         }
     }
 }
@@ -175,10 +188,36 @@ pub struct Lobe {
     pub frame: Frame,
     /// The model.
     pub bxdf: Bxdf,
-    /// For a normal-mapped lobe, the surface's own shading normal: light that arrives on the
-    /// other side of it than of the lobe's normal counts nothing (Mitsuba's rule against
-    /// light leaking through a perturbed normal).
-    pub guard: Option<Vec3>,
+    /// For a lobe whose normal a normal or bump map moved, what the surface's own shading
+    /// normal says about light arriving along wi.
+    pub guard: Option<Guard>,
+}
+
+/// The rules of a perturbed normal (Mitsuba's `normalmap` and `bumpmap`): light arriving on
+/// the other side of the surface's own shading normal than of the lobe's counts nothing, and
+/// what arrives is attenuated by the microfacet shadowing term of Estevez et al. 2019 ("A
+/// Microfacet-Based Shadowing Function to Solve the Bump Terminator Problem"),
+/// 2 / (1 + √(1 + α² tan²θ)), θ measured from the surface's own normal and
+/// α² = min(tan²θp / 8, 1) from the perturbed normal's tilt θp.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Guard {
+    /// The surface's own shading normal.
+    pub n: Vec3,
+    /// α² of the shadowing term (zero: no attenuation).
+    pub alpha2: f32,
+}
+
+impl Guard {
+    /// The shadowing term for light arriving along `wi`.
+    #[inline]
+    fn shadowing(&self, wi: Vec3) -> f32 {
+        if self.alpha2 == 0.0 {
+            return 1.0;
+        }
+        let cos = wi.dot(self.n);
+        let tan2 = (1.0 - cos * cos).max(0.0) / (cos * cos);
+        2.0 / (1.0 + (1.0 + self.alpha2 * tan2).sqrt())
+    }
 }
 
 impl Lobe {
@@ -186,7 +225,18 @@ impl Lobe {
     #[inline]
     fn admits(&self, wi: Vec3) -> bool {
         self.guard
-            .is_none_or(|n| wi.dot(n) * wi.dot(self.frame.n) > 0.0)
+            .is_none_or(|g| wi.dot(g.n) * wi.dot(self.frame.n) > 0.0)
+    }
+
+    /// The factor the guard applies to light arriving along `wi` (one without a guard; zero
+    /// where it does not admit it).
+    #[inline]
+    fn attenuation(&self, wi: Vec3) -> f32 {
+        match self.guard {
+            None => 1.0,
+            Some(g) if wi.dot(g.n) * wi.dot(self.frame.n) > 0.0 => g.shadowing(wi),
+            Some(_) => 0.0,
+        }
     }
 }
 
@@ -284,8 +334,10 @@ impl Bsdf {
             return l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi));
         }
         self.lobes()
-            .filter(|l| l.admits(wi))
-            .map(|l| l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi)) * l.weight)
+            .map(|l| {
+                l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi))
+                    * (l.weight * l.attenuation(wi))
+            })
             .sum()
     }
 
@@ -298,10 +350,9 @@ impl Bsdf {
             return l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi)) * wi.dot(l.frame.n).abs();
         }
         self.lobes()
-            .filter(|l| l.admits(wi))
             .map(|l| {
                 l.bxdf.f(l.frame.to_local(wo), l.frame.to_local(wi))
-                    * (l.weight * wi.dot(l.frame.n).abs())
+                    * (l.weight * l.attenuation(wi) * wi.dot(l.frame.n).abs())
             })
             .sum()
     }
@@ -321,8 +372,12 @@ impl Bsdf {
             if !l.admits(wi) {
                 return None;
             }
-            return (s.pdf > 0.0 && s.f.is_finite()).then(|| BsdfSample {
-                f: s.f,
+            let f = match l.guard {
+                None => s.f,
+                Some(_) => s.f * l.attenuation(wi),
+            };
+            return (s.pdf > 0.0 && f.is_finite()).then(|| BsdfSample {
+                f,
                 wi,
                 pdf: s.pdf,
                 delta: s.delta,
@@ -364,7 +419,7 @@ impl Bsdf {
         let cos = wi.dot(l.frame.n).abs();
         if s.delta {
             return Some(BsdfSample {
-                f: s.f * l.weight,
+                f: s.f * (l.weight * l.attenuation(wi)),
                 wi,
                 pdf: s.pdf * l.weight,
                 delta: true,

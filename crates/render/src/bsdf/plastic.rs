@@ -22,6 +22,8 @@ use std::f32::consts::FRAC_1_PI;
 pub struct Plastic {
     /// Diffuse reflectance of the base.
     pub diffuse: Rgb,
+    /// Scale of the coat's reflection (Mitsuba's `specular_reflectance`; 1 is physical).
+    pub specular: Rgb,
     /// Index of the coat relative to outside.
     pub eta: f32,
     /// Whether internal reflections tint by the base colour.
@@ -35,10 +37,16 @@ impl Plastic {
     pub fn new(diffuse: Rgb, eta: f32, nonlinear: bool) -> Self {
         Plastic {
             diffuse,
+            specular: Rgb::ONE,
             eta,
             nonlinear,
             fdr_int: fresnel_diffuse_reflectance(1.0 / eta),
         }
+    }
+
+    /// The same plastic with its coat reflection scaled by `specular`.
+    pub fn with_specular(self, specular: Rgb) -> Self {
+        Plastic { specular, ..self }
     }
 
     fn base(&self) -> Rgb {
@@ -49,11 +57,14 @@ impl Plastic {
         }
     }
 
-    /// Probability of sampling the specular coat reflection.
+    /// Probability of sampling the specular coat reflection: F s against (1 - F) d, with s
+    /// and d the mean specular scale and diffuse reflectance (as Mitsuba weighs them).
     fn specular_probability(&self, f_o: f32) -> f32 {
-        let d = (1.0 - f_o) * (self.diffuse.x + self.diffuse.y + self.diffuse.z) / 3.0;
-        if f_o + d > 0.0 {
-            f_o / (f_o + d)
+        let mean = |c: Rgb| (c.x + c.y + c.z) / 3.0;
+        let s = f_o * mean(self.specular.max(Rgb::ZERO));
+        let d = (1.0 - f_o) * mean(self.diffuse);
+        if s + d > 0.0 {
+            s / (s + d)
         } else {
             1.0
         }
@@ -79,7 +90,7 @@ impl Plastic {
         let f_o = fresnel_dielectric(wo.z, self.eta);
         let p_spec = self.specular_probability(f_o);
         if uc < p_spec {
-            return specular_reflection(wo, Rgb::splat(f_o), p_spec);
+            return specular_reflection(wo, self.specular * f_o, p_spec);
         }
         let wi = sample_cosine_hemisphere(u);
         LocalSample::evaluated(wi, self.pdf(wo, wi), || self.f(wo, wi))

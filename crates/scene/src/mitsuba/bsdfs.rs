@@ -256,6 +256,7 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
                 }
             }
         }
+        "principled" | "principledthin" => principled(ctx, b)?,
         "roughplastic" => {
             let alpha = ctx.texture(b, "alpha", Vec3::splat(0.1), SpectrumKind::Unbounded)?;
             let Some(alpha) = alpha.as_constant() else {
@@ -283,13 +284,22 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
                 distribution: distribution(ctx, b)?,
             }
         }
-        "dielectric" | "roughdielectric" | "thindielectric" => {
-            if b.plugin == "thindielectric" {
-                ctx.warn(
-                    b.loc,
-                    "<bsdf type=\"thindielectric\"> is drawn as a solid dielectric",
-                );
-            }
+        "thindielectric" => MaterialDesc::ThinGlass {
+            reflectance: ctx.color(
+                b,
+                "specular_reflectance",
+                Vec3::ONE,
+                SpectrumKind::Reflectance,
+            )?,
+            transmittance: ctx.color(
+                b,
+                "specular_transmittance",
+                Vec3::ONE,
+                SpectrumKind::Reflectance,
+            )?,
+            ior: relative_ior(ctx, b, BK7)?,
+        },
+        "dielectric" | "roughdielectric" => {
             let (roughness, distribution) = if b.plugin == "roughdielectric" {
                 (alpha(ctx, b)?, distribution(ctx, b)?)
             } else {
@@ -314,30 +324,22 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
                 fresnel: FresnelModel::Exact,
             }
         }
-        "plastic" => {
-            let specular = ctx.color(
+        "plastic" => MaterialDesc::Plastic {
+            specular: ctx.color(
                 b,
                 "specular_reflectance",
                 Vec3::ONE,
                 SpectrumKind::Reflectance,
-            )?;
-            if specular != Vec3::ONE {
-                ctx.warn(
-                    b.loc,
-                    "<bsdf type=\"plastic\">: specular_reflectance is not supported yet; using 1",
-                );
-            }
-            MaterialDesc::Plastic {
-                diffuse: ctx.color(
-                    b,
-                    "diffuse_reflectance",
-                    Vec3::splat(0.5),
-                    SpectrumKind::Reflectance,
-                )?,
-                ior: relative_ior(ctx, b, 1.49)?,
-                nonlinear: ctx.boolean(b, "nonlinear", false)?,
-            }
-        }
+            )?,
+            diffuse: ctx.color(
+                b,
+                "diffuse_reflectance",
+                Vec3::splat(0.5),
+                SpectrumKind::Reflectance,
+            )?,
+            ior: relative_ior(ctx, b, 1.49)?,
+            nonlinear: ctx.boolean(b, "nonlinear", false)?,
+        },
         other => {
             let what = ctx.what(b);
             ctx.warn(
@@ -350,6 +352,92 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
         }
     };
     Ok(m)
+}
+
+/// Mitsuba's `principled` and `principledthin`: optional parameters switch their lobes on
+/// when given (and not the number 0).
+fn principled(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
+    let thin = b.plugin == "principledthin";
+    let opt = |ctx: &mut Ctx, name: &str| -> Result<Option<TextureDesc>, Error> {
+        if ctx.is_zero(b, name) {
+            ctx.accept(b, &[name]);
+            return Ok(None);
+        }
+        ctx.opt_texture(b, name, SpectrumKind::Unbounded)
+    };
+    let anisotropic = opt(ctx, "anisotropic")?;
+    let spec_trans = opt(ctx, "spec_trans")?;
+    let sheen = opt(ctx, "sheen")?;
+    let sheen_tint = opt(ctx, "sheen_tint")?;
+    let spec_tint = opt(ctx, "spec_tint")?;
+    let flatness = opt(ctx, "flatness")?;
+    let (metallic, clearcoat, diff_trans) = if thin {
+        (None, None, opt(ctx, "diff_trans")?)
+    } else {
+        (opt(ctx, "metallic")?, opt(ctx, "clearcoat")?, None)
+    };
+    let rates: &[&str] = if thin {
+        &[
+            "specular_reflectance_sampling_rate",
+            "specular_transmittance_sampling_rate",
+            "diffuse_transmittance_sampling_rate",
+            "diffuse_reflectance_sampling_rate",
+        ]
+    } else {
+        &[
+            "main_specular_sampling_rate",
+            "clearcoat_sampling_rate",
+            "diffuse_reflectance_sampling_rate",
+        ]
+    };
+    for rate in rates {
+        if ctx.float(b, rate, 1.0)? != 1.0 {
+            ctx.warn(
+                ctx.loc_of(b, rate),
+                format!(
+                    "{}: '{rate}' is not supported; pathlab samples at rate 1",
+                    ctx.what(b)
+                ),
+            );
+        }
+    }
+    let eta = if thin {
+        ctx.texture(b, "eta", Vec3::splat(1.5), SpectrumKind::Unbounded)?
+    } else if ctx.has(b, "eta") {
+        if ctx.has(b, "specular") {
+            return Err(ctx.error(
+                b.loc,
+                "<bsdf type=\"principled\">: give either eta or specular",
+            ));
+        }
+        TextureDesc::value(ctx.positive(b, "eta", 1.5)? as f32)
+    } else {
+        let mut specular = ctx.float(b, "specular", 0.5)? as f32;
+        if spec_trans.is_some() && specular == 0.0 {
+            specular = 1e-3;
+        }
+        TextureDesc::value(2.0 / (1.0 - (0.08 * specular).sqrt()) - 1.0)
+    };
+    Ok(MaterialDesc::Principled(Box::new(PrincipledDesc {
+        base_color: ctx.texture(b, "base_color", Vec3::splat(0.5), SpectrumKind::Reflectance)?,
+        roughness: ctx.texture(b, "roughness", Vec3::splat(0.5), SpectrumKind::Unbounded)?,
+        anisotropic,
+        spec_trans,
+        metallic,
+        clearcoat,
+        clearcoat_gloss: if thin {
+            TextureDesc::value(0.0)
+        } else {
+            ctx.texture(b, "clearcoat_gloss", Vec3::ZERO, SpectrumKind::Unbounded)?
+        },
+        sheen,
+        sheen_tint,
+        spec_tint,
+        flatness,
+        diff_trans,
+        eta,
+        thin,
+    })))
 }
 
 fn two_sided(m: MaterialDesc) -> MaterialDesc {
@@ -371,6 +459,15 @@ impl<'t> Ctx<'t> {
     /// The material a BSDF object describes, without adding it to the scene.
     pub(super) fn material_desc(&mut self, b: Obj) -> Result<MaterialDesc, Error> {
         bsdf(self, b)
+    }
+
+    /// Whether property `name` of `o` is the number 0 (which Mitsuba's principled BSDFs take
+    /// as the parameter not being given).
+    pub(super) fn is_zero(&self, o: Obj, name: &str) -> bool {
+        self.tree.nodes[o.index].props.iter().any(|p| {
+            p.name == name
+                && matches!(p.value, Value::Float(v) if v == 0.0) | matches!(p.value, Value::Int(0))
+        })
     }
 
     /// A string property, or `None` when absent or of another type (left unused then).

@@ -116,7 +116,9 @@ pub fn parse(bytes: &[u8], index: usize) -> Result<MeshDesc, String> {
         read_vec3(&mut r)?;
     }
     let wide = vertices > u32::MAX as u64;
-    let mut indices = Vec::with_capacity(3 * triangles as usize);
+    // Reserve no more than the data left could hold: the declared count may be corrupt.
+    let index_bytes = if wide { 8 } else { 4 };
+    let mut indices = Vec::with_capacity((3 * triangles as usize).min(r.remaining() / index_bytes));
     for _ in 0..3 * triangles {
         let i = if wide { r.u64()? } else { r.u32()? as u64 };
         if i >= vertices {
@@ -187,6 +189,9 @@ struct Reader<'a> {
 }
 
 impl Reader<'_> {
+    fn remaining(&self) -> usize {
+        self.data.len() - self.at
+    }
     fn take(&mut self, n: usize) -> Result<&[u8], String> {
         let s = self
             .data
