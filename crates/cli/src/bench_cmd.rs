@@ -202,13 +202,14 @@ fn export_obj(args: &ObjArgs) -> Result<()> {
     }
     out.flush()
         .with_context(|| format!("cannot write {}", args.output.display()))?;
-    if desc.spheres.is_empty() {
+    if desc.spheres.is_empty() && desc.sdf_grids.is_empty() {
         println!("{}: {faces} triangles", args.output.display());
     } else {
         println!(
-            "{}: {faces} triangles ({} spheres left out)",
+            "{}: {faces} triangles ({} spheres and {} SDF grids left out)",
             args.output.display(),
-            desc.spheres.len()
+            desc.spheres.len(),
+            desc.sdf_grids.len()
         );
     }
     Ok(())

@@ -25,6 +25,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
             "meshes": info.meshes,
             "triangles": info.triangles,
             "spheres": info.spheres,
+            "sdf_grids": info.sdf_grids,
             "materials": info.materials,
             "lights": info.lights,
             "camera": {
@@ -50,8 +51,13 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         }
     };
     println!("{}", args.scene);
+    let grids = match info.sdf_grids {
+        0 => String::new(),
+        1 => ", 1 SDF grid".to_string(),
+        n => format!(", {n} SDF grids"),
+    };
     println!(
-        "  shapes     {} meshes ({} triangles), {} spheres",
+        "  shapes     {} meshes ({} triangles), {} spheres{grids}",
         info.meshes, info.triangles, info.spheres
     );
     println!("  materials  {}", list(&info.materials));

@@ -1,6 +1,6 @@
 //! The plain scene description that loaders produce and [`crate::scene::Scene::build`] consumes.
 
-use glam::{Affine2, Mat3, Vec2, Vec3};
+use glam::{Affine2, Affine3A, Mat3, Vec2, Vec3};
 use std::sync::Arc;
 
 pub use crate::bsdf::{FresnelModel, NormalDistribution};
@@ -16,6 +16,8 @@ pub struct SceneDesc {
     pub meshes: Vec<MeshDesc>,
     /// Spheres.
     pub spheres: Vec<SphereDesc>,
+    /// Signed distance grids.
+    pub sdf_grids: Vec<SdfGridDesc>,
     /// Materials, referenced by index.
     pub materials: Vec<MaterialDesc>,
     /// Point lights.
@@ -53,6 +55,14 @@ impl SceneDesc {
         for s in &self.spheres {
             lo = lo.min(s.center - Vec3::splat(s.radius));
             hi = hi.max(s.center + Vec3::splat(s.radius));
+        }
+        for g in &self.sdf_grids {
+            for i in 0..8 {
+                let c = Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32);
+                let p = g.to_world.transform_point3(c);
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
         }
         (lo.x <= hi.x).then_some((lo, hi))
     }
@@ -295,6 +305,23 @@ pub struct MeshDesc {
     /// Per-vertex tangents along increasing u (empty: derived from the texture coordinates,
     /// or arbitrary without them), for anisotropic materials and normal maps.
     pub tangents: Vec<Vec3>,
+}
+
+/// A signed distance grid (Mitsuba's `sdfgrid`): samples of a signed distance (negative
+/// inside) over the object-space unit cube, placed in the world by `to_world`.
+#[derive(Clone, Debug, Default)]
+pub struct SdfGridDesc {
+    /// Samples, x fastest, then y, then z; sample (i, j, k) sits at (i, j, k) / (res - 1).
+    pub values: Vec<f32>,
+    /// Samples along x, y and z.
+    pub resolution: [u32; 3],
+    /// Object-to-world transform.
+    pub to_world: Affine3A,
+    /// Shading normals blended across voxels (Mitsuba's `smooth`) rather than the
+    /// interpolant's own gradient (`analytic`).
+    pub smooth_normals: bool,
+    /// Material index.
+    pub material: usize,
 }
 
 /// A sphere in world space.

@@ -53,6 +53,7 @@ pub mod light;
 pub mod progressive;
 pub mod render;
 pub mod scene;
+pub mod sdf_grid;
 pub mod shape;
 #[cfg(target_arch = "x86_64")]
 pub mod simd;

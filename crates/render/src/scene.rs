@@ -10,6 +10,7 @@ use crate::light::{
     bounding_radius, sphere_uv, AreaShape, AreaTexture, AreaTriangle, Light, LightSampler,
     Projector,
 };
+use crate::sdf_grid::SdfGrid;
 use crate::shape::{Sphere, Triangle};
 use crate::texture::{AttributeTable, Tex, TexPoint};
 use glam::{Mat3, Vec2, Vec3};
@@ -56,6 +57,15 @@ pub enum SceneError {
 enum Prim {
     Triangle(u32),
     Sphere(u32),
+    /// A voxel of an SDF grid that the surface passes through.
+    Voxel(u32),
+}
+
+/// A voxel of an SDF grid: which grid, and the voxel's lower corner in its samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Voxel {
+    grid: u32,
+    corner: [u32; 3],
 }
 
 /// `items` rearranged so that position `i` holds `items[order[i]]`.
@@ -80,7 +90,8 @@ pub struct SurfaceInteraction {
     pub light: Option<u32>,
     /// Texture coordinates (the mesh's, else barycentric; spherical on spheres).
     pub uv: Vec2,
-    /// The triangle hit, in the scene's order (`u32::MAX` on a sphere), for mesh attributes.
+    /// The triangle hit, in the scene's order (`u32::MAX` on a sphere or an SDF grid), for
+    /// mesh attributes.
     pub prim: u32,
     /// Barycentrics of the triangle's vertices 1 and 2.
     pub b: Vec2,
@@ -119,6 +130,11 @@ pub struct Scene {
     sphere_light: Vec<u32>,
     /// Each sphere's rotation from world to its own frame (for its texture coordinates).
     sphere_to_object: Vec<Mat3>,
+    grids: Vec<SdfGrid>,
+    grid_material: Vec<u32>,
+    voxels: Vec<Voxel>,
+    /// Whether every primitive is a triangle (no spheres or SDF grids).
+    only_triangles: bool,
     /// Mesh attributes read by textures, per triangle corner.
     attributes: Vec<AttributeTable>,
     prims: Vec<Prim>,
@@ -360,15 +376,34 @@ impl Scene {
             sampleable.push(true);
             light_group.push(lights.len() as u32 + desc.meshes.len() as u32);
         }
+        let mut grids = Vec::new();
+        let mut grid_material = Vec::new();
+        let mut voxels = Vec::new();
+        let mut voxel_bounds = Vec::new();
+        for (i, g) in desc.sdf_grids.iter().enumerate() {
+            grid_material.push(check_material(&format!("SDF grid {i}"), g.material)?);
+            let grid =
+                SdfGrid::new(g).map_err(|e| SceneError::Invalid(format!("SDF grid {i}: {e}")))?;
+            for (corner, b) in grid.occupied_voxels(&g.to_world) {
+                voxels.push(Voxel {
+                    grid: i as u32,
+                    corner,
+                });
+                voxel_bounds.push(b);
+            }
+            grids.push(grid);
+        }
         let prims: Vec<Prim> = (0..triangles.len() as u32)
             .map(Prim::Triangle)
             .chain((0..spheres.len() as u32).map(Prim::Sphere))
+            .chain((0..voxels.len() as u32).map(Prim::Voxel))
             .collect();
         let bounds: Vec<Aabb> = prims
             .iter()
             .map(|p| match *p {
                 Prim::Triangle(i) => triangles[i as usize].bounds(),
                 Prim::Sphere(i) => spheres[i as usize].bounds(),
+                Prim::Voxel(i) => voxel_bounds[i as usize],
             })
             .collect();
         if prims.len() > MAX_PRIMITIVES {
@@ -400,7 +435,7 @@ impl Scene {
                     tri_order.push(t);
                     Prim::Triangle(tri_order.len() as u32 - 1)
                 }
-                sphere => sphere,
+                shape => shape,
             })
             .collect();
         if tri_order.len() < triangles.len() {
@@ -466,10 +501,11 @@ impl Scene {
             .iter()
             .map(|p| match *p {
                 Prim::Triangle(i) => tri_visibility[i as usize],
-                Prim::Sphere(_) => Visibility::ALL,
+                Prim::Sphere(_) | Prim::Voxel(_) => Visibility::ALL,
             })
             .collect();
         let all_visible = prim_visibility.iter().all(|v| *v == Visibility::ALL);
+        let only_triangles = spheres.is_empty() && voxels.is_empty();
         let (blocks, block_info) = leaf_blocks(&mut bvh, &prims, &triangles, &prim_visibility);
         let stats = BuildStats {
             bvh_seconds,
@@ -489,6 +525,10 @@ impl Scene {
             sphere_material,
             sphere_light,
             sphere_to_object,
+            grids,
+            grid_material,
+            voxels,
+            only_triangles,
             attributes,
             prims,
             all_visible,
@@ -534,6 +574,7 @@ impl Scene {
             + size_of_val(self.sphere_material.as_slice())
             + size_of_val(self.sphere_light.as_slice())
             + size_of_val(self.sphere_to_object.as_slice())
+            + size_of_val(self.voxels.as_slice())
             + self
                 .attributes
                 .iter()
@@ -717,6 +758,7 @@ impl Scene {
         match self.prims[slot as usize] {
             Prim::Triangle(i) => *si = Some(self.triangle_interaction(i, b1, b2, t)),
             Prim::Sphere(i) => *si = Some(self.sphere_interaction(i, ray, t)),
+            Prim::Voxel(i) => *si = Some(self.voxel_interaction(i, ray, t)),
         }
     }
 
@@ -770,6 +812,29 @@ impl Scene {
             material: self.sphere_material[i as usize],
             light: (light != NO_LIGHT).then_some(light),
             uv,
+            prim: u32::MAX,
+            b: Vec2::ZERO,
+        }
+    }
+
+    /// The surface interaction where `ray` meets the SDF grid surface in voxel `i` at
+    /// distance `t` (out of line, as spheres are).
+    #[inline(never)]
+    fn voxel_interaction(&self, i: u32, ray: &Ray, t: f32) -> SurfaceInteraction {
+        let v = self.voxels[i as usize];
+        let p = ray.at(t);
+        let (ng, ns) = self.grids[v.grid as usize].normals(v.corner, p);
+        // A blended shading normal may lean past the geometric one's hemisphere; the
+        // geometric side decides.
+        let ns = if ns.dot(ng) > 0.0 { ns } else { ng };
+        SurfaceInteraction {
+            p,
+            t,
+            ng,
+            ns,
+            material: self.grid_material[v.grid as usize],
+            light: None,
+            uv: Vec2::ZERO,
             prim: u32::MAX,
             b: Vec2::ZERO,
         }

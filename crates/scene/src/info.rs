@@ -13,6 +13,8 @@ pub struct SceneInfo {
     pub triangles: usize,
     /// Number of spheres.
     pub spheres: usize,
+    /// Number of signed distance grids.
+    pub sdf_grids: usize,
     /// Materials by kind (diffuse, mirror, ...).
     pub materials: BTreeMap<String, usize>,
     /// Lights by kind (area meshes, area spheres, point, spot, directional, environment).
@@ -77,6 +79,7 @@ pub fn summarize(desc: &SceneDesc) -> SceneInfo {
         meshes: shapes().count(),
         triangles: shapes().map(|m| m.indices.len() / 3).sum(),
         spheres: desc.spheres.len(),
+        sdf_grids: desc.sdf_grids.len(),
         materials,
         lights,
         camera: (

@@ -225,15 +225,19 @@ proptest! {
     }
 }
 
-/// A Mitsuba scene around one `.serialized` mesh, `case.serialized` next to it.
-const SERIALIZED_SCENE: &str = r#"<scene version="3.0.0">
+/// A Mitsuba scene around one shape of type `plugin` read from `file` next to it.
+fn scene_around(plugin: &str, file: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
     <sensor type="perspective">
         <float name="fov" value="40"/>
         <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
     </sensor>
     <emitter type="constant"/>
-    <shape type="serialized"><string name="filename" value="case.serialized"/></shape>
-</scene>"#;
+    <shape type="{plugin}"><string name="filename" value="{file}"/></shape>
+</scene>"#
+    )
+}
 
 /// Mitsuba's `.serialized` rectangle from its test suite.
 fn serialized_rectangle() -> Vec<u8> {
@@ -244,25 +248,29 @@ fn serialized_rectangle() -> Vec<u8> {
     .unwrap()
 }
 
-/// Loads the scene above with `mesh` as its serialized file, in a folder of its own for
-/// each test (`tag`): tests run in parallel.
-fn exercise_serialized(tag: &str, mesh: &[u8]) {
+/// Loads a scene whose `plugin` shape reads `bytes` from `file`, in a folder of its own for
+/// each test (`tag`): tests run in parallel. What fails to load must name the file.
+fn exercise_shape_file(tag: &str, plugin: &str, file: &str, bytes: &[u8]) {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("corruption-{tag}"));
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("case.serialized"), mesh).unwrap();
+    std::fs::write(dir.join(file), bytes).unwrap();
     let scene = dir.join("scene.xml");
-    std::fs::write(&scene, SERIALIZED_SCENE).unwrap();
+    std::fs::write(&scene, scene_around(plugin, file)).unwrap();
     match pathlab_scene::load(scene.to_str().unwrap()) {
         Ok(desc) => render_tiny(desc),
         Err(e) => {
             let message = e.to_string();
             assert!(
-                message.contains("case.serialized"),
-                "the error does not name the mesh file: {message}"
+                message.contains(file),
+                "the error does not name {file}: {message}"
             );
         }
     }
     assert_memory_bound();
+}
+
+fn exercise_serialized(tag: &str, mesh: &[u8]) {
+    exercise_shape_file(tag, "serialized", "case.serialized", mesh);
 }
 
 /// The uncompressed body of a one-shape `.serialized` file (after its 4-byte header).
@@ -285,7 +293,11 @@ fn the_serialized_rectangle_loads_and_renders() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption-serialized-ok");
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("case.serialized"), &bytes).unwrap();
-    std::fs::write(dir.join("scene.xml"), SERIALIZED_SCENE).unwrap();
+    std::fs::write(
+        dir.join("scene.xml"),
+        scene_around("serialized", "case.serialized"),
+    )
+    .unwrap();
     let desc = pathlab_scene::load(dir.join("scene.xml").to_str().unwrap()).unwrap();
     assert_eq!(desc.meshes.len(), 1);
     assert_eq!(desc.meshes[0].indices.len(), 6);
@@ -329,5 +341,30 @@ proptest! {
         let bytes = serialized_rectangle();
         let body = corrupt(inflate(&bytes), cut, &flips);
         exercise_serialized("serialized-body", &deflate(&bytes[..4], &body));
+    }
+}
+
+/// A small signed distance grid (a sphere, 6³ samples) as a `.vol` file.
+fn sphere_grid() -> Vec<u8> {
+    let n = 6u32;
+    let mut values = Vec::new();
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let p = glam::Vec3::new(x as f32, y as f32, z as f32) / (n - 1) as f32;
+                values.push((p - 0.5).length() - 0.3);
+            }
+        }
+    }
+    pathlab_scene::mitsuba::volume::write(&values, [n; 3])
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 100, failure_persistence: None, rng_seed: RngSeed::Fixed(0x5eed_0004), ..ProptestConfig::default() })]
+
+    /// SDF grids truncated or bit-flipped (header counts, samples made NaN or huge).
+    #[test]
+    fn sdf_grid_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6)) {
+        exercise_shape_file("sdfgrid", "sdfgrid", "case.vol", &corrupt(sphere_grid(), cut, &flips));
     }
 }

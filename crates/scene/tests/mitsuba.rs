@@ -238,3 +238,108 @@ fn thin_dielectric_and_plastic_specular_are_read() {
     assert!(desc.materials.iter().any(|m| matches!(m,
         MaterialDesc::Plastic { specular, .. } if *specular == glam::Vec3::splat(0.25))));
 }
+
+#[test]
+fn an_sdf_grid_of_a_plane_renders_as_the_plane_and_a_torus_grid_renders() {
+    // A linear distance is its own trilinear interpolant: the grid's surface is exactly the
+    // plane's square inside the grid's cube, so the image must match a quad's.
+    let n = 9u32;
+    let sample = |f: &dyn Fn(glam::Vec3) -> f32| {
+        let mut v = Vec::new();
+        for z in 0..n {
+            for y in 0..n {
+                for x in 0..n {
+                    v.push(f(
+                        glam::Vec3::new(x as f32, y as f32, z as f32) / (n - 1) as f32
+                    ));
+                }
+            }
+        }
+        mitsuba::volume::write(&v, [n; 3])
+    };
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mitsuba-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("plane.vol"), sample(&|p| p.y - 0.45)).unwrap();
+    let main = write(
+        "sdf_plane.xml",
+        r#"<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value="50"/>
+    <transform name="to_world"><lookat origin="0.3, 2.5, 2.8" target="0, -0.1, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="24"/></film>
+  </sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <emitter type="point"><point name="position" x="0.5" y="1.5" z="0.3"/><rgb name="intensity" value="2"/></emitter>
+  <shape type="sdfgrid"><string name="filename" value="plane.vol"/><string name="normals" value="analytic"/>
+    <transform name="to_world"><scale value="2"/><translate x="-1" y="-1" z="-1"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.6 0.4 0.2"/></bsdf></shape>
+</scene>"#,
+    );
+    let grid = mitsuba::load(&main).unwrap();
+    assert!(grid.warnings.is_empty(), "{:?}", grid.warnings);
+    assert_eq!(grid.sdf_grids.len(), 1);
+    let mut quad = grid.clone();
+    let material = quad.sdf_grids.remove(0).material;
+    quad.meshes.push(pathlab_render::desc::MeshDesc {
+        name: "quad".into(),
+        positions: vec![
+            glam::Vec3::new(-1.0, -0.1, -1.0),
+            glam::Vec3::new(1.0, -0.1, -1.0),
+            glam::Vec3::new(1.0, -0.1, 1.0),
+            glam::Vec3::new(-1.0, -0.1, 1.0),
+        ],
+        indices: vec![0, 2, 1, 0, 3, 2],
+        material,
+        ..Default::default()
+    });
+    let (a, b) = (run(&grid, 1), run(&quad, 2));
+    let mut outliers = 0;
+    for (p, q) in a.pixels().iter().zip(b.pixels()) {
+        let (d, v) = (
+            p.mean() - q.mean(),
+            p.variance_of_mean() + q.variance_of_mean(),
+        );
+        for c in 0..3 {
+            outliers += (d[c].abs() > 4.0 * v[c].sqrt() + 1e-6) as usize;
+        }
+    }
+    assert!(outliers <= 2, "{outliers} pixel channels beyond 4 sigma");
+    let (ma, mb) = (a.image_mean(), b.image_mean());
+    let (sa, sb) = (a.image_mean_std_error(), b.image_mean_std_error());
+    for c in 0..3 {
+        let z = z_test_two_sample(ma[c], sa[c], mb[c], sb[c]);
+        assert!(
+            z.within(3.5),
+            "channel {c}: {} vs {} (z {})",
+            ma[c],
+            mb[c],
+            z.z
+        );
+    }
+    // A torus with smooth normals, rotated by its transform, renders finite and lit.
+    std::fs::write(
+        dir.join("torus.vol"),
+        sample(&|p| {
+            let q = p - 0.5;
+            (glam::Vec2::new(glam::Vec2::new(q.x, q.z).length() - 0.3, q.y)).length() - 0.12
+        }),
+    )
+    .unwrap();
+    let torus = std::fs::read_to_string(&main)
+        .unwrap()
+        .replace("plane.vol", "torus.vol")
+        .replace(r#"<string name="normals" value="analytic"/>"#, "")
+        .replace(
+            r#"<translate x="-1" y="-1" z="-1"/>"#,
+            r#"<translate x="-1" y="-1" z="-1"/><rotate x="1" angle="30"/>"#,
+        );
+    let desc = mitsuba::load(&write("sdf_torus.xml", &torus)).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let film = run(&desc, 3);
+    assert!(film.pixels().iter().all(|p| p.mean().is_finite()));
+    // The torus covers some pixels and not others: the image is neither uniform nor black.
+    let lum: Vec<f64> = film.pixels().iter().map(|p| p.mean().y).collect();
+    let (lo, hi) = lum
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &l| (a.min(l), b.max(l)));
+    assert!(hi > 0.0 && hi - lo > 0.1, "luminance range {lo}..{hi}");
+}

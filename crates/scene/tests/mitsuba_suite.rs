@@ -297,5 +297,5 @@ scene!(
     various_shapes,
     "various_shapes",
     "test_various_shapes_path.xml",
-    ignore = "sdfgrid is not implemented, and its torus grid (docs/scenes/sdfgrid/torus_sdfgrid.vol) is missing from the suite"
+    ignore = "its torus SDF grid (docs/scenes/sdfgrid/torus_sdfgrid.vol in Mitsuba's data) is missing from the copy of the suite"
 );

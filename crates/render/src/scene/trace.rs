@@ -1,5 +1,6 @@
 //! Tracing rays through the scene: the BVH's leaves hold blocks of four triangles tested
-//! together (spheres, rare, are tested one by one in their lanes), and the traversal is
+//! together (other shapes, spheres and the voxels of SDF grids, are tested one by one in
+//! their lanes), and the traversal is
 //! compiled twice, for AVX2 and for the target's baseline, the CPU choosing at run time.
 
 use super::{Prim, Scene};
@@ -7,7 +8,7 @@ use crate::accel::{BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, LANES};
 use crate::desc::Visibility;
 use crate::geometry::Ray;
 use crate::lanes::F8;
-use crate::shape::{Sphere, Triangle};
+use crate::shape::Triangle;
 #[cfg(target_arch = "x86_64")]
 use crate::simd::Avx2;
 use glam::Vec3;
@@ -66,13 +67,13 @@ impl Hit {
 }
 
 /// What a [`TriBlock`]'s lanes hold: their primitives' leaf slots and which lanes are
-/// spheres (tested one by one) or seen by camera and other rays.
+/// other shapes than triangles (tested one by one) or seen by camera and other rays.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BlockInfo {
     /// Leaf slot of each lane's primitive (`u32::MAX` for an unused lane).
     slots: [u32; LANES],
-    /// Lanes that hold spheres.
-    spheres: u8,
+    /// Lanes that hold other shapes than triangles.
+    shapes: u8,
     /// Lanes seen by camera rays.
     camera: u8,
     /// Lanes seen by other rays.
@@ -81,25 +82,29 @@ pub(super) struct BlockInfo {
 
 impl Scene {
     /// The lanes of block `b` that a camera ray (`camera`) or another ray tests as triangles,
-    /// and the lanes it tests as spheres.
+    /// and the lanes it tests as other shapes.
     #[inline(always)]
     fn block_lanes(&self, b: usize, camera: bool) -> (u32, u32) {
-        if self.all_visible && self.spheres.is_empty() {
+        if self.all_visible && self.only_triangles {
             // Unused lanes never hit, so all four can be tested.
             return (0b1111, 0);
         }
         let info = &self.block_info[b];
         let seen = u32::from(if camera { info.camera } else { info.indirect });
-        let spheres = u32::from(info.spheres);
-        (seen & !spheres, seen & spheres)
+        let shapes = u32::from(info.shapes);
+        (seen & !shapes, seen & shapes)
     }
 
-    /// The sphere in leaf slot `slot`.
+    /// Where `ray` meets the shape (not a triangle) in leaf slot `slot` within its extent.
     #[inline]
-    fn sphere_at(&self, slot: u32) -> &Sphere {
+    fn shape_hit(&self, slot: u32, ray: &Ray) -> Option<f32> {
         match self.prims[slot as usize] {
-            Prim::Sphere(s) => &self.spheres[s as usize],
-            Prim::Triangle(_) => unreachable!("block lanes marked as spheres hold spheres"),
+            Prim::Sphere(s) => self.spheres[s as usize].intersect(ray),
+            Prim::Voxel(v) => {
+                let voxel = self.voxels[v as usize];
+                self.grids[voxel.grid as usize].intersect_voxel(voxel.corner, ray)
+            }
+            Prim::Triangle(_) => unreachable!("block lanes marked as shapes hold shapes"),
         }
     }
 
@@ -155,14 +160,14 @@ impl Scene {
             let (first, count) = Bvh8::leaf_range(leaf);
             let mut any = false;
             for b in first as usize..(first + count) as usize {
-                let (triangles, spheres) = self.block_lanes(b, camera);
+                let (triangles, shapes) = self.block_lanes(b, camera);
                 if let Some(h) = self.blocks[b].intersect(r, triangles) {
                     r.t_max = h.t;
                     (slot, b1, b2) = (self.block_info[b].slots[h.lane], h.b1, h.b2);
                     any = true;
                 }
-                if spheres != 0 {
-                    if let Some(s) = self.nearest_sphere(b, spheres, r) {
+                if shapes != 0 {
+                    if let Some(s) = self.nearest_shape(b, shapes, r) {
                         (slot, b1, b2) = (s, 0.0, 0.0);
                         any = true;
                     }
@@ -173,18 +178,19 @@ impl Scene {
         Hit::new(slot, b1, b2, visited)
     }
 
-    /// The leaf slot of the nearest sphere among lanes `spheres` of block `b` that `ray` hits
-    /// within its extent, shortening `ray.t_max` to it. Kept out of line: spheres are rare, and
-    /// inlined, their set-up (in `f64`) is hoisted to the start of every traversal.
+    /// The leaf slot of the nearest shape among lanes `shapes` of block `b` that `ray` hits
+    /// within its extent, shortening `ray.t_max` to it. Kept out of line: other shapes are
+    /// rare, and inlined, a sphere's set-up (in `f64`) is hoisted to the start of every
+    /// traversal.
     #[cold]
     #[inline(never)]
-    fn nearest_sphere(&self, b: usize, mut spheres: u32, ray: &mut Ray) -> Option<u32> {
+    fn nearest_shape(&self, b: usize, mut shapes: u32, ray: &mut Ray) -> Option<u32> {
         let mut nearest = None;
-        while spheres != 0 {
-            let lane = spheres.trailing_zeros() as usize;
-            spheres &= spheres - 1;
+        while shapes != 0 {
+            let lane = shapes.trailing_zeros() as usize;
+            shapes &= shapes - 1;
             let slot = self.block_info[b].slots[lane];
-            if let Some(t) = self.sphere_at(slot).intersect(ray) {
+            if let Some(t) = self.shape_hit(slot, ray) {
                 ray.t_max = t;
                 nearest = Some(slot);
             }
@@ -192,17 +198,16 @@ impl Scene {
         nearest
     }
 
-    /// Whether `ray` hits any sphere among lanes `spheres` of block `b` within its extent
-    /// (out of line, as [`Scene::nearest_sphere`]).
+    /// Whether `ray` hits any shape among lanes `shapes` of block `b` within its extent
+    /// (out of line, as [`Scene::nearest_shape`]).
     #[cold]
     #[inline(never)]
-    fn hits_sphere(&self, b: usize, mut spheres: u32, ray: &Ray) -> bool {
-        while spheres != 0 {
-            let lane = spheres.trailing_zeros() as usize;
-            spheres &= spheres - 1;
+    fn hits_shape(&self, b: usize, mut shapes: u32, ray: &Ray) -> bool {
+        while shapes != 0 {
+            let lane = shapes.trailing_zeros() as usize;
+            shapes &= shapes - 1;
             if self
-                .sphere_at(self.block_info[b].slots[lane])
-                .intersect(ray)
+                .shape_hit(self.block_info[b].slots[lane], ray)
                 .is_some()
             {
                 return true;
@@ -213,9 +218,9 @@ impl Scene {
 
     /// Whether the scene is small enough to intersect rays by testing every triangle
     /// ([`Scene::nearest_of_rays`]): at most [`SMALL_SCENE_BLOCKS`] blocks of triangles, seen
-    /// by every ray, and no spheres.
+    /// by every ray, and no other shapes.
     pub(crate) fn tests_all_triangles(&self) -> bool {
-        self.all_visible && self.spheres.is_empty() && self.blocks.len() <= SMALL_SCENE_BLOCKS
+        self.all_visible && self.only_triangles && self.blocks.len() <= SMALL_SCENE_BLOCKS
     }
 
     /// The nearest hits of eight rays ending at `t_max`, by testing every triangle against
@@ -273,9 +278,9 @@ impl Scene {
         self.bvh.occluded_leaves_with(boxes, ray, |leaf, r| {
             let (first, count) = Bvh8::leaf_range(leaf);
             (first as usize..(first + count) as usize).any(|b| {
-                let (triangles, spheres) = self.block_lanes(b, camera);
+                let (triangles, shapes) = self.block_lanes(b, camera);
                 self.blocks[b].hits(r, triangles) != 0
-                    || (spheres != 0 && self.hits_sphere(b, spheres, r))
+                    || (shapes != 0 && self.hits_shape(b, shapes, r))
             })
         })
     }
@@ -301,7 +306,7 @@ pub(super) fn leaf_blocks(
             let chunk = chunk_start..(chunk_start + LANES as u32).min(start + count);
             let mut lanes = BlockInfo {
                 slots: [u32::MAX; LANES],
-                spheres: 0,
+                shapes: 0,
                 camera: 0,
                 indirect: 0,
             };
@@ -310,7 +315,7 @@ pub(super) fn leaf_blocks(
                 lanes.slots[lane] = slot;
                 match prims[slot as usize] {
                     Prim::Triangle(t) => tris[lane] = triangles[t as usize],
-                    Prim::Sphere(_) => lanes.spheres |= 1 << lane,
+                    Prim::Sphere(_) | Prim::Voxel(_) => lanes.shapes |= 1 << lane,
                 }
                 let v = visibility[slot as usize];
                 lanes.camera |= u8::from(v.camera) << lane;
@@ -329,6 +334,7 @@ mod tests {
     use super::*;
     use crate::desc::{MeshDesc, SceneDesc};
     use crate::scene::diffuse;
+    use crate::shape::Sphere;
 
     /// Nearest distance along `ray` by testing every shape the ray kind sees.
     fn brute_force(desc: &SceneDesc, ray: &Ray, camera: bool) -> Option<f32> {
@@ -362,13 +368,43 @@ mod tests {
                 best = Some(t);
             }
         }
+        for g in &desc.sdf_grids {
+            let grid = crate::sdf_grid::SdfGrid::new(g).unwrap();
+            for (corner, _) in grid.occupied_voxels(&g.to_world) {
+                if let Some(t) = grid.intersect_voxel(corner, &r) {
+                    r.t_max = t;
+                    best = Some(t);
+                }
+            }
+        }
         best
+    }
+
+    /// A torus's signed distance sampled on an `n`³ grid over the unit cube.
+    fn torus_grid(n: u32, to_world: glam::Affine3A) -> crate::desc::SdfGridDesc {
+        let mut values = Vec::new();
+        for z in 0..n {
+            for y in 0..n {
+                for x in 0..n {
+                    let p = Vec3::new(x as f32, y as f32, z as f32) / (n - 1) as f32 - 0.5;
+                    let ring = glam::Vec2::new(glam::Vec2::new(p.x, p.z).length() - 0.3, p.y);
+                    values.push(ring.length() - 0.1);
+                }
+            }
+        }
+        crate::desc::SdfGridDesc {
+            values,
+            resolution: [n; 3],
+            to_world,
+            smooth_normals: true,
+            material: 0,
+        }
     }
 
     #[test]
     fn simd_traversal_finds_what_testing_every_shape_finds() {
-        // Two triangle soups (one hidden from camera rays) and spheres among them, so that
-        // blocks mix triangles, spheres and visibilities.
+        // Two triangle soups (one hidden from camera rays), spheres and SDF grids among them,
+        // so that blocks mix triangles, other shapes and visibilities.
         let mut rng = pathlab_mc::rng::Pcg32::new(21, 3);
         let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
         let soup = |point: &mut dyn FnMut() -> Vec3, n: usize, visibility| {
@@ -403,6 +439,17 @@ mod tests {
                     ..Default::default()
                 })
                 .collect(),
+            sdf_grids: vec![
+                torus_grid(
+                    24,
+                    glam::Affine3A::from_scale_rotation_translation(
+                        Vec3::new(3.0, 2.0, 2.5),
+                        glam::Quat::from_rotation_y(0.7),
+                        Vec3::new(4.0, 5.0, 3.0),
+                    ),
+                ),
+                torus_grid(16, glam::Affine3A::from_translation(Vec3::splat(6.0))),
+            ],
             materials: vec![diffuse(Vec3::ONE, false)],
             resolution: [4, 4],
             ..Default::default()

@@ -19,6 +19,7 @@ mod sensors;
 pub mod serialized;
 mod shapes;
 mod textures;
+pub mod volume;
 
 use crate::spectrum::{constant_to_rgb, sampled_to_rgb, SpectrumKind};
 use crate::Error;

@@ -1,5 +1,6 @@
 //! Mitsuba shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `disk`,
-//! `cylinder`, `sphere`, and `shapegroup` + `instance` (flattened into world space).
+//! `cylinder`, `sphere`, `sdfgrid`, and `shapegroup` + `instance` (flattened into world
+//! space).
 
 use super::{emitters, Ctx, Obj};
 use crate::meshfile;
@@ -115,11 +116,12 @@ pub(super) fn shape(
         "cylinder" => cylinder(ctx, s)?,
         "obj" | "ply" | "serialized" => {
             let path = ctx.file(s, "filename")?;
-            let serialized = s.plugin == "serialized";
-            let flip_uv = if serialized {
-                true
-            } else {
-                ctx.boolean(s, "flip_tex_coords", true)?
+            // Mitsuba flips an OBJ file's v unless told not to (`flip_tex_coords`), keeps a
+            // PLY file's as it is, and stores a serialized mesh's in its own convention.
+            let flip_uv = match s.plugin {
+                "obj" => ctx.boolean(s, "flip_tex_coords", true)?,
+                "ply" => false,
+                _ => true,
             };
             let face_normals = ctx.boolean(s, "face_normals", false)?;
             let mut meshes = match s.plugin {
@@ -137,8 +139,8 @@ pub(super) fn shape(
             }
             .map_err(|e| ctx.file_error(s, "filename", e))?;
             for mesh in &mut meshes {
-                // OBJ and PLY (u, v) are pathlab's as they are; Mitsuba flips v on reading
-                // them unless told not to, which then means pathlab's v is flipped.
+                // The readers give a file's (u, v) as they are, which is pathlab's convention
+                // where Mitsuba flips v on reading; where it does not, pathlab's v is flipped.
                 if !flip_uv {
                     for uv in &mut mesh.uvs {
                         uv.y = 1.0 - uv.y;
@@ -158,16 +160,7 @@ pub(super) fn shape(
             }
             return Ok(());
         }
-        "sdfgrid" => {
-            let what = ctx.what(s);
-            ctx.warn(
-                s.loc,
-                format!("{what} is not supported by pathlab yet; skipped"),
-            );
-            ctx.accept(s, &["filename", "normals", "grid"]);
-            let _ = surface(ctx, s, m)?;
-            return Ok(());
-        }
+        "sdfgrid" => return sdf_grid(ctx, s, m, flip),
         other => {
             let what = ctx.what(s);
             ctx.warn(
@@ -304,6 +297,50 @@ fn sphere(ctx: &mut Ctx, s: Obj, m: DMat4, flip: bool) -> Result<(), Error> {
     Ok(())
 }
 
+/// Mitsuba's `sdfgrid`: a signed distance grid from a `.vol` file over the object-space unit
+/// cube.
+fn sdf_grid(ctx: &mut Ctx, s: Obj, m: DMat4, flip: bool) -> Result<(), Error> {
+    let path = ctx.file(s, "filename")?;
+    let smooth = ctx.choice(s, "normals", &["smooth", "analytic"])? == "smooth";
+    let grid = super::volume::load(&path).map_err(|e| ctx.file_error(s, "filename", e))?;
+    if grid.resolution.iter().any(|&n| n < 2) {
+        let [x, y, z] = grid.resolution;
+        return Err(ctx.error(
+            s.loc,
+            format!("<shape type=\"sdfgrid\">: a grid needs at least 2 samples per axis, the file has {x} x {y} x {z}"),
+        ));
+    }
+    if flip {
+        ctx.warn(
+            s.loc,
+            "<shape type=\"sdfgrid\">: flip_normals is not supported on SDF grids; ignored",
+        );
+    }
+    let surface = surface(ctx, s, m)?;
+    if surface.emission.is_some() {
+        ctx.warn(
+            s.loc,
+            "<shape type=\"sdfgrid\"> cannot be an area emitter (as in Mitsuba); its emitter is skipped",
+        );
+    }
+    let to_world = glam::Affine3A::from_mat4(super::mat4(m));
+    let det = to_world.matrix3.determinant();
+    if det == 0.0 || !det.is_finite() {
+        return Err(ctx.error(
+            s.loc,
+            "<shape type=\"sdfgrid\">: to_world is not invertible",
+        ));
+    }
+    ctx.desc.sdf_grids.push(SdfGridDesc {
+        values: grid.values,
+        resolution: grid.resolution,
+        to_world,
+        smooth_normals: smooth,
+        material: surface.material,
+    });
+    Ok(())
+}
+
 /// Mitsuba's `rectangle`: [-1, 1]² in the xy plane facing +z, (u, v) over the unit square
 /// (pathlab's v = 1 - Mitsuba's).
 fn rectangle() -> MeshDesc {
@@ -327,30 +364,65 @@ fn rectangle() -> MeshDesc {
     }
 }
 
-/// Mitsuba's `cube`: [-1, 1]³, each face its own four vertices with outward normals and
-/// (u, v) over the unit square.
+/// Mitsuba's `cube`: [-1, 1]³, each face its own four vertices with outward normals, laid
+/// out as Mitsuba lays them out (which corner of a face gets which (u, v) decides where a
+/// texture lands).
 fn cube() -> MeshDesc {
+    // Per face: its outward normal and its corners in order; the corners take Mitsuba's
+    // (u, v) = (0, 1), (1, 1), (1, 0), (0, 0), and the triangles (0, 1, 2) and (3, 0, 2).
+    const FACES: [([f32; 3], [[f32; 3]; 4]); 6] = [
+        (
+            [0., -1., 0.],
+            [
+                [1., -1., -1.],
+                [1., -1., 1.],
+                [-1., -1., 1.],
+                [-1., -1., -1.],
+            ],
+        ),
+        (
+            [0., 1., 0.],
+            [[1., 1., -1.], [-1., 1., -1.], [-1., 1., 1.], [1., 1., 1.]],
+        ),
+        (
+            [1., 0., 0.],
+            [[1., -1., -1.], [1., 1., -1.], [1., 1., 1.], [1., -1., 1.]],
+        ),
+        (
+            [0., 0., 1.],
+            [[1., -1., 1.], [1., 1., 1.], [-1., 1., 1.], [-1., -1., 1.]],
+        ),
+        (
+            [-1., 0., 0.],
+            [
+                [-1., -1., 1.],
+                [-1., 1., 1.],
+                [-1., 1., -1.],
+                [-1., -1., -1.],
+            ],
+        ),
+        (
+            [0., 0., -1.],
+            [
+                [1., 1., -1.],
+                [1., -1., -1.],
+                [-1., -1., -1.],
+                [-1., 1., -1.],
+            ],
+        ),
+    ];
+    // Mitsuba's v grows downwards; pathlab's is 1 - that.
+    const UVS: [[f32; 2]; 4] = [[0., 0.], [1., 0.], [1., 1.], [0., 1.]];
     let mut mesh = MeshDesc::default();
-    for axis in 0..3 {
-        for sign in [-1.0f32, 1.0] {
-            let n = Vec3::AXES[axis] * sign;
-            let (u, v) = (Vec3::AXES[(axis + 1) % 3], Vec3::AXES[(axis + 2) % 3]);
-            let base = mesh.positions.len() as u32;
-            for (a, b) in [(-1.0f32, -1.0f32), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                mesh.positions.push(n + a * u + b * v);
-                mesh.normals.push(n);
-                mesh.uvs.push(Vec2::new(0.5 * (a + 1.0), 0.5 * (1.0 - b)));
-                mesh.tangents.push(u);
-            }
-            // u × v = n for sign +1; flip for the negative face so that the front faces out.
-            if sign > 0.0 {
-                mesh.indices
-                    .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-            } else {
-                mesh.indices
-                    .extend([base, base + 2, base + 1, base, base + 3, base + 2]);
-            }
+    for (normal, corners) in FACES {
+        let base = mesh.positions.len() as u32;
+        for (corner, uv) in corners.iter().zip(UVS) {
+            mesh.positions.push(Vec3::from_array(*corner));
+            mesh.normals.push(Vec3::from_array(normal));
+            mesh.uvs.push(Vec2::from_array(uv));
         }
+        mesh.indices
+            .extend([base, base + 1, base + 2, base + 3, base, base + 2]);
     }
     mesh
 }
@@ -394,9 +466,9 @@ fn cylinder(ctx: &mut Ctx, s: Obj) -> Result<MeshDesc, Error> {
             "<shape type=\"cylinder\">: p0 and p1 are the same point",
         ));
     }
+    // Mitsuba's frame around the axis (Duff et al.'s basis), from which φ is measured.
     let n_axis = axis.normalize();
-    let t1 = n_axis.any_orthonormal_vector();
-    let t2 = n_axis.cross(t1);
+    let (t1, t2) = n_axis.any_orthonormal_pair();
     let frame = DMat4::from_cols(
         (t1 * radius).extend(0.0),
         (t2 * radius).extend(0.0),
