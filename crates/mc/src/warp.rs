@@ -9,6 +9,11 @@
 //! Directions are in a local frame whose z axis is the pole (the shading normal for
 //! hemispheres, the cone axis for cones); θ is measured from +z and φ around it from +x.
 //!
+//! The warps a renderer's inner loop draws from (the concentric disk, the cosine-weighted
+//! hemisphere, the triangle, the orthonormal basis) are written once over
+//! [`crate::lanes::Real`]: `sample_x(u)` is their one-value form, and code that samples eight
+//! directions at once calls the same function on lanes, to the same bits.
+//!
 //! ```
 //! use glam::Vec2;
 //! use pathlab_mc::warp::{sample_cosine_hemisphere, cosine_hemisphere_pdf};
@@ -18,6 +23,7 @@
 //! assert!((cosine_hemisphere_pdf(w.z) - w.z / std::f32::consts::PI).abs() < 1e-7);
 //! ```
 
+use crate::lanes::{Real, Vector3};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
@@ -46,21 +52,27 @@ fn phi_fraction(y: f32, x: f32) -> f32 {
 /// concentric squares go to concentric circles, so strata stay compact.
 #[inline]
 pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
-    let uo = 2.0 * u - Vec2::ONE;
-    if uo.x == 0.0 && uo.y == 0.0 {
-        return Vec2::ZERO;
-    }
-    // θ = π/4 (y/x) in the wedges where |x| ≥ |y|, θ = π/2 - π/4 (x/y) in the others, whose
+    let (x, y) = uniform_disk_concentric(u.x, u.y);
+    Vec2::new(x, y)
+}
+
+/// [`sample_uniform_disk_concentric`] for one value or for lanes: the point (x, y) of the disk
+/// for (u₀, u₁).
+#[inline(always)]
+pub fn uniform_disk_concentric<T: Real>(u0: T, u1: T) -> (T, T) {
+    let (zero, one, two) = (T::splat(0.0), T::splat(1.0), T::splat(2.0));
+    let ux = two * u0 - one;
+    let uy = two * u1 - one;
+    let centre = ux.equals(zero) & uy.equals(zero);
+    // θ = π/4 (y/x) in the wedges where |x| > |y|, θ = π/2 - π/4 (x/y) in the others, whose
     // cosine and sine are the sine and cosine of π/4 (x/y).
-    let x_wedge = uo.x.abs() > uo.y.abs();
-    let (r, t) = if x_wedge {
-        (uo.x, uo.y / uo.x)
-    } else {
-        (uo.y, uo.x / uo.y)
-    };
-    let (sin, cos) = sin_cos_quarter_turn(t);
-    let (c, s) = if x_wedge { (cos, sin) } else { (sin, cos) };
-    r * Vec2::new(c, s)
+    let x_wedge = ux.abs().gt(uy.abs());
+    let r = T::select(x_wedge, ux, uy);
+    let ratio = T::select(x_wedge, uy / ux, ux / uy);
+    let (sin, cos) = sin_cos_quarter_turn(ratio);
+    let x = T::select(centre, zero, r * T::select(x_wedge, cos, sin));
+    let y = T::select(centre, zero, r * T::select(x_wedge, sin, cos));
+    (x, y)
 }
 
 /// (sin a, cos a) for a = π/4 · t with t in [-1, 1]: the angles of the concentric map, which
@@ -68,9 +80,9 @@ pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
 /// |a| ≤ π/4 are below (π/4)¹¹/11! ≈ 2e-9 and (π/4)¹²/12! ≈ 1e-10, far under f32's rounding;
 /// the results are within two ulps of sin and cos of π/4 · t (1.95 and 1.64 at worst over
 /// every f32 in [0, 1], and symmetric for negative t; a test checks a grid). Plain arithmetic,
-/// so that code sampling several directions at once in SIMD lanes computes the same bits.
+/// for one value or for lanes.
 #[inline(always)]
-pub fn sin_cos_quarter_turn(t: f32) -> (f32, f32) {
+pub fn sin_cos_quarter_turn<T: Real>(t: T) -> (T, T) {
     const S: [f32; 4] = [-1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362_880.0];
     const C: [f32; 5] = [
         -1.0 / 2.0,
@@ -79,10 +91,12 @@ pub fn sin_cos_quarter_turn(t: f32) -> (f32, f32) {
         1.0 / 40_320.0,
         -1.0 / 3_628_800.0,
     ];
-    let a = FRAC_PI_4 * t;
+    let k = |c: f32| T::splat(c);
+    let a = k(FRAC_PI_4) * t;
     let a2 = a * a;
-    let sin = a + a * a2 * (S[0] + a2 * (S[1] + a2 * (S[2] + a2 * S[3])));
-    let cos = 1.0 + a2 * (C[0] + a2 * (C[1] + a2 * (C[2] + a2 * (C[3] + a2 * C[4]))));
+    let sin = a + a * a2 * (k(S[0]) + a2 * (k(S[1]) + a2 * (k(S[2]) + a2 * k(S[3]))));
+    let cos =
+        k(1.0) + a2 * (k(C[0]) + a2 * (k(C[1]) + a2 * (k(C[2]) + a2 * (k(C[3]) + a2 * k(C[4])))));
     (sin, cos)
 }
 
@@ -151,15 +165,21 @@ pub fn invert_uniform_hemisphere_sample(w: Vec3) -> Vec2 {
 /// point of the disk, lifted to the hemisphere).
 #[inline]
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = sample_uniform_disk_concentric(u);
-    let z = safe_sqrt(1.0 - d.x * d.x - d.y * d.y);
-    Vec3::new(d.x, d.y, z)
+    cosine_hemisphere(u.x, u.y)
+}
+
+/// [`sample_cosine_hemisphere`] for one value or for lanes.
+#[inline(always)]
+pub fn cosine_hemisphere<T: Real>(u0: T, u1: T) -> T::V3 {
+    let (x, y) = uniform_disk_concentric(u0, u1);
+    let z = (T::splat(1.0) - x * x - y * y).max(T::splat(0.0)).sqrt();
+    T::V3::new(x, y, z)
 }
 
 /// Density of [`sample_cosine_hemisphere`] per unit solid angle: cos θ / π (0 below the horizon).
-#[inline]
-pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
-    cos_theta.max(0.0) * FRAC_1_PI
+#[inline(always)]
+pub fn cosine_hemisphere_pdf<T: Real>(cos_theta: T) -> T {
+    cos_theta.max(T::splat(0.0)) * T::splat(FRAC_1_PI)
 }
 
 /// The `u` that [`sample_cosine_hemisphere`] maps to `w`.
@@ -224,10 +244,17 @@ pub fn invert_uniform_cone_sample(w: Vec3, cos_theta_max: f32) -> Vec2 {
 /// `b₀ p₀ + b₁ p₁ + b₂ p₂`).
 #[inline]
 pub fn sample_uniform_triangle(u: Vec2) -> [f32; 3] {
-    let su0 = u.x.sqrt();
-    let b0 = 1.0 - su0;
-    let b1 = u.y * su0;
-    [b0, b1, (1.0 - b0 - b1).max(0.0)]
+    uniform_triangle(u.x, u.y)
+}
+
+/// [`sample_uniform_triangle`] for one value or for lanes.
+#[inline(always)]
+pub fn uniform_triangle<T: Real>(u0: T, u1: T) -> [T; 3] {
+    let one = T::splat(1.0);
+    let su0 = u0.sqrt();
+    let b0 = one - su0;
+    let b1 = u1 * su0;
+    [b0, b1, (one - b0 - b1).max(T::splat(0.0))]
 }
 
 /// Density of [`sample_uniform_triangle`] per unit area of a triangle of `area`: 1/area.
@@ -249,15 +276,17 @@ pub fn invert_uniform_triangle_sample(b: [f32; 3]) -> Vec2 {
 // Frames
 
 /// Two unit vectors completing `n` (unit) to a right-handed orthonormal basis (Duff et al.,
-/// "Building an Orthonormal Basis, Revisited", JCGT 2017).
-#[inline]
-pub fn coordinate_system(n: Vec3) -> (Vec3, Vec3) {
-    let sign = 1.0f32.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
+/// "Building an Orthonormal Basis, Revisited", JCGT 2017); for one vector or for lanes.
+#[inline(always)]
+pub fn coordinate_system<V: Vector3>(n: V) -> (V, V) {
+    let (x, y, z) = (n.x(), n.y(), n.z());
+    let one = V::R::splat(1.0);
+    let sign = z.sign_one();
+    let a = V::R::splat(-1.0) / (sign + z);
+    let b = x * y * a;
     (
-        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        Vec3::new(b, sign + n.y * n.y * a, -n.y),
+        V::new(one + sign * x * x * a, sign * b, -sign * x),
+        V::new(b, sign + y * y * a, -y),
     )
 }
 

@@ -2,6 +2,7 @@
 //! surface they leave.
 
 use glam::Vec3;
+use pathlab_mc::lanes::{Real, Vector3};
 
 /// A ray `o + t d` for `t` in `(t_min, t_max)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -132,34 +133,38 @@ impl Aabb {
     }
 }
 
-/// An orthonormal frame: local z is the normal.
+/// An orthonormal frame: local z is the normal. `V` is glam's `Vec3`, or [`V8`] for the
+/// frames of eight lanes.
+///
+/// [`V8`]: crate::lanes::V8
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Frame {
+pub struct Frame<V = Vec3> {
     /// Local x.
-    pub s: Vec3,
+    pub s: V,
     /// Local y.
-    pub t: Vec3,
+    pub t: V,
     /// Local z, the normal.
-    pub n: Vec3,
+    pub n: V,
 }
 
-impl Frame {
+impl<V: Vector3> Frame<V> {
     /// A frame around the unit normal `n`.
-    pub fn from_normal(n: Vec3) -> Self {
+    #[inline(always)]
+    pub fn from_normal(n: V) -> Self {
         let (s, t) = pathlab_mc::warp::coordinate_system(n);
         Frame { s, t, n }
     }
 
     /// World → local.
-    #[inline]
-    pub fn to_local(&self, v: Vec3) -> Vec3 {
-        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    #[inline(always)]
+    pub fn to_local(&self, v: V) -> V {
+        V::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
     }
 
     /// Local → world.
-    #[inline]
-    pub fn to_world(&self, v: Vec3) -> Vec3 {
-        v.x * self.s + v.y * self.t + v.z * self.n
+    #[inline(always)]
+    pub fn to_world(&self, v: V) -> V {
+        self.s.scale(v.x()) + self.t.scale(v.y()) + self.n.scale(v.z())
     }
 }
 
@@ -169,15 +174,14 @@ pub const RAY_EPSILON: f32 = 1e-4;
 /// A point moved off a surface along its geometric normal `ng`, to the side of `w`, by
 /// `RAY_EPSILON` times the point's magnitude (at least `RAY_EPSILON`): enough to clear the
 /// rounding error of single-precision intersection at that magnitude, small against scene
-/// features.
-#[inline]
-pub fn offset_ray_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
-    let eps = RAY_EPSILON * (1.0 + p.abs().max_element());
-    if w.dot(ng) >= 0.0 {
-        p + eps * ng
-    } else {
-        p - eps * ng
-    }
+/// features. For one point or for lanes.
+#[inline(always)]
+pub fn offset_ray_origin<V: Vector3>(p: V, ng: V, w: V) -> V {
+    let one = V::R::splat(1.0);
+    let eps = V::R::splat(RAY_EPSILON) * (one + p.abs().max_element());
+    let step = ng.scale(eps);
+    // `w · ng >= 0`, false for NaN.
+    V::select(V::R::splat(0.0).le(w.dot(ng)), p + step, p - step)
 }
 
 /// A ray leaving surface point `p` (geometric normal `ng`) in direction `w`.

@@ -5,12 +5,13 @@
 use crate::desc::{ProjectorKind, Rgb};
 use crate::envmap::EnvironmentMap;
 use crate::geometry::Aabb;
-use crate::shape::{ShapeSample, Sphere, Triangle};
+use crate::shape::{Sphere, Triangle};
 use crate::texture::{Tex, TexPoint};
 use glam::{Mat3, Vec2, Vec3};
 use pathlab_mc::distribution::AliasTable;
+use pathlab_mc::lanes::{Real, Vector3, F8, M8, V8};
 use pathlab_mc::warp::{
-    sample_uniform_sphere, sample_uniform_triangle, uniform_sphere_pdf, uniform_triangle_pdf,
+    sample_uniform_sphere, uniform_sphere_pdf, uniform_triangle, uniform_triangle_pdf,
 };
 use std::f32::consts::PI;
 use std::sync::Arc;
@@ -49,20 +50,115 @@ impl AreaTriangle {
         }
     }
 
-    /// A point uniform over the triangle and its barycentrics: [`Triangle::sample`] without
-    /// recomputing the normal and area (the same values to the bit).
+    /// The triangle as a [`TriangleEmitter`] of `radiance`.
     #[inline]
-    fn sample_barycentric(&self, u: Vec2) -> (ShapeSample, [f32; 3]) {
-        let b = sample_uniform_triangle(u);
-        let p = &self.triangle.p;
-        (
-            ShapeSample {
-                p: b[0] * p[0] + b[1] * p[1] + b[2] * p[2],
-                n: self.normal,
-                pdf_area: self.pdf_area,
-            },
+    pub fn emitter(&self, radiance: Rgb, two_sided: bool) -> TriangleEmitter<Vec3> {
+        TriangleEmitter {
+            vertices: self.triangle.p,
+            normal: self.normal,
+            pdf_area: self.pdf_area,
+            radiance,
+            two_sided,
+        }
+    }
+}
+
+/// An emitting triangle of uniform radiance, for light sampling at one point or at eight
+/// lanes' points ([`Vector3`] is `Vec3` or [`crate::lanes::V8`]): the one implementation of a
+/// triangle's light sample.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleEmitter<V: Vector3> {
+    /// The corners.
+    pub vertices: [V; 3],
+    /// The unit normal (the winding's side).
+    pub normal: V,
+    /// Density per unit area of a uniform point (1 / area).
+    pub pdf_area: V::R,
+    /// Emitted radiance.
+    pub radiance: V,
+    /// Whether it emits from both sides.
+    pub two_sided: <V::R as Real>::Mask,
+}
+
+/// A light sample of a [`TriangleEmitter`] from a reference point.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleLiSample<V: Vector3> {
+    /// The point on the triangle.
+    pub p_light: V,
+    /// Its barycentrics.
+    pub b: [V::R; 3],
+    /// Squared distance to it (a sample at distance zero does not exist).
+    pub dist2: V::R,
+    /// Unit direction towards it.
+    pub wi: V,
+    /// |cos| at the light (a sample seen edge-on does not exist).
+    pub abs_cos_light: V::R,
+    /// Whether the triangle emits towards the reference point.
+    pub emits: <V::R as Real>::Mask,
+    /// Radiance arriving along `wi` (zero where it does not emit).
+    pub li: V,
+    /// Density per unit solid angle.
+    pub pdf: V::R,
+}
+
+impl Default for TriangleEmitter<V8> {
+    fn default() -> Self {
+        TriangleEmitter {
+            vertices: [V8::default(); 3],
+            normal: V8::default(),
+            pdf_area: F8::default(),
+            radiance: V8::default(),
+            two_sided: M8::default(),
+        }
+    }
+}
+
+impl TriangleEmitter<V8> {
+    /// Sets lane `i` to `e`. Every field is taken apart here: a field added to
+    /// [`TriangleEmitter`] fails to compile until its lanes are set too.
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, e: TriangleEmitter<Vec3>) {
+        let TriangleEmitter {
+            vertices,
+            normal,
+            pdf_area,
+            radiance,
+            two_sided,
+        } = e;
+        for (lanes, v) in self.vertices.iter_mut().zip(vertices) {
+            lanes.set(i, v);
+        }
+        self.normal.set(i, normal);
+        self.pdf_area.0[i] = pdf_area;
+        self.radiance.set(i, radiance);
+        self.two_sided.set(i, two_sided);
+    }
+}
+
+impl<V: Vector3> TriangleEmitter<V> {
+    /// A point uniform over the triangle from `u`, as seen from `p`.
+    #[inline(always)]
+    pub fn sample_li(&self, p: V, u0: V::R, u1: V::R) -> TriangleLiSample<V> {
+        let zero = V::R::splat(0.0);
+        let b = uniform_triangle(u0, u1);
+        let [v0, v1, v2] = self.vertices;
+        let p_light = v0.scale(b[0]) + v1.scale(b[1]) + v2.scale(b[2]);
+        let to_light = p_light - p;
+        let dist2 = to_light.dot(to_light);
+        let wi = to_light.div_by(dist2.sqrt());
+        let cos_light = self.normal.dot(-wi);
+        let emits = cos_light.gt(zero) | (self.two_sided & cos_light.lt(zero));
+        let abs_cos_light = cos_light.abs();
+        TriangleLiSample {
+            p_light,
             b,
-        )
+            dist2,
+            wi,
+            abs_cos_light,
+            emits,
+            li: V::select(emits, self.radiance, V::splat(Vec3::ZERO)),
+            pdf: self.pdf_area * dist2 / abs_cos_light,
+        }
     }
 }
 
@@ -333,7 +429,28 @@ impl Light {
                 two_sided,
             } => {
                 let (s, b) = match shape {
-                    AreaShape::Triangle(t) => t.sample_barycentric(u),
+                    AreaShape::Triangle(t) => {
+                        let s = t.emitter(radiance, two_sided).sample_li(p, u.x, u.y);
+                        if s.dist2 == 0.0 || s.abs_cos_light == 0.0 {
+                            return None;
+                        }
+                        let li = match texture {
+                            None => s.li,
+                            Some(tex) if s.emits => {
+                                radiance
+                                    * tex.tex.eval(&TexPoint::uv(tex.uv(&shape, s.p_light, s.b)))
+                            }
+                            Some(_) => Rgb::ZERO,
+                        };
+                        return Some(LightLiSample {
+                            li,
+                            wi: s.wi,
+                            pdf: s.pdf,
+                            p_light: s.p_light,
+                            n_light: Some(t.normal),
+                            is_delta: false,
+                        });
+                    }
                     AreaShape::Sphere(sph) => (sph.sample(u), [0.0; 3]),
                 };
                 let to_light = s.p - p;
@@ -610,17 +727,32 @@ mod tests {
     use pathlab_mc::rng::Pcg32;
 
     #[test]
-    fn area_triangles_sample_as_their_triangles_do() {
+    fn triangle_light_samples_lie_on_the_triangle_with_the_density_pdf_li_gives() {
         let mut rng = Pcg32::new(4, 4);
         let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
         for _ in 0..1000 {
             let triangle = Triangle {
                 p: [point(), point() * 3.0, point() - 2.0],
             };
-            let light = AreaTriangle::new(triangle);
-            let u = point().truncate();
-            assert_eq!(light.sample_barycentric(u).0, triangle.sample(u));
-            assert_eq!(light.area, triangle.area());
+            let area = AreaTriangle::new(triangle);
+            assert_eq!(area.area, triangle.area());
+            let light = Light::Area {
+                shape: AreaShape::Triangle(area),
+                radiance: Vec3::ONE,
+                two_sided: true,
+                texture: None,
+            };
+            let (p, u) = (point() * 4.0 + Vec3::splat(3.0), point().truncate());
+            let s = area.emitter(Vec3::ONE, true).sample_li(p, u.x, u.y);
+            let [a, b, c] = triangle.p;
+            let expected = s.b[0] * a + s.b[1] * b + s.b[2] * c;
+            assert!((s.p_light - expected).length() < 1e-5);
+            assert!((s.b.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+            assert!(s.b.iter().all(|&x| x >= 0.0));
+            let pdf = light.pdf_li(p, s.wi, s.p_light, area.normal);
+            assert!((s.pdf - pdf).abs() <= 1e-4 * pdf, "{} vs {pdf}", s.pdf);
+            let ls = light.sample_li(p, u).unwrap();
+            assert_eq!((ls.pdf, ls.wi, ls.p_light), (s.pdf, s.wi, s.p_light));
         }
     }
 }

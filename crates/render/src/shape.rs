@@ -2,7 +2,7 @@
 
 use crate::geometry::{Aabb, Ray};
 use glam::{Vec2, Vec3};
-use pathlab_mc::warp::{sample_uniform_sphere, sample_uniform_triangle};
+use pathlab_mc::warp::sample_uniform_sphere;
 use std::f32::consts::PI;
 
 /// A triangle's vertices.
@@ -78,16 +78,6 @@ impl Triangle {
         }
         let t = e2.dot(qvec) * inv_det;
         (t > ray.t_min && t < ray.t_max).then_some(TriangleHit { t, b1, b2 })
-    }
-
-    /// A point uniform over the triangle.
-    pub fn sample(&self, u: Vec2) -> ShapeSample {
-        let b = sample_uniform_triangle(u);
-        ShapeSample {
-            p: b[0] * self.p[0] + b[1] * self.p[1] + b[2] * self.p[2],
-            n: self.normal(),
-            pdf_area: 1.0 / self.area(),
-        }
     }
 }
 

@@ -234,12 +234,12 @@ impl Material {
 
     /// The reflectance and sidedness of a plain (untextured) Lambertian material.
     #[inline]
-    pub fn as_lambertian(&self) -> Option<(Rgb, bool)> {
+    pub fn as_lambertian(&self) -> Option<(Diffuse, bool)> {
         match self {
             Material::Leaf(Leaf {
                 model: Model::Fixed(Bxdf::Diffuse(d)),
                 two_sided,
-            }) => Some((d.reflectance, *two_sided)),
+            }) => Some((*d, *two_sided)),
             _ => None,
         }
     }

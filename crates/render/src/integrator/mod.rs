@@ -21,6 +21,7 @@ use crate::desc::Rgb;
 use crate::geometry::{offset_ray_origin, spawn_ray_to, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::{Vec2, Vec3};
+use pathlab_mc::lanes::Real;
 use pathlab_mc::sampler::{AnySampler, Sampler};
 
 /// Counters an integrator keeps while it works.
@@ -187,17 +188,21 @@ pub(crate) fn trace(
 /// against `ng` samples of density `g_pdf`.
 #[inline]
 pub fn power_heuristic(nf: u32, f_pdf: f32, ng: u32, g_pdf: f32) -> f32 {
-    let f = nf as f32 * f_pdf;
-    let g = ng as f32 * g_pdf;
-    if f.is_infinite() {
-        return 1.0;
-    }
+    power_heuristic_weight(nf as f32 * f_pdf, ng as f32 * g_pdf)
+}
+
+/// The power heuristic's weight f² / (f² + g²) of a strategy with (sample count times)
+/// density `f` against one with `g`: one for an infinite `f` (a delta), zero where both
+/// vanish. For one value or for lanes.
+#[inline(always)]
+pub fn power_heuristic_weight<T: Real>(f: T, g: T) -> T {
+    let (zero, one) = (T::splat(0.0), T::splat(1.0));
     let (f2, g2) = (f * f, g * g);
-    if f2 + g2 == 0.0 {
-        0.0
-    } else {
-        f2 / (f2 + g2)
-    }
+    T::select(
+        f.is_infinite(),
+        one,
+        T::select((f2 + g2).equals(zero), zero, f2 / (f2 + g2)),
+    )
 }
 
 /// A light sample's contribution f · Li · |cos θi| / p at a surface point, weighted by MIS

@@ -1,10 +1,15 @@
 //! Path tracing eight paths at a time: each lane follows one pixel sample, and a lane whose
 //! path ends takes the next sample at once, so the lanes stay busy. Rays are traced one lane
 //! after another through the BVH (its own SIMD traversal), or, in scenes of a few dozen
-//! triangles, all eight against every triangle at once; the scattering at diffuse surfaces
-//! lit by emitting triangles (light sampling with its MIS weight, the shadow ray's ends, the
-//! cosine-weighted BSDF sample) is computed for all eight lanes together in SIMD registers;
-//! any other material or light falls back to the scalar path code for that lane and bounce.
+//! triangles, all eight against every triangle at once.
+//!
+//! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
+//! for every lane and bounce, except where a lane's surface is Lambertian and its light an
+//! emitting triangle. There the lanes are shaded together in SIMD registers by the same
+//! functions the one-path code calls, instantiated on eight lanes (the [`Diffuse`] BSDF,
+//! [`TriangleEmitter::sample_li`], the shading [`Frame`], [`offset_ray_origin`],
+//! [`power_heuristic_weight`]; see `scatter_lanes`): this module holds only the scheduling
+//! and the masks that stand for the one-path code's early returns.
 //!
 //! Each lane computes exactly what [`PathIntegrator::li`] computes for its sample, to the bit
 //! (tested): the same random numbers in the same order, the same operations in the same
@@ -12,37 +17,31 @@
 //! tested, which of several triangles at exactly the same distance a ray is taken to hit.
 
 use super::path::{PathIntegrator, PathState};
-use super::{camera_ray, sample_light, PathStats, SampleRef};
+use super::{camera_ray, power_heuristic_weight, sample_light, PathStats, SampleRef};
 use crate::accel::RayLanes;
-use crate::bsdf::Material;
+use crate::bsdf::Diffuse;
 use crate::desc::Rgb;
-use crate::geometry::{Ray, RAY_EPSILON, SHADOW_RAY_END};
+use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
 use crate::lanes::{F8, M8, V8, W};
-use crate::light::{AreaShape, Light};
+use crate::light::{AreaShape, Light, TriangleEmitter};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::Vec2;
 use pathlab_mc::sampler::AnySampler;
-use pathlab_mc::warp::sin_cos_quarter_turn;
-use std::f32::consts::FRAC_1_PI;
 
 /// What the lanes' scattering reads: the surface point, the directions, the material, the
-/// light point's triangle and the random numbers (structure of arrays).
+/// light's triangle and the random numbers (structure of arrays).
 #[derive(Clone, Copy, Default)]
 struct ScatterIn {
     p: V8,
     ng: V8,
     ns: V8,
     wo: V8,
-    reflectance: V8,
+    diffuse: Diffuse<V8>,
     two_sided: M8,
     /// Lanes whose light sample is a point on an emitting triangle (the others have no light
     /// sample, or took theirs one lane at a time).
     light: M8,
-    light_vertices: [V8; 3],
-    light_normal: V8,
-    light_pdf_area: F8,
-    light_radiance: V8,
-    light_two_sided: M8,
+    emitter: TriangleEmitter<V8>,
     /// Probability of choosing the lane's light.
     light_pmf: F8,
     u_light: [F8; 2],
@@ -66,108 +65,48 @@ struct ScatterOut {
     weight: V8,
 }
 
-/// `offset_ray_origin` in lanes: `p` moved off the surface along `ng`, to the side of `w`.
-#[inline(always)]
-fn offset_ray_origin(p: V8, ng: V8, w: V8) -> V8 {
-    let eps = F8::splat(RAY_EPSILON) * (F8::splat(1.0) + p.abs().max_element());
-    let step = ng.scale(eps);
-    // `w · ng >= 0`, false for NaN as there.
-    F8::splat(0.0).le(w.dot(ng)).select3(p + step, p - step)
-}
-
-/// The lanes' scattering at diffuse surfaces: [`super::sample_light`] for a point on an
-/// emitting triangle, up to the shadow ray, and [`crate::bsdf::Bsdf::sample_f`] for a
-/// Lambertian BSDF, each expression as the scalar code writes it.
+/// The lanes' scattering at diffuse surfaces, composed of the functions the one-path code
+/// calls, on lanes: the shading frame ([`Frame::from_normal`], turned towards wo for a
+/// two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does), [`super::sample_light`] for
+/// a point on an emitting triangle up to the shadow ray ([`TriangleEmitter::sample_li`],
+/// [`Diffuse::f_z`], [`offset_ray_origin`], [`power_heuristic_weight`] against
+/// [`Diffuse::pdf_z`]), and [`crate::bsdf::Bsdf::sample_f`] for a Lambertian BSDF
+/// ([`Diffuse::sample_z`]). Only the control flow is the lanes' own: masks where the one-path
+/// code returns early.
 #[inline(always)]
 fn scatter_lanes(a: &ScatterIn, out: &mut ScatterOut) {
     let zero = F8::splat(0.0);
-    let one = F8::splat(1.0);
-    let inv_pi = F8::splat(FRAC_1_PI);
-    // The shading frame (`Bsdf::from_bxdf`, `coordinate_system`): a two-sided material turns
-    // its normal towards wo.
     let flip = a.two_sided & a.wo.dot(a.ns).lt(zero);
-    let n = flip.select3(-a.ns, a.ns);
-    let sign = n.z.sign_one();
-    let inv = F8::splat(-1.0) / (sign + n.z);
-    let b = n.x * n.y * inv;
-    let s = V8 {
-        x: one + sign * n.x * n.x * inv,
-        y: sign * b,
-        z: -sign * n.x,
-    };
-    let t = V8 {
-        x: b,
-        y: sign + n.y * n.y * inv,
-        z: -n.y,
-    };
-    let wo_z = a.wo.dot(n);
-    let f_lambert = a.reflectance.scale(inv_pi);
+    let frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
+    let wo_z = a.wo.dot(frame.n);
 
-    // Light sampling (`AreaTriangle::sample`, `Light::sample_li`, `sample_light`).
-    let su0 = a.u_light[0].sqrt();
-    let b0 = one - su0;
-    let b1 = a.u_light[1] * su0;
-    let b2 = (one - b0 - b1).max(zero);
-    let [v0, v1, v2] = a.light_vertices;
-    let p_light = v0.scale(b0) + v1.scale(b1) + v2.scale(b2);
-    let to_light = p_light - a.p;
-    let dist2 = to_light.dot(to_light);
-    let wi = to_light.div_by(dist2.sqrt());
-    let cos_light = a.light_normal.dot(-wi);
-    let abs_cos_light = cos_light.abs();
-    let emits = cos_light.gt(zero) | (a.light_two_sided & cos_light.lt(zero));
-    let li = emits.select3(a.light_radiance, V8::default());
-    let pdf_light = a.light_pdf_area * dist2 / abs_cos_light;
-    let wi_z = wi.dot(n);
-    let lambert = wo_z.gt(zero) & wi_z.gt(zero);
-    let f = lambert
-        .select3(f_lambert, V8::default())
-        .scale(wi.dot(a.ns).abs());
-    // `sample_light`'s early returns, kept as written (`!(x <= 0)` lets NaN through).
-    let shadow = a.light
-        & dist2.not_equal(zero)
-        & abs_cos_light.not_equal(zero)
-        & !pdf_light.le(zero)
-        & !li.max_element().le(zero)
+    // Light sampling.
+    let ls = a.emitter.sample_li(a.p, a.u_light[0], a.u_light[1]);
+    let wi_z = ls.wi.dot(frame.n);
+    let f = a.diffuse.f_z(wo_z, wi_z).scale(ls.wi.dot(frame.n).abs());
+    // `sample_light`'s early returns (`!(x <= 0)` lets NaN through, as there).
+    out.shadow = a.light
+        & ls.dist2.not_equal(zero)
+        & ls.abs_cos_light.not_equal(zero)
+        & !ls.pdf.le(zero)
+        & !ls.li.max_element().le(zero)
         & !f.max_element().le(zero);
-    let o = offset_ray_origin(a.p, a.ng, to_light);
-    let end = offset_ray_origin(p_light, a.light_normal, o - p_light);
-    let pdf = a.light_pmf * pdf_light;
-    // `power_heuristic(1, pdf, 1, bsdf.pdf(wo, wi))`.
-    let pdf_bsdf = lambert.select(wi_z.max(zero) * inv_pi, zero);
-    let (f2, g2) = (pdf * pdf, pdf_bsdf * pdf_bsdf);
-    let mis = pdf
-        .is_infinite()
-        .select(one, (f2 + g2).equals(zero).select(zero, f2 / (f2 + g2)));
-    out.shadow = shadow;
+    let o = offset_ray_origin(a.p, a.ng, ls.p_light - a.p);
+    let end = offset_ray_origin(ls.p_light, a.emitter.normal, o - ls.p_light);
     out.shadow_o = o;
     out.shadow_d = end - o;
-    out.ld = f.mul_axes(li).scale(mis / pdf);
+    let pdf = a.light_pmf * ls.pdf;
+    let mis = power_heuristic_weight(pdf, a.diffuse.pdf_z(wo_z, wi_z));
+    out.ld = f.mul_axes(ls.li).scale(mis / pdf);
 
-    // BSDF sampling (`Diffuse::sample`: the concentric disk lifted to the hemisphere).
-    let ux = F8::splat(2.0) * a.u_bsdf[0] - one;
-    let uy = F8::splat(2.0) * a.u_bsdf[1] - one;
-    let centre = ux.equals(zero) & uy.equals(zero);
-    let x_wedge = ux.abs().gt(uy.abs());
-    let r = x_wedge.select(ux, uy);
-    let ratio = x_wedge.select(uy / ux, ux / uy);
-    let mut sin = [0.0; W];
-    let mut cos = [0.0; W];
-    for i in 0..W {
-        (sin[i], cos[i]) = sin_cos_quarter_turn(ratio.0[i]);
-    }
-    let (sin, cos) = (F8(sin), F8(cos));
-    let dx = centre.select(zero, r * x_wedge.select(cos, sin));
-    let dy = centre.select(zero, r * x_wedge.select(sin, cos));
-    let z = (one - dx * dx - dy * dy).max(zero).sqrt();
-    let pdf_sample = z.max(zero) * inv_pi;
-    let finite = f_lambert.x.is_finite() & f_lambert.y.is_finite() & f_lambert.z.is_finite();
-    // `Diffuse::sample` returns nothing where `wo.z <= 0` (so a NaN goes on).
-    out.sampled = !wo_z.le(zero) & pdf_sample.gt(zero) & finite;
-    let wi = s.scale(dx) + t.scale(dy) + n.scale(z);
+    // BSDF sampling (and `Bsdf::sample_f`'s check of a finite value).
+    let bs = a.diffuse.sample_z(wo_z, a.u_bsdf[0], a.u_bsdf[1]);
+    let wi = frame.to_world(bs.wi);
+    let finite = bs.f.x.is_finite() & bs.f.y.is_finite() & bs.f.z.is_finite();
+    out.sampled = bs.valid & finite;
     out.wi = wi;
-    out.pdf = pdf_sample;
-    out.weight = f_lambert.scale(wi.dot(a.ns).abs() / pdf_sample);
+    out.pdf = bs.pdf;
+    out.weight = bs.f.scale(wi.dot(frame.n).abs() / bs.pdf);
 }
 
 /// [`scatter_lanes`] compiled for AVX2.
@@ -186,12 +125,6 @@ fn scatter(a: &ScatterIn, out: &mut ScatterOut) {
         return unsafe { scatter_avx2(avx2, a, out) };
     }
     scatter_lanes(a, out)
-}
-
-/// The reflectance and sidedness of a plain (untextured) Lambertian material.
-#[inline]
-fn lambertian(m: &Material) -> Option<(Rgb, bool)> {
-    m.as_lambertian()
 }
 
 /// One lane's path: its sample's tag and where the path stands.
@@ -294,7 +227,7 @@ impl PathIntegrator {
                 }
                 // `arrive` goes on only at a surface.
                 let Some(si) = &hits[i] else { continue };
-                let Some((reflectance, two_sided)) = lambertian(scene.material(si.material)) else {
+                let Some((diffuse, two_sided)) = scene.material(si.material).as_lambertian() else {
                     if !self.scatter(scene, st, si, smp, stats) {
                         out(lane.tag, st.l);
                         lanes[i] = None;
@@ -307,7 +240,7 @@ impl PathIntegrator {
                 a.ng.set(i, si.ng);
                 a.ns.set(i, si.ns);
                 a.wo.set(i, wo);
-                a.reflectance.set(i, reflectance);
+                a.diffuse.set_lane(i, diffuse);
                 a.two_sided.set(i, two_sided);
                 lambert_lanes |= 1 << i;
             }
@@ -406,13 +339,7 @@ fn gather_light(
             two_sided,
             texture: None,
         } => {
-            for (v, p) in a.light_vertices.iter_mut().zip(t.triangle.p) {
-                v.set(i, p);
-            }
-            a.light_normal.set(i, t.normal);
-            a.light_pdf_area.0[i] = t.pdf_area;
-            a.light_radiance.set(i, *radiance);
-            a.light_two_sided.set(i, *two_sided);
+            a.emitter.set_lane(i, t.emitter(*radiance, *two_sided));
             a.light_pmf.0[i] = pmf;
             true
         }
@@ -424,5 +351,123 @@ fn gather_light(
             st.l += st.beta * ld;
             false
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::diffuse::TEST_SCALE;
+    use crate::desc::{CameraDesc, Emission, MeshDesc, SceneDesc};
+    use crate::integrator::Integrator;
+    use glam::Vec3;
+
+    /// A floor and a back wall lit by an emitting quad above, seen from the front.
+    fn room() -> Scene {
+        let quad = |c: [Vec3; 4], material, emission| MeshDesc {
+            name: "quad".into(),
+            positions: c.to_vec(),
+            indices: vec![0, 1, 2, 0, 2, 3],
+            material,
+            emission,
+            ..Default::default()
+        };
+        let desc = SceneDesc {
+            meshes: vec![
+                quad(
+                    [
+                        Vec3::new(-1.0, 0.0, -1.0),
+                        Vec3::new(-1.0, 0.0, 1.0),
+                        Vec3::new(1.0, 0.0, 1.0),
+                        Vec3::new(1.0, 0.0, -1.0),
+                    ],
+                    0,
+                    None,
+                ),
+                quad(
+                    [
+                        Vec3::new(-1.0, 0.0, -1.0),
+                        Vec3::new(1.0, 0.0, -1.0),
+                        Vec3::new(1.0, 2.0, -1.0),
+                        Vec3::new(-1.0, 2.0, -1.0),
+                    ],
+                    0,
+                    None,
+                ),
+                quad(
+                    [
+                        Vec3::new(-0.3, 1.5, -0.3),
+                        Vec3::new(0.3, 1.5, -0.3),
+                        Vec3::new(0.3, 1.5, 0.3),
+                        Vec3::new(-0.3, 1.5, 0.3),
+                    ],
+                    0,
+                    Some(Emission {
+                        radiance: Vec3::splat(10.0),
+                        two_sided: false,
+                    }),
+                ),
+            ],
+            materials: vec![crate::scene::diffuse(Vec3::splat(0.6), false)],
+            camera: CameraDesc {
+                origin: Vec3::new(0.0, 1.0, 3.0),
+                target: Vec3::new(0.0, 0.5, 0.0),
+                up: Vec3::Y,
+                fov_degrees: 50.0,
+                ..Default::default()
+            },
+            resolution: [8, 8],
+            ..Default::default()
+        };
+        Scene::build(&desc).unwrap()
+    }
+
+    /// The default path tracer's estimates of every pixel's samples, on this thread.
+    fn render_here(scene: &Scene) -> Vec<Rgb> {
+        let integrator = PathIntegrator::default();
+        assert!(
+            integrator.packets_apply(),
+            "the default settings take the lanes"
+        );
+        let mut sampler = pathlab_mc::sampler::SamplerKind::Independent.build(4, 1);
+        let samples: Vec<SampleRef> = (0..64u32)
+            .flat_map(|p| {
+                (0..4).map(move |index| SampleRef {
+                    pixel: [p % 8, p / 8],
+                    index,
+                    tag: p * 4 + index,
+                })
+            })
+            .collect();
+        let mut out = vec![Rgb::ZERO; samples.len()];
+        integrator.li_samples(
+            scene,
+            &mut sampler,
+            &mut samples.iter().copied(),
+            &mut |tag, l| out[tag as usize] = l,
+            &mut PathStats::default(),
+        );
+        out
+    }
+
+    #[test]
+    fn the_lanes_shade_with_the_diffuse_bsdfs_own_code() {
+        // Halving what `Diffuse` computes must dim every lit sample of the default render,
+        // which runs in lanes: there is no second copy of the BSDF for them.
+        let scene = room();
+        let full = render_here(&scene);
+        TEST_SCALE.with(|s| s.set(0.5));
+        let half = render_here(&scene);
+        TEST_SCALE.with(|s| s.set(1.0));
+        let lit = full.iter().filter(|l| l.max_element() > 0.0).count();
+        assert!(lit > 100, "only {lit} lit samples");
+        let (sum_full, sum_half): (f32, f32) = (
+            full.iter().map(|l| l.y).sum(),
+            half.iter().map(|l| l.y).sum(),
+        );
+        assert!(
+            sum_half < 0.75 * sum_full,
+            "halving the BSDF: {sum_half} vs {sum_full}"
+        );
     }
 }
