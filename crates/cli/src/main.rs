@@ -10,6 +10,7 @@ mod plot;
 mod render_cmd;
 mod sample;
 
+use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -40,7 +41,10 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return argument_error(e),
+    };
     let result = match &cli.command {
         Command::Render(args) => render_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
@@ -57,6 +61,25 @@ fn main() -> ExitCode {
             let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
             eprintln!("error: {}", chain.join(": "));
             ExitCode::FAILURE
+        }
+    }
+}
+
+/// A command line clap refused: help and version as clap prints them; any other error as one
+/// line (its first), as every other error is.
+fn argument_error(e: clap::Error) -> ExitCode {
+    match e.kind() {
+        ErrorKind::DisplayHelp
+        | ErrorKind::DisplayVersion
+        | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => e.exit(),
+        _ => {
+            let text = e.to_string();
+            let first = text
+                .lines()
+                .find(|l| !l.trim().is_empty())
+                .unwrap_or("error: invalid arguments");
+            eprintln!("{} (see --help)", first.trim_end());
+            ExitCode::from(2)
         }
     }
 }

@@ -88,28 +88,29 @@ pub struct RenderArgs {
     #[arg(default_value = "cornell-box")]
     pub scene: String,
     /// Samples per pixel (default: the scene file's, else 64).
-    #[arg(short = 's', long)]
+    #[arg(short = 's', long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
     /// Light samples per surface point (direct lighting: directions or light points per pixel
     /// sample).
-    #[arg(short = 'l', long, default_value_t = 1)]
+    #[arg(short = 'l', long, default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub light_samples: u32,
     /// Largest bounce: 0 = light seen directly, 1 = direct lighting, 2 = one indirect bounce,
-    /// ..., inf = unbounded (with Russian roulette). Default: the scene file's, else inf.
-    #[arg(short = 'm', long)]
+    /// ..., inf (or -1, as Mitsuba writes it) = unbounded (with Russian roulette). Default: the
+    /// scene file's, else inf.
+    #[arg(short = 'm', long, allow_negative_numbers = true)]
     pub max_depth: Option<String>,
     /// First bounce at which Russian roulette may end a path (default: the scene file's, else
     /// 5).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..))]
     pub rr_depth: Option<u32>,
     /// Only the radiance of bounce K (0 = emission seen directly, 1 = direct, ...).
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..))]
     pub only_bounce: Option<u32>,
     /// Worker threads (0: all cores).
-    #[arg(short = 't', long, default_value_t = 0)]
+    #[arg(short = 't', long, default_value_t = 0, allow_negative_numbers = true, value_parser = threads_arg)]
     pub threads: usize,
     /// Image size in pixels (default: the scene's).
-    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"])]
+    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"], allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub resolution: Option<Vec<u32>>,
     /// Adaptive sampling: batches of BATCH samples; a pixel stops once the 95% interval of its
     /// mean luminance is within ± TOL relative (at most --spp samples). Defaults 32 0.05. Writes
@@ -125,14 +126,20 @@ pub struct RenderArgs {
     )]
     pub lens_radius: Option<f32>,
     /// Thin lens: distance to the plane in focus. Overrides the scene's.
-    #[arg(short = 'd', long, value_name = "DISTANCE")]
+    #[arg(
+        short = 'd',
+        long,
+        value_name = "DISTANCE",
+        allow_negative_numbers = true
+    )]
     pub focal_distance: Option<f32>,
     /// Adaptive stopping rule: course (1.96σ/√n ≤ TOL·μ), or neyman (n ≥ (1.96/TOL)² σ/L̄
     /// with L̄ from a 4-spp pilot: samples in proportion to σ, which minimises the image's MSE).
-    #[arg(long, value_enum, default_value_t = RuleName::Course)]
-    pub adaptive_rule: RuleName,
+    /// Default: course. Only with -a.
+    #[arg(long, value_enum)]
+    pub adaptive_rule: Option<RuleName>,
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black).
-    #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"])]
+    #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..))]
     pub crop: Option<Vec<u32>>,
     /// Output image: .exr (linear) or .png (sRGB). Default: SCENE.png.
     #[arg(short = 'o', long, visible_short_alias = 'f', value_name = "FILE")]
@@ -145,9 +152,10 @@ pub struct RenderArgs {
     #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
     pub define: Vec<String>,
     /// How the path tracer finds light at each vertex: mis (light and BSDF sampling combined),
-    /// bsdf (BSDF sampling only) or light (light sampling only).
-    #[arg(long, value_enum, default_value_t = LightingName::Mis)]
-    pub lighting: LightingName,
+    /// bsdf (BSDF sampling only) or light (light sampling only). Default: mis. Path tracer
+    /// only.
+    #[arg(long, value_enum)]
+    pub lighting: Option<LightingName>,
     /// Light the scene with this environment map (equirectangular .exr, .hdr, .png or .jpg, in
     /// Mitsuba's convention), in place of the scene's own environment.
     #[arg(short = 'e', long, value_name = "FILE")]
@@ -158,9 +166,10 @@ pub struct RenderArgs {
     /// Fresnel reflectance of smooth glass: exact, or schlick (the course's approximation).
     #[arg(long, value_enum, default_value_t = FresnelName::Exact)]
     pub fresnel: FresnelName,
-    /// Direct-lighting strategy for --integrator direct: hemisphere, cosine, light or mis.
-    #[arg(long, default_value = "mis")]
-    pub direct: DirectStrategy,
+    /// Direct-lighting strategy for --integrator direct: hemisphere, cosine, light or mis
+    /// (default).
+    #[arg(long)]
+    pub direct: Option<DirectStrategy>,
     /// Where the uniform numbers come from: sobol (Owen-scrambled, padded per dimension),
     /// stratified or independent. Per-pixel variances (--aov variance) are exact estimates only
     /// for independent samples; for the others they overstate the error.
@@ -193,6 +202,12 @@ pub struct RenderArgs {
     /// Print run statistics as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// A `--threads` value: a count of worker threads, 0 for all cores.
+fn threads_arg(text: &str) -> std::result::Result<usize, String> {
+    text.parse::<usize>()
+        .map_err(|_| format!("'{text}' is not a number of threads (0 for all cores, 1, 2, ...)"))
 }
 
 /// [`parse_max_depth`] as a clap value parser.
@@ -268,14 +283,55 @@ pub fn apply_resolution(desc: &mut SceneDesc, resolution: Option<&[u32]>) -> Res
 /// Set by Ctrl-C: the render stops and writes what it has.
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
+/// Flags that contradict each other or a value no image can show: an error, before anything
+/// is loaded; flags that the chosen integrator does not read: a warning each (returned).
+fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>> {
+    if !args.exposure.is_finite() {
+        bail!(
+            "--exposure {}: must be a finite number of stops",
+            args.exposure
+        );
+    }
+    if let (Some(k), Some(m)) = (args.only_bounce, cli_depth) {
+        if k > m {
+            bail!("--only-bounce {k} is beyond --max-depth {m}: the image would be black");
+        }
+    }
+    let mut warnings = Vec::new();
+    let mut unused = |flag: &str, applies: &str| {
+        warnings.push(format!("{flag} applies to {applies} only; ignored"))
+    };
+    let integrator = args.integrator;
+    let path = matches!(integrator, None | Some(IntegratorName::Path));
+    let debug = matches!(
+        integrator,
+        Some(IntegratorName::Normals | IntegratorName::Depth | IntegratorName::Bvh)
+    );
+    if args.direct.is_some() && integrator != Some(IntegratorName::Direct) {
+        unused("--direct", "--integrator direct");
+    }
+    if args.lighting.is_some() && !path {
+        unused("--lighting", "the path tracer (--integrator path)");
+    }
+    if args.only_bounce.is_some() && !path {
+        unused("--only-bounce", "the path tracer (--integrator path)");
+    }
+    if debug && args.light_samples > 1 {
+        unused("--light-samples", "the path and direct integrators");
+    }
+    if args.adaptive_rule.is_some() && args.adaptive.is_none() {
+        unused("--adaptive-rule", "adaptive sampling (-a)");
+    }
+    Ok(warnings)
+}
+
 /// Runs `pathlab render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let cli_depth = args.max_depth.as_deref().map(parse_max_depth).transpose()?;
-    if args.spp == Some(0) {
-        bail!("--spp must be at least 1");
-    }
-    if args.light_samples == 0 {
-        bail!("--light-samples must be at least 1");
+    for w in check_flags(args, cli_depth)? {
+        if !args.quiet {
+            eprintln!("warning: {w}");
+        }
     }
     let output = args.output.clone().unwrap_or_else(|| {
         let stem = Path::new(&args.scene)
@@ -334,6 +390,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let spp = args.spp.or(desc.hints.spp).unwrap_or(64);
     let max_depth = cli_depth.or(desc.hints.max_depth).unwrap_or(u32::MAX);
+    if let Some(k) = args.only_bounce.filter(|&k| k > max_depth) {
+        bail!("--only-bounce {k} is beyond the scene's largest bounce {max_depth}: the image would be black");
+    }
     apply_resolution(&mut desc, args.resolution.as_deref())?;
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let rr_depth = args.rr_depth.or(desc.hints.rr_depth).unwrap_or(5);
@@ -351,14 +410,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             hide_emitters: desc.hints.hide_emitters,
             only_bounce: args.only_bounce,
             light_samples: args.light_samples,
-            lighting: match args.lighting {
+            lighting: match args.lighting.unwrap_or(LightingName::Mis) {
                 LightingName::Mis => PathLighting::Mis,
                 LightingName::Bsdf => PathLighting::Bsdf,
                 LightingName::Light => PathLighting::Light,
             },
         }),
         IntegratorName::Direct => IntegratorKind::Direct(DirectIntegrator {
-            strategy: args.direct,
+            strategy: args.direct.unwrap_or(DirectStrategy::Mis),
             samples: args.light_samples,
             hide_emitters: desc.hints.hide_emitters,
             ..Default::default()
@@ -368,6 +427,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         IntegratorName::Bvh => IntegratorKind::Debug(DebugView::BvhHeat),
     };
     let progressive = args.target_error.is_some() || args.time.is_some();
+    // Most samples a pixel may take: -s, or for the progressive modes 65536 by default.
+    let stop_cap = if progressive {
+        args.spp.unwrap_or(65536)
+    } else {
+        spp
+    };
     if let Some(e) = args.target_error {
         if !(e.is_finite() && e > 0.0) {
             bail!("--target-error {e}: must be a positive number such as 0.02");
@@ -408,7 +473,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         settings.crop = Some([c[0], c[1], c[2], c[3]]);
     }
-    if args.adaptive_rule == RuleName::Neyman {
+    if args.adaptive_rule == Some(RuleName::Neyman) {
         if let Some(a) = settings.adaptive.as_mut() {
             // A short pilot for the image's mean luminance (its samples are not reused).
             let pilot = RenderSettings::new(4, args.seed.wrapping_add(1), sampler);
@@ -458,7 +523,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let stop = StopRule {
             target_error: args.target_error,
             time_limit: args.time,
-            max_spp: args.spp.unwrap_or(65536),
+            max_spp: stop_cap,
         };
         let bar_pass = Arc::clone(&bar);
         let report_pass = move |pass: u32, error: f64| {
@@ -486,7 +551,24 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             stats.samples
         );
     }
-    write_outputs(&film, &output, format, args)?;
+    // The BVH view counts nodes (1 to a few hundred): a PNG shows them as a heat map scaled
+    // to the image's own range, the EXR keeps the counts.
+    let heat_range = (integrator_name == IntegratorName::Bvh).then(|| value_range(&film));
+    match heat_range {
+        Some((_, hi)) if format == OutputFormat::Png => {
+            let counts: Vec<f32> = film.mean_image().iter().map(|v| v.x).collect();
+            write_heat_image(&film, &counts, hi, &output)?;
+        }
+        _ => write_outputs(&film, &output, format, args)?,
+    }
+    if let (Some((lo, hi)), false) = (heat_range, args.quiet || args.json) {
+        let how = if format == OutputFormat::Png {
+            format!("the PNG runs blue (0) through green to red ({hi:.0})")
+        } else {
+            "the EXR holds the counts".to_string()
+        };
+        eprintln!("bvh view: {lo:.0} to {hi:.0} nodes visited per camera ray; {how}");
+    }
     if settings.adaptive.is_some() {
         let rate = PathBuf::from(format!("{}_rate.png", output.with_extension("").display()));
         write_rate_image(&film, spp, &rate)?;
@@ -502,12 +584,26 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let build = scene.stats();
     let mean = film.image_mean();
+    // Samples per pixel as taken: adaptive and progressive renders vary them per pixel.
+    let counts = film.sample_counts();
+    let (spp_lo, spp_hi) = counts.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &c| {
+        (lo.min(c), hi.max(c))
+    });
+    let spp_mean = counts.iter().map(|&c| c as f64).sum::<f64>() / counts.len().max(1) as f64;
+    let varies = spp_lo != spp_hi || progressive || settings.adaptive.is_some();
+    let spp_text = if varies {
+        format!("{spp_mean:.1} spp on average ({spp_lo:.0} to {spp_hi:.0})")
+    } else {
+        format!("{spp_mean:.0} spp")
+    };
     if args.json {
         let out = json!({
             "scene": args.scene,
             "output": output,
             "resolution": [w, h],
-            "spp": spp,
+            "spp": if varies { json!(spp_mean) } else { json!(spp_mean.round() as u64) },
+            "spp_range": [spp_lo, spp_hi],
+            "spp_cap": if progressive || settings.adaptive.is_some() { json!(stop_cap) } else { json!(null) },
             "integrator": format!("{integrator_name:?}").to_lowercase(),
             "max_depth": if max_depth == u32::MAX { json!("inf") } else { json!(max_depth) },
             "threads": threads,
@@ -524,15 +620,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "cancelled": stats.cancelled,
             "sampler": sampler.name(),
             "estimated_relative_rmse": estimated_error,
+            "debug_range": heat_range.map(|(lo, hi)| json!({"min": lo, "max": hi})),
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else if !args.quiet {
         eprintln!(
-            "{}: {}x{}, {} spp, {:.2} s, {:.3e} samples/s, {:.3e} rays/s, BVH {} nodes in {:.1} ms; wrote {}",
+            "{}: {}x{}, {spp_text}, {:.2} s, {:.3e} samples/s, {:.3e} rays/s, BVH {} nodes in {:.1} ms; wrote {}",
             args.scene,
             w,
             h,
-            spp,
             stats.seconds,
             stats.samples as f64 / stats.seconds.max(1e-9),
             stats.rays as f64 / stats.seconds.max(1e-9),
@@ -552,17 +648,30 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
 /// The samples-per-pixel heat map: blue (few) through green to red (`spp`).
 fn write_rate_image(film: &Film, spp: u32, path: &Path) -> Result<()> {
-    let bytes: Vec<u8> = film
-        .sample_counts()
+    write_heat_image(film, &film.sample_counts(), spp as f32, path)
+}
+
+/// `values` (one per pixel) as a heat map: blue (0) through green to red (`max` and above).
+fn write_heat_image(film: &Film, values: &[f32], max: f32, path: &Path) -> Result<()> {
+    let bytes: Vec<u8> = values
         .iter()
         .flat_map(|&n| {
-            let t = (n / spp.max(1) as f32).clamp(0.0, 1.0);
+            let t = (n / max.max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
             let ramp = |c: f32| ((1.5 - (4.0 * t - c).abs()).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
             [ramp(3.0), ramp(2.0), ramp(1.0)]
         })
         .collect();
     write_rgb8(path, film.width(), film.height(), &bytes)?;
     Ok(())
+}
+
+/// The smallest and largest of the view's per-pixel values (its first channel).
+fn value_range(film: &Film) -> (f32, f32) {
+    film.mean_image()
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v.x), hi.max(v.x))
+        })
 }
 
 fn write_outputs(

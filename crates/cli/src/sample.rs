@@ -100,6 +100,16 @@ struct Moment {
     variance: f64,
 }
 
+/// A density of these weights needs a positive total: the library reads all zeros as
+/// uniform (what an environment map's black row needs), which asked for by name is a mistake.
+fn positive_sum(w: &[f32]) -> Result<()> {
+    let total: f64 = w.iter().map(|&x| x as f64).sum();
+    if !(total > 0.0 && total.is_finite()) {
+        bail!("--weights: the weights must have a finite, positive sum (got {total})");
+    }
+    Ok(())
+}
+
 fn parse_list(text: &str) -> Result<Vec<f64>> {
     text.split(',')
         .map(|t| {
@@ -137,7 +147,9 @@ impl Dist {
             DistributionName::Piecewise => {
                 let w: Vec<f32> = parse_list(&a.weights)?.iter().map(|&x| x as f32).collect();
                 let (lo, hi) = parse_range(&a.range)?;
-                Dist::Piecewise(PiecewiseConstant1D::new(&w, lo, hi)?)
+                let d = PiecewiseConstant1D::new(&w, lo, hi)?;
+                positive_sum(&w)?;
+                Dist::Piecewise(d)
             }
             DistributionName::Piecewise2d => {
                 let rows = a
@@ -151,6 +163,7 @@ impl Dist {
                 }
                 let flat: Vec<f32> = rows.iter().flatten().map(|&x| x as f32).collect();
                 let d = PiecewiseConstant2D::new(&flat, nu, rows.len(), Vec2::ZERO, Vec2::ONE)?;
+                positive_sum(&flat)?;
                 Dist::Piecewise2D(d, [nu, rows.len()])
             }
             DistributionName::Alias => Dist::Alias(AliasTable::new(&parse_list(&a.weights)?)?),

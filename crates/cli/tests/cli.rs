@@ -128,6 +128,16 @@ fn bad_sample_input_is_one_line_error() {
         &pathlab(&["sample", "piecewise", "--range", "1,0"]),
         "--range",
     );
+    // All-zero weights have no density (the library's uniform fallback is for tables with
+    // empty rows, not for a density asked for by name).
+    assert_one_line_error(
+        &pathlab(&["sample", "piecewise", "--weights", "0,0,0"]),
+        "positive sum",
+    );
+    assert_one_line_error(
+        &pathlab(&["sample", "piecewise2d", "--weights", "0,0;0,0"]),
+        "positive sum",
+    );
     assert_one_line_error(
         &pathlab(&["sample", "piecewise2d", "--weights", "1,2;3"]),
         "every row",
@@ -549,6 +559,116 @@ fn bad_render_flags_are_one_line_errors() {
     );
 }
 
+#[test]
+fn negative_and_contradictory_flags_are_errors_and_unused_ones_warnings() {
+    // Negative numbers reach the option (not the scene argument) and get a range message.
+    for (args, expected) in [
+        (&["render", "-s", "-1"][..], "--spp"),
+        (&["render", "-r", "-256", "256"][..], "--resolution"),
+        (&["render", "-l", "-2"][..], "--light-samples"),
+        (&["render", "-t", "-1"][..], "--threads"),
+        (&["render", "-m", "-3"][..], "--max-depth"),
+        (&["render", "--only-bounce", "-1"][..], "--only-bounce"),
+        // Contradictions that would write a black or meaningless image.
+        (
+            &["render", "-m", "1", "--only-bounce", "3"][..],
+            "beyond --max-depth",
+        ),
+        (&["render", "--exposure", "nan"][..], "--exposure"),
+        (&["render", "--exposure", "inf"][..], "--exposure"),
+    ] {
+        assert_one_line_error(&pathlab(args), expected);
+    }
+    // `-m -1` is Mitsuba's spelling of unbounded, and works.
+    let out = scratch("m-minus-one.png");
+    let run = pathlab(&[
+        "render",
+        "-m",
+        "-1",
+        "-s",
+        "1",
+        "-r",
+        "8",
+        "8",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    // Flags the chosen integrator does not read: a warning each, and the render goes on.
+    for (args, flag) in [
+        (&["--direct", "hemisphere"][..], "--direct"),
+        (
+            &["--integrator", "normals", "--only-bounce", "1"][..],
+            "--only-bounce",
+        ),
+        (
+            &["--integrator", "direct", "--lighting", "bsdf"][..],
+            "--lighting",
+        ),
+        (&["--adaptive-rule", "neyman"][..], "--adaptive-rule"),
+    ] {
+        let out = scratch("unused-flag.png");
+        let mut all = vec![
+            "render",
+            "-s",
+            "1",
+            "-r",
+            "8",
+            "8",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        all.extend_from_slice(args);
+        let run = pathlab(&all);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(&format!("warning: {flag} applies to")),
+            "{args:?}: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn the_bvh_view_is_a_heat_map_of_its_own_range() {
+    // Node counts (one to dozens) written raw would clamp to white in a PNG.
+    let png = scratch("bvh-view.png");
+    let run = pathlab(&[
+        "render",
+        &course_scene("CBbunny.dae"),
+        "--integrator",
+        "bvh",
+        "-s",
+        "1",
+        "-r",
+        "80",
+        "60",
+        "--json",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    let j = json_of(&run);
+    let (lo, hi) = (
+        j["debug_range"]["min"].as_f64().unwrap(),
+        j["debug_range"]["max"].as_f64().unwrap(),
+    );
+    assert!(lo >= 1.0 && hi > lo + 2.0, "range {lo}..{hi}");
+    let img = image::open(&png).unwrap().to_rgb8();
+    let mut colours: Vec<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    colours.sort();
+    colours.dedup();
+    assert!(colours.len() > 5, "{} distinct colours", colours.len());
+    assert!(
+        img.pixels().filter(|p| p.0 == [255, 255, 255]).count() == 0,
+        "white pixels: counts were clamped"
+    );
+}
+
 fn course_scene(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../scene/tests/data/cs184")
@@ -765,6 +885,20 @@ fn target_error_and_time_budget() {
         "--json",
     ]));
     assert!(v["seconds"].as_f64().unwrap() < 5.0);
+    // The samples per pixel reported are those taken, not the -s default.
+    let [w, h] = [0, 1].map(|i| v["resolution"][i].as_f64().unwrap());
+    let spp = v["spp"].as_f64().unwrap();
+    let taken = v["samples"].as_f64().unwrap() / (w * h);
+    assert!(
+        (spp - taken).abs() < 1e-6 * taken,
+        "spp {spp} vs {taken} taken"
+    );
+    let (lo, hi) = (
+        v["spp_range"][0].as_f64().unwrap(),
+        v["spp_range"][1].as_f64().unwrap(),
+    );
+    assert!(lo <= spp && spp <= hi && hi <= 65536.0, "{lo} {spp} {hi}");
+    assert_eq!(v["spp_cap"], 65536);
     assert_one_line_error(
         &pathlab(&["render", "--target-error", "-1"]),
         "--target-error",

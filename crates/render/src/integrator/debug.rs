@@ -12,8 +12,8 @@ pub enum DebugView {
     /// Distance along the camera ray, divided by the distance from the camera to the far side of
     /// the scene's bounding sphere (so the scene spans [0, 1]); black where rays escape.
     Depth,
-    /// BVH nodes visited by the camera ray, as a raw count in every channel (view the EXR, or
-    /// the PNG with a negative `--exposure`).
+    /// BVH nodes visited by the camera ray, as a raw count in every channel (`pathlab render`
+    /// writes a PNG of it as a heat map scaled to the image's range).
     BvhHeat,
 }
 
