@@ -45,6 +45,43 @@ fn dimension_of(name: &str, dims: usize) -> Option<usize> {
 
 /// Rewrites what exmex does not read itself: the word `pi` becomes its constant `PI`, and
 /// numbers in scientific notation (`2.5e-3`) are written out in positional notation.
+/// The functions expressions may call (exmex's for `f64`).
+const FUNCTIONS: [&str; 28] = [
+    "abs", "signum", "sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "asinh",
+    "acosh", "atanh", "floor", "round", "ceil", "trunc", "fract", "exp", "sqrt", "cbrt", "ln",
+    "log2", "log10", "log", "min", "max",
+];
+
+/// Every name called as a function, `name(`, is one of [`FUNCTIONS`] (the parser's own message
+/// for an unknown one is about parentheses).
+fn check_functions(text: &str) -> Result<()> {
+    let chars: Vec<char> = text.chars().collect();
+    let is_word = |c: char| c.is_alphanumeric() || c == '_';
+    let mut i = 0;
+    while i < chars.len() {
+        if chars[i].is_alphabetic() && (i == 0 || !is_word(chars[i - 1])) {
+            let start = i;
+            while i < chars.len() && is_word(chars[i]) {
+                i += 1;
+            }
+            let name: String = chars[start..i].iter().collect();
+            let mut j = i;
+            while j < chars.len() && chars[j].is_whitespace() {
+                j += 1;
+            }
+            if chars.get(j) == Some(&'(') && !FUNCTIONS.contains(&name.as_str()) {
+                bail!(
+                    "unknown function '{name}' (the functions are {})",
+                    FUNCTIONS.join(", ")
+                );
+            }
+        } else {
+            i += 1;
+        }
+    }
+    Ok(())
+}
+
 fn normalise(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let chars: Vec<char> = text.chars().collect();
@@ -197,6 +234,7 @@ impl Expression {
             bail!("{what} is empty: expected an expression such as \"x*x + y\"");
         }
         check_ambiguity(text).with_context(|| format!("cannot use {what}"))?;
+        check_functions(text).with_context(|| format!("cannot use {what} \"{text}\""))?;
         let expr = exmex::parse::<f64>(&normalise(text))
             .map_err(|e| anyhow!("cannot parse {what} \"{text}\": {}", clean_message(e.msg())))?;
         let var_dims = expr

@@ -34,8 +34,22 @@ impl Format {
     }
 }
 
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("plotting failed: {e:?}")
+fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow!("plotting failed: {e}")
+}
+
+/// A plot that could not be written, naming its file (the backend's own error is the cause).
+fn write_err<E: std::fmt::Display>(path: &Path, e: E) -> anyhow::Error {
+    // The backend wraps the file's I/O error in its own debug text; ask the file system.
+    if let Err(io) = std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)
+    {
+        return anyhow!("cannot write the plot {}: {io}", path.display());
+    }
+    anyhow!("cannot write the plot {}: {e}", path.display())
 }
 
 /// Registers the embedded font for plotters' text (idempotent).
@@ -60,12 +74,12 @@ macro_rules! with_root {
             Format::Png => {
                 let $root = BitMapBackend::new($path, $size).into_drawing_area();
                 $body?;
-                $root.present().map_err(err)?;
+                $root.present().map_err(|e| write_err($path, e))?;
             }
             Format::Svg => {
                 let $root = SVGBackend::new($path, $size).into_drawing_area();
                 $body?;
-                $root.present().map_err(err)?;
+                $root.present().map_err(|e| write_err($path, e))?;
             }
         }
         Ok(())

@@ -738,6 +738,91 @@ fn bad_scene_files_are_short_errors() {
     assert_one_line_error(&pathlab(&["info", "model.fbx"]), "unknown scene format");
 }
 
+/// Asserts a one-line error that reads as a sentence: no Rust debug text in it.
+fn assert_plain_error(out: &Output, expected: &str) {
+    assert_one_line_error(out, expected);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    for debug in [
+        "Os {",
+        "Error(",
+        "ParseError",
+        "{ ",
+        "`.\"",
+        ":0:0:",
+        "wlog",
+    ] {
+        assert!(!stderr.contains(debug), "debug text '{debug}' in: {stderr}");
+    }
+}
+
+#[test]
+fn error_messages_are_plain_sentences_naming_the_file() {
+    let write = |name: &str, text: &str| {
+        let p = scratch(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let ply = write(
+        "bad-element.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n2\nfoo\n",
+    );
+    assert_plain_error(
+        &pathlab(&["info", &ply]),
+        "bad-element.ply:8: not a valid PLY file",
+    );
+    let obj = write("bad-index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    assert_plain_error(
+        &pathlab(&["info", &obj]),
+        "bad-index.obj:4: not a valid OBJ file",
+    );
+    let gltf = write(
+        "bad-accessor.gltf",
+        r#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":5}}]}]}"#,
+    );
+    assert_plain_error(&pathlab(&["info", &gltf]), "accessor 5");
+    let txt = write("sky.txt", "not an image");
+    assert_plain_error(
+        &pathlab(&[
+            "render",
+            "-s",
+            "1",
+            "-e",
+            &txt,
+            "-o",
+            scratch("e.png").to_str().unwrap(),
+        ]),
+        "not an image format pathlab reads",
+    );
+    let exr = write("broken.exr", "not an exr");
+    assert_plain_error(
+        &pathlab(&[
+            "render",
+            "-s",
+            "1",
+            "-e",
+            &exr,
+            "-o",
+            scratch("e.png").to_str().unwrap(),
+        ]),
+        "not a valid OpenEXR file",
+    );
+    assert_plain_error(
+        &pathlab(&[
+            "sample",
+            "exponential",
+            "-n",
+            "100",
+            "--plot",
+            "/no/such/dir/p.png",
+        ]),
+        "cannot write the plot /no/such/dir/p.png",
+    );
+    assert_plain_error(
+        &pathlab(&["integrate", "foo(x)", "-d", "0,1"]),
+        "unknown function 'foo'",
+    );
+}
+
 #[test]
 fn compare_ranks_the_strategies() {
     let out = scratch("compare.png");

@@ -92,11 +92,26 @@ pub fn read_exr_rgb(path: &Path) -> std::result::Result<(u32, u32, Vec<Rgb>), Im
     )
     .map_err(|e| ImageError::Exr {
         path: path.display().to_string(),
-        message: e.to_string(),
+        message: exr_message(&e),
     })?;
     let (w, h, px) = image.layer_data.channel_data.pixels;
     Ok((w as u32, h as u32, px))
 }
+
+/// The OpenEXR reader's error as a sentence: an unreadable file, or what is wrong inside one.
+fn exr_message(e: &exr::error::Error) -> String {
+    match e {
+        exr::error::Error::Io(io) => format!("cannot read the file ({io})"),
+        exr::error::Error::NotSupported(what) => {
+            format!("an OpenEXR feature pathlab cannot read: {what}")
+        }
+        exr::error::Error::Invalid(what) => format!("not a valid OpenEXR file ({what})"),
+        exr::error::Error::Aborted => "reading the OpenEXR file was aborted".to_string(),
+    }
+}
+
+/// Image formats [`read_rgb`] decodes, by extension.
+const READABLE: [&str; 6] = ["exr", "hdr", "png", "jpg", "jpeg", "bmp"];
 
 /// Reads an image's RGB values: (width, height, pixels row-major from the top). OpenEXR and
 /// Radiance HDR are linear already; 8- and 16-bit formats (PNG, JPEG) are sRGB-encoded colour,
@@ -116,6 +131,13 @@ pub fn read_rgb(
         path: path.display().to_string(),
         message,
     };
+    // A file without an extension is identified by its content.
+    if ext.as_deref().is_some_and(|e| !READABLE.contains(&e)) {
+        return Err(err(format!(
+            "not an image format pathlab reads (.{})",
+            READABLE.join(", .")
+        )));
+    }
     let img = image::ImageReader::open(path)
         .map_err(|e| err(e.to_string()))?
         .with_guessed_format()

@@ -12,6 +12,50 @@ use pathlab_render::desc::*;
 use std::path::Path;
 use std::sync::Arc;
 
+/// The JSON of a `.gltf` file, or of a `.glb` file's first chunk.
+fn gltf_json(bytes: &[u8]) -> Option<&[u8]> {
+    if !bytes.starts_with(b"glTF") {
+        return Some(bytes);
+    }
+    let word = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+    };
+    let (length, kind) = (word(12)?, word(16)?);
+    (kind == 0x4E4F_534A).then(|| bytes.get(20..20 + length))?
+}
+
+/// That every mesh primitive's `POSITION` names an existing accessor: the `gltf` crate's
+/// validation reads that accessor before checking the index (and panics on a bad one).
+/// Anything else is left to the crate.
+fn check_position_accessors(bytes: &[u8]) -> Result<(), String> {
+    let Some(json) = gltf_json(bytes) else {
+        return Ok(());
+    };
+    let Ok(root) = serde_json::from_slice::<serde_json::Value>(json) else {
+        return Ok(());
+    };
+    let accessors = root["accessors"].as_array().map_or(0, Vec::len);
+    for (m, mesh) in root["meshes"].as_array().into_iter().flatten().enumerate() {
+        for (p, prim) in mesh["primitives"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .enumerate()
+        {
+            if let Some(i) = prim["attributes"]["POSITION"].as_u64() {
+                if i as usize >= accessors {
+                    return Err(format!(
+                        "not a valid glTF file: meshes[{m}].primitives[{p}] takes its positions from accessor {i}, but there are {accessors} accessors"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Loads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<SceneDesc, Error> {
     let err = |message: String| Error::Parse {
@@ -20,6 +64,8 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
         column: 0,
         message,
     };
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    check_position_accessors(&bytes).map_err(err)?;
     let (doc, buffers, images) = gltf::import(path).map_err(|e| match e {
         gltf::Error::Io(io) => Error::io(path, io),
         other => err(format!("not a valid glTF file: {other}")),

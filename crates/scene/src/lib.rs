@@ -49,8 +49,9 @@ pub enum Error {
         /// What failed.
         message: String,
     },
-    /// A file's content is not what the format expects.
-    #[error("{path}:{line}:{column}: {message}")]
+    /// A file's content is not what the format expects (`path:line:column:` where the
+    /// format's parser gives them, `path:line:` or `path:` where it gives less).
+    #[error("{path}{}: {message}", location(*line, *column))]
     Parse {
         /// The file (or built-in source).
         path: String,
@@ -62,13 +63,22 @@ pub enum Error {
         message: String,
     },
     /// The file's extension names no format pathlab reads.
-    #[error("{path}: unknown scene format (expected .dae, .xml, .obj, .ply, .gltf or .glb, or a built-in scene name: {known})")]
+    #[error("{path}: unknown scene format (expected .xml, .dae, .obj, .ply, .gltf or .glb, or a built-in scene name: {known})")]
     UnknownFormat {
         /// The file.
         path: String,
         /// Built-in scene names.
         known: String,
     },
+}
+
+/// `:line:column`, `:line` or nothing, as far as they are known (0: unknown).
+fn location(line: usize, column: usize) -> String {
+    match (line, column) {
+        (0, _) => String::new(),
+        (l, 0) => format!(":{l}"),
+        (l, c) => format!(":{l}:{c}"),
+    }
 }
 
 impl Error {

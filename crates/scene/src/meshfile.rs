@@ -148,11 +148,55 @@ fn obj_error(path: &Path, e: tobj::LoadError) -> Error {
         },
         other => Error::Parse {
             path: path.display().to_string(),
-            line: 0,
+            line: obj_bad_line(path).unwrap_or(0),
             column: 0,
             message: format!("not a valid OBJ file: {other}"),
         },
     }
+}
+
+/// The first line of an OBJ file that the reader refuses (tobj names the fault but not the
+/// line): a vertex, normal or texture coordinate that is not numbers, or a face whose index
+/// refers to an element that does not exist (1-based, or negative from the end).
+fn obj_bad_line(path: &Path) -> Option<usize> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut counts = [0i64; 3]; // v, vt, vn
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let kind = words.next();
+        let slot = match kind {
+            Some("v") => Some(0),
+            Some("vt") => Some(1),
+            Some("vn") => Some(2),
+            _ => None,
+        };
+        if let Some(k) = slot {
+            let numbers: Vec<&str> = words.collect();
+            let needed = if k == 1 { 1 } else { 3 };
+            if numbers.len() < needed || numbers.iter().any(|w| w.parse::<f32>().is_err()) {
+                return Some(i + 1);
+            }
+            counts[k] += 1;
+        } else if kind == Some("f") {
+            for corner in words {
+                for (k, index) in corner.split('/').enumerate().take(3) {
+                    if index.is_empty() {
+                        continue;
+                    }
+                    let slot = [0, 1, 2][k];
+                    let ok = match index.parse::<i64>() {
+                        Ok(n) if n > 0 => n <= counts[slot],
+                        Ok(n) if n < 0 => -n <= counts[slot],
+                        _ => false,
+                    };
+                    if !ok {
+                        return Some(i + 1);
+                    }
+                }
+            }
+        }
+    }
+    None
 }
 
 fn vec3s(path: &Path, values: &[f32], what: &str) -> Result<Vec<Vec3>, Error> {
@@ -291,6 +335,29 @@ fn ply_attributes(
         .collect()
 }
 
+/// A PLY reader's error as one plain sentence: its "Line N:" as the location, and of its
+/// nested restatements ("... String: 'x' Error: ...") only what it could not read.
+fn ply_error(path: &Path, text: &str) -> Error {
+    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let (line, rest) = match text.strip_prefix("Line ").and_then(|r| r.split_once(':')) {
+        Some((n, rest)) if n.parse::<usize>().is_ok() => (n.parse().unwrap_or(0), rest.trim()),
+        _ => (0, text.as_str()),
+    };
+    let message = match rest.split_once(" String: ") {
+        Some((what, found)) => {
+            let found = found.split(" Error:").next().unwrap_or("").trim();
+            format!("{} (found {found})", what.trim_end_matches('.'))
+        }
+        None => rest.to_string(),
+    };
+    Error::Parse {
+        path: path.display().to_string(),
+        line,
+        column: 0,
+        message: format!("not a valid PLY file: {message}"),
+    }
+}
+
 /// The mesh of a PLY file: positions, normals and texture coordinates where present, faces
 /// fanned into triangles, and the extra vertex and face properties as named attributes
 /// (`vertex_color`, `face_weight`, ...; a polygon's face attribute goes to each of its
@@ -300,19 +367,7 @@ pub fn ply_mesh(path: &Path) -> Result<MeshDesc, Error> {
     let mut reader = std::io::BufReader::new(file);
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut reader)
-        .map_err(|e| Error::Parse {
-            path: path.display().to_string(),
-            line: 0,
-            column: 0,
-            // The parser's message spans lines; keep it on one.
-            message: format!(
-                "not a valid PLY file: {}",
-                e.to_string()
-                    .split_whitespace()
-                    .collect::<Vec<_>>()
-                    .join(" ")
-            ),
-        })?;
+        .map_err(|e| ply_error(path, &e.to_string()))?;
     let err = |message: String| Error::Parse {
         path: path.display().to_string(),
         line: 0,

@@ -368,3 +368,79 @@ proptest! {
         exercise_shape_file("sdfgrid", "sdfgrid", "case.vol", &corrupt(sphere_grid(), cut, &flips));
     }
 }
+
+/// Standard base64 of `bytes`, for a glTF buffer's data URI.
+fn base64(bytes: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                out.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// A glTF 2.0 file of one triangle (positions and indices in an embedded buffer), a camera
+/// and an emissive material.
+fn gltf_triangle() -> String {
+    let mut buffer = Vec::new();
+    for c in [0.0f32, 0., 0., 1., 0., 0., 0., 1., 0.] {
+        buffer.extend(c.to_le_bytes());
+    }
+    for i in [0u16, 1, 2, 0] {
+        buffer.extend(i.to_le_bytes());
+    }
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1]}}],
+"nodes":[{{"mesh":0}},{{"camera":0,"translation":[0.3,0.3,2]}}],
+"cameras":[{{"type":"perspective","perspective":{{"yfov":0.8,"znear":0.01}}}}],
+"materials":[{{"pbrMetallicRoughness":{{"baseColorFactor":[0.8,0.5,0.2,1]}},"emissiveFactor":[1,1,1]}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"material":0}}]}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+{{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}],
+"bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],
+"buffers":[{{"byteLength":44,"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
+        base64(&buffer)
+    )
+}
+
+#[test]
+fn the_gltf_triangle_loads() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption-gltf-ok");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("tri.gltf");
+    std::fs::write(&path, gltf_triangle()).unwrap();
+    let desc = pathlab_scene::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(desc.meshes.len(), 1);
+    assert_eq!(desc.meshes[0].indices, vec![0, 1, 2]);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 150, failure_persistence: None, rng_seed: RngSeed::Fixed(0x5eed_0005), ..ProptestConfig::default() })]
+
+    /// glTF truncated or bit-flipped.
+    #[test]
+    fn gltf_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6)) {
+        exercise_file("case.gltf", &corrupt(gltf_triangle().into_bytes(), cut, &flips));
+    }
+
+    /// glTF whose numbers (indices, counts, offsets, sizes) are mangled.
+    #[test]
+    fn gltf_numbers_mangled(edits in prop::collection::vec((0.0f64..1.0, 0usize..MANGLED.len()), 1..6)) {
+        let mut text = gltf_triangle();
+        for (pos, k) in edits {
+            let spans = number_spans(&text);
+            let (s, e) = spans[((pos * spans.len() as f64) as usize).min(spans.len() - 1)];
+            text.replace_range(s..e, MANGLED[k]);
+        }
+        exercise_file("case-n.gltf", text.as_bytes());
+    }
+}
