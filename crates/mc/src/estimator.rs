@@ -246,8 +246,85 @@ where
     total.estimate()
 }
 
+/// The share of the sample variance that the single largest term carries:
+/// max (v_i - mean)² / Σ (v_i - mean)² over the `n` terms f/p that [`integrate_parallel`]
+/// draws (the same terms, recomputed). With finite variance it falls towards zero as n grows
+/// (like ln² n / n for exponential tails); when the terms have infinite variance, one term
+/// keeps a sizeable share however many there are, and the standard error means nothing.
+pub fn largest_term_share<S, X>(
+    f: impl Fn(&X) -> f64 + Sync,
+    sampler: &S,
+    sample: impl Fn(&mut S) -> (X, f64) + Sync,
+    n: u32,
+    mean: f64,
+) -> f64
+where
+    S: Sampler + Clone + Send + Sync,
+{
+    let chunks = n.div_ceil(PARALLEL_CHUNK);
+    let (sum, largest) = (0..chunks)
+        .into_par_iter()
+        .map(|c| {
+            let mut s = sampler.clone();
+            let (mut sum, mut largest) = (0.0f64, 0.0f64);
+            let start = c * PARALLEL_CHUNK;
+            for i in start..start.saturating_add(PARALLEL_CHUNK).min(n) {
+                s.start_pixel_sample([0, 0], i, 0);
+                let d = weighted_value(&mut &f, &mut s, &mut &sample) - mean;
+                sum += d * d;
+                largest = largest.max(d * d);
+            }
+            (sum, largest)
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .fold((0.0, 0.0), |(s, l), (cs, cl)| (s + cs, f64::max(l, cl)));
+    if sum > 0.0 {
+        largest / sum
+    } else {
+        0.0
+    }
+}
+
+/// Whether a largest-term share ([`largest_term_share`]) of `n` terms is too large for a
+/// distribution with finite variance: above 5% and above 10 ln² n / n, which light-tailed
+/// terms (uniform, Gaussian, exponential) stay far below.
+pub fn looks_heavy_tailed(share: f64, n: u64) -> bool {
+    let ln = (n.max(2) as f64).ln();
+    share > 0.05 && share > 10.0 * ln * ln / n as f64
+}
+
 #[cfg(test)]
 mod tests {
+    use crate::sampler::IndependentSampler;
+
+    /// The largest-term share of f/p = g(U) for U uniform on (0, 1).
+    fn share_of(g: impl Fn(f64) -> f64 + Sync, n: u32) -> (f64, f64) {
+        let sampler = IndependentSampler::new(n, 7);
+        let term = |x: &f64| g(*x);
+        let draw = |s: &mut IndependentSampler| (s.next_1d() as f64, 1.0);
+        let est = integrate_parallel(term, &sampler, draw, n);
+        (
+            largest_term_share(term, &sampler, draw, n, est.mean),
+            est.mean,
+        )
+    }
+
+    #[test]
+    fn heavy_tails_are_told_from_light_ones() {
+        let n = 200_000;
+        // ∫ 1/x over (0, 1) diverges; ∫ x^-0.75 = 4 has infinite variance (E[x^-1.5] = ∞).
+        for g in [|x: f64| 1.0 / x, |x: f64| x.powf(-0.75)] {
+            let (share, _) = share_of(g, n);
+            assert!(looks_heavy_tailed(share, n as u64), "share {share}");
+        }
+        // Finite variance: uniform, exponential (-ln U), x^-0.25 (E[x^-0.5] = 2).
+        for g in [|x: f64| x, |x: f64| -(1.0 - x).ln(), |x: f64| x.powf(-0.25)] {
+            let (share, _) = share_of(g, n);
+            assert!(!looks_heavy_tailed(share, n as u64), "share {share}");
+        }
+    }
+
     use super::*;
 
     #[test]

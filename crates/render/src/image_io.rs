@@ -185,8 +185,8 @@ pub enum ToneMap {
     /// Scale by 2^exposure, clamp to [0, 1], sRGB transfer function.
     #[default]
     Srgb,
-    /// The CS184 course's images: clamp((√2 · 2^exposure · c)^(1/2.2), 0, 1), i.e. one stop
-    /// of exposure and gamma 2.2.
+    /// The CS184 course's images: clamp((√2 · 2^exposure · c)^(1/2.2), 0, 1), i.e. half a
+    /// stop up (√2 = 2^0.5) and gamma 2.2: linear values from 1/√2 ≈ 0.71 up are white.
     Cs184,
 }
 

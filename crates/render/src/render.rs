@@ -27,41 +27,53 @@ pub struct RenderSettings {
     pub adaptive: Option<Adaptive>,
 }
 
-/// The course's per-pixel adaptive sampling: samples come in batches; after each, a pixel
-/// whose n samples have luminance mean μ and standard deviation σ stops when
-/// 1.96 σ / √n ≤ `tolerance` · μ, i.e. when the 95% confidence interval of its mean is within
-/// ± `tolerance` relative.
+/// Per-pixel adaptive sampling: each pixel's sample count is chosen from its samples'
+/// luminance, at most [`RenderSettings::spp`].
 ///
-/// Guards: no pixel stops before `min_samples`; a pixel whose samples are all equal (σ = 0, for
-/// instance all zero because none has found a small light yet, or all on the light though the
-/// pixel straddles its edge) never counts as converged, since a zero sample variance says
-/// nothing about the true one; and a single bright sample among dark ones cannot stop a pixel,
-/// since then σ ≈ μ √n and the test would need 1.96 ≤ `tolerance`.
+/// With [`AdaptiveRule::TwoStage`] (the default) the count comes from a pilot of `batch`
+/// samples drawn from a stream of their own and left out of the estimate, so the estimate is
+/// an average of a number of samples fixed before any of them is drawn: unbiased by
+/// construction. With [`AdaptiveRule::Course`] and [`AdaptiveRule::Neyman`] samples come in
+/// batches and a pixel stops after a batch when its own samples say so; that is optional
+/// stopping, which biases each pixel slightly (a pixel tends to stop after a run of samples
+/// that happened to agree), by an amount that shrinks with `min_samples` and `tolerance`; the
+/// tests measure it against the reference.
 ///
-/// Stopping on a pixel's own samples makes its estimate slightly biased (optional stopping: a
-/// pixel tends to stop after a run of samples that happened to agree), by an amount that shrinks
-/// with `min_samples` and `tolerance`; the tests measure it against the reference.
+/// Guards: no pixel stops before `min_samples` (the two-stage rule plans at least `batch`); a
+/// pixel whose samples are all equal (σ = 0) counts as converged only when its radiance cannot
+/// vary, because no sample met a surface that scatters (camera rays that escaped, or met black
+/// emitters: [`crate::integrator::PathStats::random_vertices`]); otherwise a zero sample
+/// variance says nothing about the true one (all zero because none has found a small light
+/// yet). A single bright sample among dark ones cannot stop a pixel, since then σ ≈ μ √n and
+/// the test would need 1.96 ≤ `tolerance`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Adaptive {
-    /// Samples per batch between convergence checks.
+    /// Samples per batch between convergence checks (two-stage: the pilot's size).
     pub batch: u32,
     /// Relative half-width of the 95% interval at which a pixel stops.
     pub tolerance: f32,
-    /// Samples every pixel takes before it may stop.
+    /// Samples every pixel takes before it may stop (course and Neyman rules).
     pub min_samples: u32,
     /// Which stopping rule.
     pub rule: AdaptiveRule,
 }
 
-/// When an adaptive pixel stops.
+/// How an adaptive pixel's sample count is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum AdaptiveRule {
-    /// The course's: the 95% interval of the pixel's mean is within ± tolerance of that mean,
-    /// 1.96 σ/√n ≤ tolerance · μ. It gives n ∝ (σ/μ)², spending most on dark, noisy pixels.
+    /// Kirk and Arvo's two-stage scheme with the course's precision target: a pilot of one
+    /// batch from an independent stream gives μ and σ; the pixel then takes
+    /// n = (1.96 σ / (tolerance μ))² samples (rounded up to whole batches, at least one, at
+    /// most the cap) of its own stream, and only those make the estimate. Unbiased.
+    TwoStage,
+    /// The course's: after each batch, stop once the 95% interval of the pixel's mean is
+    /// within ± tolerance of that mean, 1.96 σ/√n ≤ tolerance · μ. It gives n ∝ (σ/μ)²,
+    /// spending most on dark, noisy pixels; biased by optional stopping.
     Course,
     /// n ≥ (1.96/tolerance)² · σ / L̄, with L̄ the image's mean luminance (from a short pilot
     /// render): the course's test with μ replaced by √(σ L̄). It gives n ∝ σ, the allocation
     /// that minimises the image's mean squared error for a given total (Neyman allocation).
+    /// Biased by optional stopping, as the course's rule.
     Neyman {
         /// The image's mean luminance.
         image_luminance: f64,
@@ -69,29 +81,67 @@ pub enum AdaptiveRule {
 }
 
 impl Adaptive {
-    /// The course's defaults: batches of 32, tolerance 0.05; at least four batches.
+    /// The defaults: batches of 32, tolerance 0.05, the two-stage rule; at least four batches
+    /// for the stopping rules.
     pub const DEFAULT: Adaptive = Adaptive {
         batch: 32,
         tolerance: 0.05,
         min_samples: 128,
-        rule: AdaptiveRule::Course,
+        rule: AdaptiveRule::TwoStage,
     };
 
-    /// Whether a pixel with these luminance statistics may stop.
-    pub fn converged(&self, luminance: &pathlab_mc::estimator::RunningStats) -> bool {
+    /// Seed offset of the two-stage pilot's stream (independent of the estimate's).
+    const PILOT_STREAM: u64 = 0x5851_f42d_4c95_7f2d;
+
+    /// Whether a pixel with these luminance statistics may stop (course and Neyman rules;
+    /// the two-stage rule uses the course's test). `deterministic`: none of the samples met a
+    /// surface that scatters, so equal samples are the pixel's exact value.
+    pub fn converged(
+        &self,
+        luminance: &pathlab_mc::estimator::RunningStats,
+        deterministic: bool,
+    ) -> bool {
         let n = luminance.count();
         if n < self.min_samples.max(2) as u64 {
             return false;
         }
         let sigma = luminance.std_dev();
         if sigma <= 0.0 {
-            return false;
+            return deterministic;
         }
         let z = 1.96 / self.tolerance as f64;
         match self.rule {
-            AdaptiveRule::Course => z * sigma / (n as f64).sqrt() <= luminance.mean(),
+            AdaptiveRule::Course | AdaptiveRule::TwoStage => {
+                z * sigma / (n as f64).sqrt() <= luminance.mean()
+            }
             AdaptiveRule::Neyman { image_luminance } => n as f64 * image_luminance >= z * z * sigma,
         }
+    }
+
+    /// The two-stage rule's sample count for a pixel whose pilot had these luminance
+    /// statistics, at most `cap`: the course's n = (1.96 σ / (tolerance μ))² in whole
+    /// batches, at least one batch; one batch where the pilot shows the pixel cannot vary, and
+    /// `cap` where its samples are equal for no such reason (or its mean is zero) and so say
+    /// nothing.
+    pub fn planned_samples(
+        &self,
+        pilot: &pathlab_mc::estimator::RunningStats,
+        deterministic: bool,
+        cap: u32,
+    ) -> u32 {
+        let batch = self.batch.max(1);
+        let sigma = pilot.std_dev();
+        let mean = pilot.mean();
+        let n = if sigma <= 0.0 && deterministic {
+            batch as f64
+        } else if sigma <= 0.0 || mean <= 0.0 || pilot.count() < 2 {
+            cap as f64
+        } else {
+            let r = 1.96 * sigma / (self.tolerance as f64 * mean);
+            r * r
+        };
+        let batches = (n / batch as f64).ceil().clamp(1.0, u32::MAX as f64);
+        (batches as u64 * batch as u64).min(cap as u64) as u32
     }
 }
 
@@ -117,6 +167,9 @@ pub struct RenderStats {
     pub samples: u64,
     /// Samples whose radiance was NaN or infinite, discarded.
     pub nonfinite_samples: u64,
+    /// Pilot samples of the two-stage adaptive rule: traced to choose sample counts, not
+    /// part of the image.
+    pub pilot_samples: u64,
     /// Rays traced.
     pub rays: u64,
     /// BVH nodes visited by closest-hit rays.
@@ -133,6 +186,7 @@ struct TileResult {
     path: PathStats,
     samples: u64,
     nonfinite: u64,
+    pilot: u64,
 }
 
 /// Adds the samples with indices `range` of pixel `[x, y]` to `px`; returns how many were
@@ -212,32 +266,61 @@ pub fn render(
                 path: PathStats::default(),
                 samples: 0,
                 nonfinite: 0,
+                pilot: 0,
             };
             if let Some(adaptive) = settings.adaptive {
+                let batch = adaptive.batch.max(1);
+                let mut pilot_sampler = (adaptive.rule == AdaptiveRule::TwoStage).then(|| {
+                    let seed = settings.seed ^ Adaptive::PILOT_STREAM;
+                    settings.sampler.build(batch, seed)
+                });
                 for y in y0..y0 + h {
                     for x in x0..x0 + w {
                         if cancel.load(Ordering::Relaxed) {
                             continue;
                         }
                         let px = &mut out.pixels[((y - y0) * w + (x - x0)) as usize];
-                        let batch = adaptive.batch.max(1);
-                        let mut i = 0;
-                        while i < settings.spp {
-                            if i > 0 && adaptive.converged(px.luminance()) {
-                                break;
-                            }
-                            let end = (i + batch).min(settings.spp);
+                        let mut run = |sampler: &mut pathlab_mc::sampler::AnySampler,
+                                       range: std::ops::Range<u32>,
+                                       px: &mut PixelStats,
+                                       out_path: &mut PathStats|
+                         -> (u64, bool) {
+                            let before = out_path.random_vertices;
                             let (ok, bad) = sample_pixel(
                                 scene,
                                 integrator,
-                                &mut sampler,
+                                sampler,
                                 [x, y],
-                                i..end,
+                                range,
                                 px,
-                                &mut out.path,
+                                out_path,
                             );
-                            out.samples += ok;
                             out.nonfinite += bad;
+                            (ok, out_path.random_vertices == before)
+                        };
+                        if let Some(pilot_sampler) = pilot_sampler.as_mut() {
+                            let mut pilot = PixelStats::default();
+                            let (n_pilot, deterministic) =
+                                run(pilot_sampler, 0..batch, &mut pilot, &mut out.path);
+                            out.pilot += n_pilot;
+                            let n = adaptive.planned_samples(
+                                pilot.luminance(),
+                                deterministic,
+                                settings.spp,
+                            );
+                            out.samples += run(&mut sampler, 0..n, px, &mut out.path).0;
+                            continue;
+                        }
+                        let mut i = 0;
+                        let mut deterministic = true;
+                        while i < settings.spp {
+                            if i > 0 && adaptive.converged(px.luminance(), deterministic) {
+                                break;
+                            }
+                            let end = (i + batch).min(settings.spp);
+                            let (ok, fixed) = run(&mut sampler, i..end, px, &mut out.path);
+                            out.samples += ok;
+                            deterministic &= fixed;
                             i = end;
                         }
                     }
@@ -280,6 +363,7 @@ pub fn render(
         }
         stats.samples += t.samples;
         stats.nonfinite_samples += t.nonfinite;
+        stats.pilot_samples += t.pilot;
         stats.rays += t.path.rays;
         stats.nodes_visited += t.path.nodes_visited;
     }
@@ -309,21 +393,24 @@ mod tests {
         };
         // Equal samples (all black, or all on a light) never stop a pixel: their variance
         // estimate of zero is no evidence of a tight interval.
-        assert!(!a.converged(&stats(&[1.0; 100])));
-        assert!(!a.converged(&stats(&[0.0; 100])));
+        assert!(!a.converged(&stats(&[1.0; 100]), false));
+        assert!(!a.converged(&stats(&[0.0; 100]), false));
+        // ... unless no sample met a scattering surface: then they are the pixel's value.
+        assert!(a.converged(&stats(&[0.0; 16]), true));
+        assert!(!a.converged(&stats(&[0.0; 15]), true));
         // Nearly constant samples stop once the minimum is reached.
         let near: Vec<f64> = (0..16).map(|i| 1.0 + 1e-3 * (i % 2) as f64).collect();
-        assert!(!a.converged(&stats(&near[..8])));
-        assert!(a.converged(&stats(&near)));
+        assert!(!a.converged(&stats(&near[..8]), false));
+        assert!(a.converged(&stats(&near), false));
         // One bright sample among dark ones never stops a pixel.
         let mut firefly = vec![0.0; 999];
         firefly.push(100.0);
-        assert!(!a.converged(&stats(&firefly)));
+        assert!(!a.converged(&stats(&firefly), false));
         // The course's rule: 1.96 σ/√n ≤ tol μ. Values 1 ± 0.5 (σ ≈ 0.5) need n ≥ (1.96·0.5/0.05)² ≈ 384.
         let alternating =
             |n: usize| -> Vec<f64> { (0..n).map(|i| if i % 2 == 0 { 0.5 } else { 1.5 }).collect() };
-        assert!(!a.converged(&stats(&alternating(300))));
-        assert!(a.converged(&stats(&alternating(400))));
+        assert!(!a.converged(&stats(&alternating(300)), false));
+        assert!(a.converged(&stats(&alternating(400)), false));
         // Neyman: n ≥ (1.96/tol)² σ / L̄; with σ = 0.5 and L̄ = 1 that is n ≥ 768.4.
         let neyman = Adaptive {
             rule: AdaptiveRule::Neyman {
@@ -331,7 +418,30 @@ mod tests {
             },
             ..a
         };
-        assert!(!neyman.converged(&stats(&alternating(760))));
-        assert!(neyman.converged(&stats(&alternating(780))));
+        assert!(!neyman.converged(&stats(&alternating(760)), false));
+        assert!(neyman.converged(&stats(&alternating(780)), false));
+    }
+
+    #[test]
+    fn two_stage_plans_the_courses_count_from_its_pilot() {
+        let a = Adaptive {
+            batch: 8,
+            tolerance: 0.05,
+            min_samples: 16,
+            rule: AdaptiveRule::TwoStage,
+        };
+        // σ = 0.5 (values 0.5, 1.5), μ = 1: n = (1.96 · 0.5 / 0.05)² = 384.16, so 49 batches.
+        let pilot = stats(&(0..8).map(|i| 0.5 + (i % 2) as f64).collect::<Vec<_>>());
+        let sigma = pilot.std_dev();
+        let expect = ((1.96 * sigma / 0.05).powi(2) / 8.0).ceil() as u32 * 8;
+        assert_eq!(a.planned_samples(&pilot, false, 100_000), expect);
+        assert_eq!(a.planned_samples(&pilot, false, 100), 100);
+        // A pixel that cannot vary takes one batch; equal samples that could vary, the cap.
+        assert_eq!(a.planned_samples(&stats(&[0.0; 8]), true, 512), 8);
+        assert_eq!(a.planned_samples(&stats(&[0.0; 8]), false, 512), 512);
+        assert_eq!(a.planned_samples(&stats(&[2.0; 8]), false, 512), 512);
+        // A tiny relative spread still takes one batch.
+        let tight = stats(&(0..8).map(|i| 1.0 + 1e-6 * i as f64).collect::<Vec<_>>());
+        assert_eq!(a.planned_samples(&tight, false, 512), 8);
     }
 }

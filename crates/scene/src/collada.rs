@@ -128,11 +128,30 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             .ok_or_else(|| self.file.error(root, "no <visual_scene> to render"))
     }
 
-    fn transform(&self, node: Node) -> Result<Mat4, Error> {
+    /// A `<matrix>`'s 16 numbers, row-major. The course's reader fills the numbers a short
+    /// matrix lacks with zeros; so does this, with a warning naming the element's line.
+    fn matrix(&mut self, c: Node) -> Result<Mat4, Error> {
+        let mut v = self.file.floats(c)?;
+        if v.len() < 16 {
+            let at = self.file.error(c, "");
+            let line = match &at {
+                Error::Parse { path, line, .. } => format!("{path}:{line}"),
+                _ => String::new(),
+            };
+            self.desc.warnings.push(format!(
+                "{line}: <matrix> has {} of its 16 numbers; the rest are taken as 0, as the course's renderer does",
+                v.len()
+            ));
+            v.resize(16, 0.0);
+        }
+        Ok(Mat4::from_cols_slice(&v[..16]).transpose())
+    }
+
+    fn transform(&mut self, node: Node) -> Result<Mat4, Error> {
         let mut m = Mat4::IDENTITY;
         for c in node.children().filter(|c| c.is_element()) {
             let t = match c.tag_name().name() {
-                "matrix" => Mat4::from_cols_slice(&self.file.floats_n(c, 16)?).transpose(),
+                "matrix" => self.matrix(c)?,
                 "translate" => Mat4::from_translation(Vec3::from_slice(&self.file.floats_n(c, 3)?)),
                 "scale" => Mat4::from_scale(Vec3::from_slice(&self.file.floats_n(c, 3)?)),
                 "rotate" => {

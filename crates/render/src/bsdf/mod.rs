@@ -306,6 +306,17 @@ impl Bsdf {
         self.rest[0].is_none() && self.null == 0.0
     }
 
+    /// Whether the BSDF reflects and transmits nothing whatever the directions (black
+    /// Lambertian lobes only, nothing passing through): radiance leaving such a point is its
+    /// emission alone, which no random number can change.
+    pub fn is_black(&self) -> bool {
+        self.null == 0.0
+            && self.lobes().all(|l| match &l.bxdf {
+                Bxdf::Diffuse(d) => l.weight == 0.0 || d.reflectance.max_element() <= 0.0,
+                _ => l.weight == 0.0,
+            })
+    }
+
     /// The weight of passing straight through.
     pub fn pass_through(&self) -> f32 {
         self.null

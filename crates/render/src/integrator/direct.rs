@@ -120,6 +120,7 @@ impl Integrator for DirectIntegrator {
         let wo = -ray.d;
         let mut l = seen(emitted(scene, ray.o, &ray, &si));
         let bsdf = scene.bsdf(&si, wo);
+        stats.random_vertices += u64::from(!bsdf.is_black());
         if self.strategy == DirectStrategy::Mis {
             return l + self.mis(scene, &si, &bsdf, wo, sampler, stats);
         }

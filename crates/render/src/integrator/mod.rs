@@ -31,6 +31,11 @@ pub struct PathStats {
     pub rays: u64,
     /// BVH nodes visited by closest-hit rays.
     pub nodes_visited: u64,
+    /// Surface points at which a path drew random numbers that could change its radiance
+    /// (a BSDF that is not black). A pixel whose samples added none has radiance that only
+    /// its camera rays decide (they escaped, or met black emitters): see
+    /// [`crate::render::Adaptive`].
+    pub random_vertices: u64,
 }
 
 impl PathStats {
@@ -38,6 +43,7 @@ impl PathStats {
     pub fn merge(&mut self, o: &PathStats) {
         self.rays += o.rays;
         self.nodes_visited += o.nodes_visited;
+        self.random_vertices += o.random_vertices;
     }
 }
 

@@ -235,6 +235,7 @@ impl PathIntegrator {
                     hits[i] = None;
                     continue;
                 };
+                stats.random_vertices += u64::from(diffuse.reflectance.max_element() > 0.0);
                 let wo = -st.ray.d;
                 a.p.set(i, si.p);
                 a.ng.set(i, si.ng);

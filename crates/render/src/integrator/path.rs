@@ -176,6 +176,7 @@ impl PathIntegrator {
         let bsdf_samples = u32::from(self.lighting == PathLighting::Mis);
         let wo = -st.ray.d;
         let bsdf = scene.bsdf(si, wo);
+        stats.random_vertices += u64::from(!bsdf.is_black());
         if self.wants(st.depth + 1) && !bsdf.is_delta() && self.lighting != PathLighting::Bsdf {
             let mut ld = Rgb::ZERO;
             for _ in 0..n_light {
