@@ -18,7 +18,8 @@ use std::path::PathBuf;
 /// Raw command-line arguments of `pathlab compare`.
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// The scene: a file or a built-in scene's name.
+    /// The scene: a file (.xml Mitsuba 3, .dae the course's COLLADA, .obj, .ply, .gltf, .glb) or
+    /// a built-in scene's name (cornell-box).
     #[arg(default_value = "cornell-box")]
     pub scene: String,
     /// Strategies to compare, comma-separated: hemisphere, cosine, light, mis (direct lighting)
@@ -129,16 +130,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             .map(|p| p.variance().element_sum() / 3.0)
             .sum::<f64>()
             / n;
-        let rmse = reference.as_ref().map(|r| {
-            (film
-                .pixels()
-                .iter()
-                .zip(r)
-                .map(|(p, q)| (p.mean().as_vec3() - *q).length_squared() as f64 / 3.0)
-                .sum::<f64>()
-                / n)
-                .sqrt()
-        });
+        let rmse = reference
+            .as_ref()
+            .map(|r| crate::images::film_rmse(&film, r));
         rows.push(Row {
             name: name.trim().to_string(),
             seconds: stats.seconds,
@@ -146,6 +140,22 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             rmse,
             film,
         });
+    }
+    if let (Some(r), Some(p), Some(best)) = (
+        &reference,
+        &args.reference,
+        rows.iter().min_by(|a, b| a.variance.total_cmp(&b.variance)),
+    ) {
+        // Direct-lighting strategies stop at the first bounce; path strategies at -m.
+        let path = args.strategies.iter().any(|s| s.trim().starts_with("path"));
+        let depth = match (path, args.max_depth) {
+            (false, _) => "1".to_string(),
+            (true, u32::MAX) => "inf".to_string(),
+            (true, d) => d.to_string(),
+        };
+        if let Some(w) = crate::images::reference_mismatch(&best.film, r, p, &depth) {
+            eprintln!("warning: {w}");
+        }
     }
     write_side_by_side(&rows, &args.output)?;
     // Undefined when the variance is unknown (one sample per pixel) or the time too short to

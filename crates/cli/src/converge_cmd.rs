@@ -17,7 +17,8 @@ use std::path::PathBuf;
 /// Raw command-line arguments of `pathlab converge`.
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
-    /// The scene: a file or a built-in scene's name.
+    /// The scene: a file (.xml Mitsuba 3, .dae the course's COLLADA, .obj, .ply, .gltf, .glb) or
+    /// a built-in scene's name (cornell-box).
     #[arg(default_value = "cornell-box")]
     pub scene: String,
     /// The reference image: a linear EXR of the scene at the render's resolution.
@@ -68,21 +69,30 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         max_depth: args.max_depth,
         ..Default::default()
     });
-    let rmse = |film: &Film| -> f64 {
-        let n = film.pixels().len() as f64;
-        (film
-            .pixels()
-            .iter()
-            .zip(&reference)
-            .map(|(p, r)| (p.mean().as_vec3() - *r).length_squared() as f64 / 3.0)
-            .sum::<f64>()
-            / n)
-            .sqrt()
-    };
     let levels: Vec<u32> = (0..=16)
         .map(|k| 1u32 << k)
         .filter(|&s| s <= args.max_spp)
         .collect();
+    let top = levels.last().copied().unwrap_or(1);
+    let rmse = |film: &Film| -> f64 { crate::images::film_rmse(film, &reference) };
+    // The first independent render at the most samples checks the reference belongs to it.
+    let mut checked = false;
+    let mut check = |film: &Film, kind: SamplerKind, spp: u32| {
+        if checked || kind != SamplerKind::Independent || spp != top {
+            return;
+        }
+        checked = true;
+        let depth = if args.max_depth == u32::MAX {
+            "inf".to_string()
+        } else {
+            args.max_depth.to_string()
+        };
+        if let Some(w) =
+            crate::images::reference_mismatch(film, &reference, &args.reference, &depth)
+        {
+            eprintln!("warning: {w}");
+        }
+    };
     let mut curves = Vec::new();
     for (name, kind) in [
         ("independent", SamplerKind::Independent),
@@ -98,6 +108,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
                     &|_| {},
                     &Default::default(),
                 );
+                check(&film, kind, spp);
                 (spp as f64, stats.seconds, rmse(&film))
             })
             .collect::<Vec<_>>();

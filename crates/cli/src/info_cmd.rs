@@ -7,7 +7,8 @@ use serde_json::json;
 /// Raw command-line arguments of `pathlab info`.
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// The scene: a file (.xml Mitsuba 3, .dae, .obj, .ply) or a built-in scene's name (cornell-box).
+    /// The scene: a file (.xml Mitsuba 3, .dae the course's COLLADA, .obj, .ply, .gltf, .glb) or
+    /// a built-in scene's name (cornell-box).
     pub scene: String,
     /// Print the summary as JSON on stdout.
     #[arg(long)]

@@ -6,7 +6,9 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use glam::Vec2;
 use pathlab_mc::distribution::{PiecewiseConstant1D, PiecewiseConstant2D};
-use pathlab_mc::estimator::{integrate_parallel, Estimate, RunningStats};
+use pathlab_mc::estimator::{
+    integrate_parallel, largest_term_share, looks_heavy_tailed, Estimate, RunningStats,
+};
 use pathlab_mc::sampler::{AnySampler, Sampler, SamplerKind};
 use pathlab_mc::stats::z_test;
 use rayon::prelude::*;
@@ -283,6 +285,23 @@ impl Problem {
         e
     }
 
+    /// The share of the sample variance carried by the largest of the terms f/p (see
+    /// [`largest_term_share`]).
+    fn largest_share(&self, kind: SamplerKind, n: u32, seed: u64, mean: f64) -> f64 {
+        let sampler = kind.build(n, seed);
+        largest_term_share(
+            |x: &[f64; MAX_DIMS]| self.f.eval(&x[..self.domains.len()]),
+            &sampler,
+            |s| {
+                let mut x = [0.0; MAX_DIMS];
+                let pdf = self.proposal.draw(s, &mut x);
+                (x, pdf)
+            },
+            n,
+            mean,
+        )
+    }
+
     /// Finds a sample point where the integrand is not finite (for the error message).
     fn find_non_finite(&self, kind: SamplerKind, n: u32, seed: u64) -> Option<[f64; MAX_DIMS]> {
         let mut s = kind.build(n, seed);
@@ -360,6 +379,17 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
         );
     }
     let rate = est.n as f64 / seconds.max(1e-9);
+    let share = problem.largest_share(args.sampler, n, args.seed, est.mean);
+    let heavy = looks_heavy_tailed(share, n as u64);
+    let mut warnings = problem.warnings.clone();
+    if heavy {
+        let w = format!(
+            "one of the {n} samples carries {:.0}% of the sample variance: f/p looks heavy-tailed (infinite variance, or a divergent integral such as 1/x at 0), so the standard error and interval are not to be trusted; sample in proportion to the integrand's peak (--importance) or change variables",
+            100.0 * share
+        );
+        eprintln!("warning: {w}");
+        warnings.push(w);
+    }
 
     let convergence = match &args.convergence {
         Some(path) => Some(convergence(
@@ -388,7 +418,9 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
             "variance_per_sample": est.variance,
             "seconds": seconds,
             "samples_per_second": rate,
-            "warnings": problem.warnings,
+            "largest_sample_share": share,
+            "heavy_tailed": heavy,
+            "warnings": warnings,
         });
         if let Some(x) = exact {
             let z = z_test(est.mean, est.std_error, x);

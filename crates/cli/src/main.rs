@@ -4,6 +4,8 @@ mod bench_cmd;
 mod compare_cmd;
 mod converge_cmd;
 mod expr;
+mod image_cmd;
+mod images;
 mod info_cmd;
 mod integrate;
 mod plot;
@@ -36,6 +38,10 @@ enum Command {
     Sample(sample::SampleArgs),
     /// Estimate an integral over a box by Monte Carlo, with its error.
     Integrate(integrate::IntegrateArgs),
+    /// Re-encode an image: EXR to PNG with exposure and tone map, or any readable image to EXR.
+    Convert(image_cmd::ConvertArgs),
+    /// Compare two images of one size: RMSE, relative MSE, and a difference image.
+    Diff(image_cmd::DiffArgs),
     /// Measure speed (not a test): BVH build and ray throughput against Embree's ray files.
     Bench(bench_cmd::BenchArgs),
 }
@@ -52,6 +58,8 @@ fn main() -> ExitCode {
         Command::Converge(args) => converge_cmd::run(args),
         Command::Sample(args) => sample::run(args),
         Command::Integrate(args) => integrate::run(args),
+        Command::Convert(args) => image_cmd::run_convert(args),
+        Command::Diff(args) => image_cmd::run_diff(args),
         Command::Bench(args) => bench_cmd::run(args),
     };
     match result {

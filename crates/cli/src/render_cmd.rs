@@ -2,9 +2,11 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::desc::{FresnelModel, IntegratorHint, MaterialDesc, SceneDesc};
+use pathlab_render::desc::{
+    FovAxis, FresnelModel, IntegratorHint, MaterialDesc, Projection, SceneDesc,
+};
 use pathlab_render::film::Film;
 use pathlab_render::image_io::{write_exr, write_png_with, write_rgb8, ExtraChannel, ToneMap};
 use pathlab_render::integrator::{
@@ -37,7 +39,11 @@ pub enum IntegratorName {
 /// Adaptive stopping rules.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum RuleName {
-    /// The course's relative-precision rule.
+    /// Unbiased: a pilot batch from its own stream plans each pixel's count (the course's
+    /// precision target), and only the planned samples make the image.
+    TwoStage,
+    /// The course's relative-precision rule, checked after each batch (biased by optional
+    /// stopping).
     Course,
     /// Samples in proportion to each pixel's standard deviation.
     Neyman,
@@ -48,7 +54,7 @@ pub enum RuleName {
 pub enum ToneMapName {
     /// Exposure, clamp, sRGB transfer function.
     Srgb,
-    /// The CS184 course's renderer: clamp((√2 c)^(1/2.2)).
+    /// The CS184 course's renderer: clamp((√2 c)^(1/2.2)), √2 being half a stop up.
     Cs184,
 }
 
@@ -84,7 +90,8 @@ pub enum FresnelName {
 /// Raw command-line arguments of `pathlab render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The scene: a file (.xml Mitsuba 3, .dae, .obj, .ply) or a built-in scene's name (cornell-box).
+    /// The scene: a file (.xml Mitsuba 3, .dae the course's COLLADA, .obj, .ply, .gltf, .glb) or
+    /// a built-in scene's name (cornell-box).
     #[arg(default_value = "cornell-box")]
     pub scene: String,
     /// Samples per pixel (default: the scene file's, else 64).
@@ -109,12 +116,23 @@ pub struct RenderArgs {
     /// Worker threads (0: all cores).
     #[arg(short = 't', long, default_value_t = 0, allow_negative_numbers = true, value_parser = threads_arg)]
     pub threads: usize,
-    /// Image size in pixels (default: the scene's).
+    /// Image size in pixels (default: the scene's). The view is scaled to fit, except for the
+    /// course's .dae scenes, whose camera keeps the course viewer's pixel scale: a smaller
+    /// size shows a centred crop, a larger one more around it (use --scale to resize those).
     #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"], allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub resolution: Option<Vec<u32>>,
-    /// Adaptive sampling: batches of BATCH samples; a pixel stops once the 95% interval of its
-    /// mean luminance is within ± TOL relative (at most --spp samples). Defaults 32 0.05. Writes
-    /// the samples-per-pixel heat map to NAME_rate.png.
+    /// The scene's own view at F times its resolution (any format; the .dae scenes' way to
+    /// change their size without cropping).
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
+    pub scale: Option<f32>,
+    /// Field of view in degrees on the image's smaller axis, in place of the scene camera's.
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub fov: Option<f32>,
+    /// Adaptive sampling: each pixel takes the samples that bring the 95% interval of its mean
+    /// luminance within ± TOL relative (at most --spp), in batches of BATCH; by default planned
+    /// from a pilot batch that is not part of the image, so that the image stays unbiased
+    /// (see --adaptive-rule). Defaults 32 0.05. Writes the samples-per-pixel heat map to
+    /// NAME_rate.png.
     #[arg(short = 'a', long, num_args = 0..=2, value_names = ["BATCH", "TOL"], default_missing_values = ["32", "0.05"])]
     pub adaptive: Option<Vec<String>>,
     /// Thin lens: aperture radius (0: pinhole). Overrides the scene's.
@@ -133,17 +151,20 @@ pub struct RenderArgs {
         allow_negative_numbers = true
     )]
     pub focal_distance: Option<f32>,
-    /// Adaptive stopping rule: course (1.96σ/√n ≤ TOL·μ), or neyman (n ≥ (1.96/TOL)² σ/L̄
-    /// with L̄ from a 4-spp pilot: samples in proportion to σ, which minimises the image's MSE).
-    /// Default: course. Only with -a.
+    /// Adaptive rule: two-stage (default; n = (1.96σ/(TOL·μ))² from a pilot batch of its own,
+    /// unbiased), course (stop after a batch once 1.96σ/√n ≤ TOL·μ, the course's rule, biased
+    /// by optional stopping), or neyman (stop once n ≥ (1.96/TOL)² σ/L̄ with L̄ from a 4-spp
+    /// pilot: samples in proportion to σ, which minimises the image's MSE; biased as course).
+    /// Only with -a.
     #[arg(long, value_enum)]
     pub adaptive_rule: Option<RuleName>,
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black).
     #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..))]
     pub crop: Option<Vec<u32>>,
-    /// Output image: .exr (linear) or .png (sRGB). Default: SCENE.png.
+    /// Output image: .exr (linear) or .png (sRGB). Repeat for several files from one render
+    /// (-o a.exr -o a.png). Default: SCENE.png.
     #[arg(short = 'o', long, visible_short_alias = 'f', value_name = "FILE")]
-    pub output: Option<PathBuf>,
+    pub output: Vec<PathBuf>,
     /// The integrator (default: the one the scene file names, else path).
     #[arg(long, value_enum)]
     pub integrator: Option<IntegratorName>,
@@ -190,7 +211,8 @@ pub struct RenderArgs {
     /// Exposure in stops applied before PNG encoding.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
-    /// PNG encoding: srgb, or cs184 (the course's one stop of exposure and gamma 2.2).
+    /// PNG encoding: srgb (exposure, clamp, the sRGB curve), or cs184 (the course's renderer:
+    /// radiance times √2, which is half a stop up, then gamma 2.2 and clamp).
     #[arg(long, value_enum, default_value_t = ToneMapName::Srgb)]
     pub tonemap: ToneMapName,
     /// Extra outputs, comma-separated: variance, samples (EXR channels, or files next to a PNG).
@@ -225,7 +247,7 @@ pub(crate) fn parse_max_depth(text: &str) -> Result<u32> {
     })
 }
 
-fn parse_adaptive(values: &[String]) -> Result<Adaptive> {
+fn parse_adaptive(values: &[String], rule: Option<RuleName>) -> Result<Adaptive> {
     let batch = match values.first() {
         Some(b) => b.parse::<u32>().ok().filter(|&b| b > 0).with_context(|| {
             format!("--adaptive {b}: BATCH must be a positive number of samples")
@@ -246,7 +268,12 @@ fn parse_adaptive(values: &[String]) -> Result<Adaptive> {
         batch,
         tolerance,
         min_samples: 4 * batch,
-        rule: AdaptiveRule::Course,
+        rule: match rule {
+            Some(RuleName::Course) => AdaptiveRule::Course,
+            // The Neyman rule's image luminance comes from its pilot render, later.
+            Some(RuleName::Neyman) => AdaptiveRule::Course,
+            Some(RuleName::TwoStage) | None => AdaptiveRule::TwoStage,
+        },
     })
 }
 
@@ -278,6 +305,73 @@ pub fn apply_resolution(desc: &mut SceneDesc, resolution: Option<&[u32]>) -> Res
         desc.resolution = [w, h];
     }
     Ok(())
+}
+
+/// Applies `--scale F` (the scene's view at F times its resolution) and `--fov DEG`.
+pub fn apply_view(desc: &mut SceneDesc, scale: Option<f32>, fov: Option<f32>) -> Result<()> {
+    if let Some(f) = scale {
+        if !(f.is_finite() && f > 0.0) {
+            bail!("--scale {f}: must be a positive factor such as 0.5 or 2");
+        }
+        let [w, h] = desc.resolution;
+        let size = |n: u32| (n as f64 * f as f64).round();
+        let (sw, sh) = (size(w), size(h));
+        if !(1.0..=16384.0).contains(&sw) || !(1.0..=16384.0).contains(&sh) {
+            bail!("--scale {f}: {w}x{h} would become {sw}x{sh}; width and height must be between 1 and 16384");
+        }
+        desc.resolution = [sw as u32, sh as u32];
+        // A camera whose field of view follows from its resolution keeps its view.
+        if let Some(p) = desc.camera.focal_pixels.as_mut() {
+            *p *= sw as f32 / w as f32;
+        }
+    }
+    if let Some(deg) = fov {
+        if !(deg.is_finite() && deg > 0.0 && deg < 180.0) {
+            bail!("--fov {deg}: must be an angle between 0 and 180 degrees");
+        }
+        if !matches!(desc.camera.projection, Projection::Perspective) {
+            bail!("--fov {deg}: the scene's camera is orthographic, which has no field of view");
+        }
+        desc.camera.fov_degrees = deg;
+        desc.camera.fov_axis = FovAxis::Smaller;
+        desc.camera.focal_pixels = None;
+    }
+    Ok(())
+}
+
+/// An output path that can be written: its folder exists and a file can be made there
+/// (checked before rendering, so that no render is lost to a typo).
+fn check_writable(path: &Path) -> Result<()> {
+    let existed = path.exists();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)
+        .with_context(|| format!("{}: cannot write the output", path.display()))?;
+    if !existed {
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(())
+}
+
+/// A count or rate with an SI prefix and three significant digits: 950, 12.3 k, 4.56 M.
+pub(crate) fn si_prefixed(v: f64) -> String {
+    if !v.is_finite() || v < 0.0 {
+        return "-".to_string();
+    }
+    let (scaled, prefix) = [(1e12, " T"), (1e9, " G"), (1e6, " M"), (1e3, " k")]
+        .iter()
+        .find(|(p, _)| v >= *p)
+        .map_or((v, ""), |&(p, n)| (v / p, n));
+    let digits = if scaled >= 100.0 || prefix.is_empty() {
+        0
+    } else if scaled >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{scaled:.digits$}{prefix}")
 }
 
 /// Set by Ctrl-C: the render stops and writes what it has.
@@ -333,14 +427,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             eprintln!("warning: {w}");
         }
     }
-    let output = args.output.clone().unwrap_or_else(|| {
+    let outputs = if args.output.is_empty() {
         let stem = Path::new(&args.scene)
             .file_stem()
             .and_then(|s| s.to_str())
             .unwrap_or("render");
-        PathBuf::from(format!("{stem}.png"))
-    });
-    let format = output_format(&output)?;
+        vec![PathBuf::from(format!("{stem}.png"))]
+    } else {
+        args.output.clone()
+    };
+    let formats = outputs
+        .iter()
+        .map(|o| output_format(o))
+        .collect::<Result<Vec<_>>>()?;
+    for o in &outputs {
+        check_writable(o)?;
+    }
+    let output = outputs[0].clone();
     let params = args
         .define
         .iter()
@@ -394,6 +497,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("--only-bounce {k} is beyond the scene's largest bounce {max_depth}: the image would be black");
     }
     apply_resolution(&mut desc, args.resolution.as_deref())?;
+    apply_view(&mut desc, args.scale, args.fov)?;
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let rr_depth = args.rr_depth.or(desc.hints.rr_depth).unwrap_or(5);
     let integrator_name = args.integrator.unwrap_or(match desc.hints.integrator {
@@ -458,7 +562,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         });
     let mut settings = RenderSettings::new(spp, args.seed, sampler);
     if let Some(a) = &args.adaptive {
-        settings.adaptive = Some(parse_adaptive(a)?);
+        settings.adaptive = Some(parse_adaptive(a, args.adaptive_rule)?);
     }
     if let Some(c) = &args.crop {
         let [w, h] = desc.resolution;
@@ -501,10 +605,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         b
     } else {
         let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        // The bar takes what the terminal's width leaves; counts and rates with SI prefixes.
         b.set_style(
             ProgressStyle::with_template(
-                "{bar:40} {percent:>3}%  {human_pos}/{human_len} samples  {per_sec}  ETA {eta}",
+                "{wide_bar} {percent:>3}% {done}/{all} samples {rate} ETA {eta}",
             )
+            .map(|s| {
+                s.with_key("done", |st: &ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = write!(w, "{}", si_prefixed(st.pos() as f64));
+                })
+                .with_key("all", |st: &ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = write!(w, "{}", si_prefixed(st.len().unwrap_or(0) as f64));
+                })
+                .with_key(
+                    "rate",
+                    |st: &ProgressState, w: &mut dyn std::fmt::Write| {
+                        let _ = write!(w, "{}/s", si_prefixed(st.per_sec()));
+                    },
+                )
+            })
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
         b
@@ -554,15 +673,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // The BVH view counts nodes (1 to a few hundred): a PNG shows them as a heat map scaled
     // to the image's own range, the EXR keeps the counts.
     let heat_range = (integrator_name == IntegratorName::Bvh).then(|| value_range(&film));
-    match heat_range {
-        Some((_, hi)) if format == OutputFormat::Png => {
-            let counts: Vec<f32> = film.mean_image().iter().map(|v| v.x).collect();
-            write_heat_image(&film, &counts, hi, &output)?;
+    for (path, &format) in outputs.iter().zip(&formats) {
+        match heat_range {
+            Some((_, hi)) if format == OutputFormat::Png => {
+                let counts: Vec<f32> = film.mean_image().iter().map(|v| v.x).collect();
+                write_heat_image(&film, &counts, hi, path)?;
+            }
+            _ => write_outputs(&film, path, format, args)?,
         }
-        _ => write_outputs(&film, &output, format, args)?,
     }
     if let (Some((lo, hi)), false) = (heat_range, args.quiet || args.json) {
-        let how = if format == OutputFormat::Png {
+        let how = if formats.contains(&OutputFormat::Png) {
             format!("the PNG runs blue (0) through green to red ({hi:.0})")
         } else {
             "the EXR holds the counts".to_string()
@@ -575,8 +696,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         if !args.quiet {
             let counts = film.sample_counts();
             let mean = counts.iter().map(|&c| c as f64).sum::<f64>() / counts.len().max(1) as f64;
+            let pixels = counts.len().max(1) as f64;
+            let pilot = if stats.pilot_samples > 0 {
+                format!(
+                    ", plus {:.1} pilot samples per pixel that chose the counts",
+                    stats.pilot_samples as f64 / pixels
+                )
+            } else {
+                String::new()
+            };
             eprintln!(
-                "adaptive: {mean:.1} samples per pixel on average (at most {spp}); rate image {}",
+                "adaptive: {mean:.1} samples per pixel on average (at most {spp}){pilot}; rate image {}",
                 rate.display()
             );
         }
@@ -600,6 +730,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let out = json!({
             "scene": args.scene,
             "output": output,
+            "outputs": outputs,
             "resolution": [w, h],
             "spp": if varies { json!(spp_mean) } else { json!(spp_mean.round() as u64) },
             "spp_range": [spp_lo, spp_hi],
@@ -609,6 +740,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "threads": threads,
             "seconds": stats.seconds,
             "samples": stats.samples,
+            "pilot_samples": stats.pilot_samples,
             "samples_per_second": stats.samples as f64 / stats.seconds.max(1e-9),
             "rays": stats.rays,
             "rays_per_second": stats.rays as f64 / stats.seconds.max(1e-9),
@@ -625,16 +757,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else if !args.quiet {
         eprintln!(
-            "{}: {}x{}, {spp_text}, {:.2} s, {:.3e} samples/s, {:.3e} rays/s, BVH {} nodes in {:.1} ms; wrote {}",
+            "{}: {}x{}, {spp_text}, {:.2} s, {} samples/s, {} rays/s, BVH {} nodes in {:.1} ms; wrote {}",
             args.scene,
             w,
             h,
             stats.seconds,
-            stats.samples as f64 / stats.seconds.max(1e-9),
-            stats.rays as f64 / stats.seconds.max(1e-9),
+            si_prefixed(stats.samples as f64 / stats.seconds.max(1e-9)),
+            si_prefixed(stats.rays as f64 / stats.seconds.max(1e-9)),
             build.bvh_nodes,
             build.bvh_seconds * 1e3,
-            output.display()
+            outputs
+                .iter()
+                .map(|o| o.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         );
         if stats.nonfinite_samples > 0 {
             eprintln!(
@@ -741,4 +877,18 @@ fn write_outputs(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::si_prefixed;
+
+    #[test]
+    fn counts_and_rates_get_si_prefixes_and_three_digits() {
+        assert_eq!(si_prefixed(950.0), "950");
+        assert_eq!(si_prefixed(12_345.0), "12.3 k");
+        assert_eq!(si_prefixed(4_567_891.0), "4.57 M");
+        assert_eq!(si_prefixed(123_456_789_012.0), "123 G");
+        assert_eq!(si_prefixed(f64::NAN), "-");
+    }
 }

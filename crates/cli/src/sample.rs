@@ -445,6 +445,31 @@ fn fit(dist: &Dist, kind: SamplerKind, n: u32, seed: u64, want_plot: bool) -> Fi
 }
 
 /// Runs `pathlab sample`.
+/// The tests' conclusion in words, at α = 0.01.
+fn verdict(n: u32, test: &pathlab_mc::stats::ChiSquareTest) -> String {
+    if n < 2 {
+        return format!(
+            "{n} sample is too few: a standard error (and so z) needs at least 2, the chi-square test many more (use -n 10000 or more)"
+        );
+    }
+    if test.dof == 0 {
+        return format!(
+            "{n} samples are too few for the chi-square test: every cell expects fewer than 5 (use -n 10000 or more)"
+        );
+    }
+    if test.p_value >= 0.01 {
+        format!(
+            "consistent with the pdf at α = 0.01 (p = {:.3})",
+            test.p_value
+        )
+    } else {
+        format!(
+            "NOT consistent with the pdf at α = 0.01 (p = {:.2e}): the samples do not follow it",
+            test.p_value
+        )
+    }
+}
+
 pub fn run(args: &SampleArgs) -> Result<()> {
     if args.samples == 0 || args.samples > u32::MAX as u64 {
         bail!(
@@ -502,7 +527,7 @@ pub fn run(args: &SampleArgs) -> Result<()> {
                 "mean": s.mean(),
                 "std_error": s.std_error(),
                 "exact_mean": m.mean,
-                "z": z.z,
+                "z": if n >= 2 { json!(z.z) } else { json!(null) },
                 "variance": s.variance(),
                 "exact_variance": m.variance,
             })).collect::<Vec<_>>(),
@@ -511,6 +536,7 @@ pub fn run(args: &SampleArgs) -> Result<()> {
                 "dof": fit.test.dof,
                 "p_value": fit.test.p_value,
             },
+            "verdict": verdict(n, &fit.test),
             "seconds": seconds,
             "samples_per_second": n as f64 / seconds.max(1e-9),
             "plot": args.plot,
@@ -530,12 +556,17 @@ pub fn run(args: &SampleArgs) -> Result<()> {
         "", "mean", "exact mean", "z", "variance", "exact var"
     );
     for (m, s, z) in &rows {
+        let z = if n >= 2 {
+            format!("{:.2}", z.z)
+        } else {
+            "-".to_string()
+        };
         println!(
-            "  {:<6} {:>12.6} {:>12.6} {:>8.2} {:>12.6} {:>12.6}",
+            "  {:<6} {:>12.6} {:>12.6} {:>8} {:>12.6} {:>12.6}",
             m.name,
             s.mean(),
             m.mean,
-            z.z,
+            z,
             s.variance(),
             m.variance
         );
@@ -544,6 +575,7 @@ pub fn run(args: &SampleArgs) -> Result<()> {
         "  chi-square fit against the pdf: statistic {:.1}, {} dof, p = {:.3}",
         fit.test.statistic, fit.test.dof, fit.test.p_value
     );
+    println!("  {}", verdict(n, &fit.test));
     if args.sampler != SamplerKind::Independent {
         println!(
             "  (z and p assume independent samples; a {} sampler is more even than that)",

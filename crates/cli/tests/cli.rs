@@ -1119,3 +1119,268 @@ fn bench_rays_checks_hits_against_the_ray_file() {
     let text = std::fs::read_to_string(&exported).unwrap();
     assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 36);
 }
+
+const PNG: &[u8] = b"\x89PNG\r\n\x1a\n";
+const EXR: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
+
+/// Asserts the file exists and starts with its format's magic number.
+fn assert_magic(path: &PathBuf, magic: &[u8]) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(bytes.starts_with(magic), "{}: wrong format", path.display());
+}
+
+#[test]
+fn one_render_writes_several_outputs_and_convert_and_diff_read_them() {
+    let (exr, png) = (scratch("multi.exr"), scratch("multi.png"));
+    let v = json_of(&pathlab(&[
+        "render",
+        "-s",
+        "4",
+        "-r",
+        "32",
+        "24",
+        "-o",
+        exr.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "-q",
+        "--json",
+    ]));
+    assert_magic(&exr, EXR);
+    assert_magic(&png, PNG);
+    assert_eq!(v["outputs"].as_array().unwrap().len(), 2);
+    // An output that cannot be written is found before rendering.
+    assert_one_line_error(
+        &pathlab(&["render", "-s", "100000", "-o", "/no/such/folder/x.png"]),
+        "cannot write the output",
+    );
+    assert_one_line_error(
+        &pathlab(&["render", "-o", "a.exr", "-o", "b.tiff"]),
+        "must end in .exr or .png",
+    );
+    // convert: EXR to PNG with exposure; PNG back to EXR.
+    let converted = scratch("converted.png");
+    let out = pathlab(&[
+        "convert",
+        exr.to_str().unwrap(),
+        converted.to_str().unwrap(),
+        "--exposure",
+        "1",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_magic(&converted, PNG);
+    let back = scratch("converted.exr");
+    let out = pathlab(&["convert", png.to_str().unwrap(), back.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // diff: an image against itself is zero; against another render it is not.
+    let same = json_of(&pathlab(&[
+        "diff",
+        exr.to_str().unwrap(),
+        exr.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(same["rmse"].as_f64(), Some(0.0));
+    let other = scratch("other.exr");
+    json_of(&pathlab(&[
+        "render",
+        "-s",
+        "4",
+        "-r",
+        "32",
+        "24",
+        "--seed",
+        "9",
+        "-o",
+        other.to_str().unwrap(),
+        "-q",
+        "--json",
+    ]));
+    let heat = scratch("diff.png");
+    let d = json_of(&pathlab(&[
+        "diff",
+        exr.to_str().unwrap(),
+        other.to_str().unwrap(),
+        "-o",
+        heat.to_str().unwrap(),
+        "--json",
+    ]));
+    let rmse = d["rmse"].as_f64().unwrap();
+    assert!(rmse > 0.0 && rmse < 1.0, "{rmse}");
+    assert!(d["relative_mse"].as_f64().unwrap() > 0.0);
+    assert_magic(&heat, PNG);
+    let small = scratch("small.exr");
+    json_of(&pathlab(&[
+        "render",
+        "-s",
+        "1",
+        "-r",
+        "8",
+        "8",
+        "-o",
+        small.to_str().unwrap(),
+        "-q",
+        "--json",
+    ]));
+    assert_one_line_error(
+        &pathlab(&["diff", exr.to_str().unwrap(), small.to_str().unwrap()]),
+        "images of one size are compared",
+    );
+}
+
+#[test]
+fn the_default_adaptive_rule_is_two_stage_with_its_pilot_reported() {
+    let out = scratch("adaptive2.png");
+    let run = |rule: Option<&str>| {
+        let mut args = vec![
+            "render",
+            "-a",
+            "-s",
+            "64",
+            "-r",
+            "16",
+            "16",
+            "-o",
+            out.to_str().unwrap(),
+            "--json",
+        ];
+        if let Some(r) = rule {
+            args.extend(["--adaptive-rule", r]);
+        }
+        json_of(&pathlab(&args))
+    };
+    let v = run(None);
+    assert_eq!(v["pilot_samples"].as_u64(), Some(32 * 256));
+    let v = run(Some("course"));
+    assert_eq!(v["pilot_samples"].as_u64(), Some(0));
+}
+
+#[test]
+fn compare_warns_when_the_reference_is_of_another_depth() {
+    let data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scene/tests/data/cornell-box");
+    let run = |reference: &str, strategies: &str| {
+        let out = scratch("compare_warn.png");
+        pathlab(&[
+            "compare",
+            "-s",
+            "4",
+            "--strategies",
+            strategies,
+            "-m",
+            "1",
+            "--ref",
+            data.join(reference).to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let o = run("mean-maxdepth-inf.exr", "path");
+    assert!(o.status.success());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("warning:") && stderr.contains("its name suggests -m inf"),
+        "{stderr}"
+    );
+    let o = run("mean-maxdepth-2.exr", "light");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success() && !stderr.contains("warning"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn sample_says_its_verdict_and_when_n_is_too_small() {
+    let o = pathlab(&["sample", "exponential", "-n", "1"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("too few") && !text.contains("inf"), "{text}");
+    let v = json_of(&pathlab(&["sample", "exponential", "-n", "1", "--json"]));
+    assert!(v["components"][0]["z"].is_null());
+    let o = pathlab(&["sample", "exponential", "-n", "100000"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("consistent with the pdf at α = 0.01"),
+        "{text}"
+    );
+}
+
+#[test]
+fn integrate_warns_of_heavy_tails() {
+    let o = pathlab(&["integrate", "1/x", "-d", "0,1", "--json"]);
+    let v = json_of(&o);
+    assert_eq!(v["heavy_tailed"], true);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("heavy-tailed"));
+    let v = json_of(&pathlab(&["integrate", "x^2", "-d", "0,1", "--json"]));
+    assert_eq!(v["heavy_tailed"], false);
+}
+
+#[test]
+fn scale_and_fov_resize_and_reframe_any_scene() {
+    let out = scratch("scaled.png");
+    let v = json_of(&pathlab(&[
+        "render",
+        &course_scene("CBspheres_lambertian.dae"),
+        "--scale",
+        "0.05",
+        "-s",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(v["resolution"], serde_json::json!([40, 30]));
+    // The same view at a twentieth of the size: the box fills the same part of the image,
+    // where -r 40 30 shows a crop of the middle (the course's pixel scale).
+    let scaled = v["image_mean_rgb"][0].as_f64().unwrap();
+    let v = json_of(&pathlab(&[
+        "render",
+        &course_scene("CBspheres_lambertian.dae"),
+        "-r",
+        "40",
+        "30",
+        "-s",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    let cropped = v["image_mean_rgb"][0].as_f64().unwrap();
+    assert!(cropped > 1.5 * scaled, "crop {cropped} vs scaled {scaled}");
+    let wide = json_of(&pathlab(&[
+        "render",
+        "--fov",
+        "80",
+        "-s",
+        "1",
+        "-r",
+        "32",
+        "32",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    let narrow = json_of(&pathlab(&[
+        "render",
+        "--fov",
+        "10",
+        "-s",
+        "1",
+        "-r",
+        "32",
+        "32",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_ne!(wide["image_mean_rgb"], narrow["image_mean_rgb"]);
+    assert_one_line_error(&pathlab(&["render", "--scale", "0"]), "--scale 0");
+    assert_one_line_error(&pathlab(&["render", "--fov", "200"]), "--fov 200");
+}

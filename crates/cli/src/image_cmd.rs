@@ -1,0 +1,173 @@
+//! `pathlab convert` and `pathlab diff`: the images pathlab writes, re-encoded and compared.
+
+use crate::images::{relative_mse, rmse};
+use crate::render_cmd::ToneMapName;
+use anyhow::{bail, Result};
+use clap::Args;
+use glam::Vec3;
+use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, write_rgb8, ToneMap};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// Raw command-line arguments of `pathlab convert`.
+#[derive(Args, Debug)]
+pub struct ConvertArgs {
+    /// The image to read (.exr, .hdr linear; .png, .jpg sRGB).
+    pub input: PathBuf,
+    /// The image to write: .png (sRGB after --exposure) or .exr (linear).
+    pub output: PathBuf,
+    /// Exposure in stops applied before PNG encoding.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// PNG encoding: srgb, or cs184 (the course's: times √2, half a stop up, then gamma 2.2).
+    #[arg(long, value_enum, default_value_t = ToneMapName::Srgb)]
+    pub tonemap: ToneMapName,
+}
+
+/// Raw command-line arguments of `pathlab diff`.
+#[derive(Args, Debug)]
+pub struct DiffArgs {
+    /// The image to judge.
+    pub a: PathBuf,
+    /// The image to compare it with (the reference for the relative error).
+    pub b: PathBuf,
+    /// Write the difference: .exr holds A - B per channel, .png a heat map of |A - B|
+    /// (luminance) from black to white at the 99th percentile.
+    #[arg(short = 'o', long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Print the numbers as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What `--output` may end in.
+fn check_extension(path: &Path, allowed: &[&str]) -> Result<String> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    if !allowed.contains(&ext.as_str()) {
+        bail!(
+            "{}: the output must end in .{}",
+            path.display(),
+            allowed.join(" or .")
+        );
+    }
+    Ok(ext)
+}
+
+/// Runs `pathlab convert`.
+pub fn run_convert(args: &ConvertArgs) -> Result<()> {
+    if !args.exposure.is_finite() {
+        bail!(
+            "--exposure {}: must be a finite number of stops",
+            args.exposure
+        );
+    }
+    let ext = check_extension(&args.output, &["png", "exr"])?;
+    let (w, h, px) = read_rgb(&args.input, true)?;
+    if ext == "exr" {
+        write_exr(&args.output, w, h, &px, &[])?;
+    } else {
+        let tone = match args.tonemap {
+            ToneMapName::Srgb => ToneMap::Srgb,
+            ToneMapName::Cs184 => ToneMap::Cs184,
+        };
+        write_png_with(&args.output, w, h, &px, args.exposure, tone)?;
+    }
+    eprintln!(
+        "{}: {w}x{h}; wrote {}",
+        args.input.display(),
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// Runs `pathlab diff`.
+pub fn run_diff(args: &DiffArgs) -> Result<()> {
+    let ext = args
+        .output
+        .as_deref()
+        .map(|o| check_extension(o, &["png", "exr"]))
+        .transpose()?;
+    let (wa, ha, a) = read_rgb(&args.a, true)?;
+    let (wb, hb, b) = read_rgb(&args.b, true)?;
+    if (wa, ha) != (wb, hb) {
+        bail!(
+            "{} is {wa}x{ha} but {} is {wb}x{hb}: images of one size are compared",
+            args.a.display(),
+            args.b.display()
+        );
+    }
+    let e = rmse(&a, &b);
+    let rel = relative_mse(&a, &b);
+    let mean = |img: &[Vec3]| img.iter().sum::<Vec3>() / img.len().max(1) as f32;
+    let (ma, mb) = (mean(&a), mean(&b));
+    let largest = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| (*p - *q).abs().max_element())
+        .fold(0.0f32, f32::max);
+    if let (Some(out), Some(ext)) = (&args.output, &ext) {
+        let diff: Vec<Vec3> = a.iter().zip(&b).map(|(p, q)| *p - *q).collect();
+        if ext == "exr" {
+            write_exr(out, wa, ha, &diff, &[])?;
+        } else {
+            write_difference_heat(out, wa, ha, &diff)?;
+        }
+    }
+    if args.json {
+        let out = json!({
+            "a": args.a,
+            "b": args.b,
+            "resolution": [wa, ha],
+            "rmse": e,
+            "relative_mse": rel,
+            "max_abs_difference": largest,
+            "mean_a": [ma.x, ma.y, ma.z],
+            "mean_b": [mb.x, mb.y, mb.z],
+            "output": args.output,
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        println!(
+            "{wa}x{ha}: RMSE {e:.6}, relative MSE {rel:.6}, largest difference {largest:.6}; mean {:.5} vs {:.5}{}",
+            ma.element_sum() / 3.0,
+            mb.element_sum() / 3.0,
+            args.output
+                .as_ref()
+                .map_or(String::new(), |o| format!("; wrote {}", o.display()))
+        );
+    }
+    Ok(())
+}
+
+/// |difference| in luminance as grey levels: black at zero, white at the 99th percentile (the
+/// scale printed), so that a few fireflies do not hide the rest.
+fn write_difference_heat(path: &Path, w: u32, h: u32, diff: &[Vec3]) -> Result<()> {
+    let lum: Vec<f32> = diff
+        .iter()
+        .map(|d| (0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z).abs())
+        .collect();
+    let mut sorted = lum.clone();
+    sorted.sort_by(f32::total_cmp);
+    let top = sorted
+        .get((sorted.len() as f64 * 0.99) as usize)
+        .or(sorted.last())
+        .copied()
+        .unwrap_or(0.0)
+        .max(f32::MIN_POSITIVE);
+    let bytes: Vec<u8> = lum
+        .iter()
+        .flat_map(|&v| {
+            let g = ((v / top).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+            [g, g, g]
+        })
+        .collect();
+    write_rgb8(path, w, h, &bytes)?;
+    eprintln!(
+        "difference image: black 0 to white {top:.4} (the 99th percentile of |A - B|, luminance)"
+    );
+    Ok(())
+}

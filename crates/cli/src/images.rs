@@ -1,0 +1,116 @@
+//! Comparing images: RMSE and relative MSE, and the check that a reference belongs to the
+//! render it is compared with.
+
+use glam::Vec3;
+use pathlab_render::film::Film;
+use std::path::Path;
+
+/// Root mean squared error over pixels and channels.
+pub fn rmse(a: &[Vec3], b: &[Vec3]) -> f64 {
+    let n = a.len().min(b.len()).max(1) as f64;
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (*p - *q).length_squared() as f64 / 3.0)
+        .sum();
+    (sum / n).sqrt()
+}
+
+/// Relative mean squared error, (a - b)² / (b² + 0.01) averaged over pixels and channels (the
+/// 0.01 keeps black pixels of `b` from dominating).
+pub fn relative_mse(a: &[Vec3], b: &[Vec3]) -> f64 {
+    let n = a.len().min(b.len()).max(1) as f64 * 3.0;
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .flat_map(|(p, q)| {
+            (0..3).map(move |c| {
+                let d = (p[c] - q[c]) as f64;
+                d * d / ((q[c] as f64).powi(2) + 0.01)
+            })
+        })
+        .sum();
+    sum / n
+}
+
+/// The render's RMSE against `reference`.
+pub fn film_rmse(film: &Film, reference: &[Vec3]) -> f64 {
+    rmse(&film.mean_image(), reference)
+}
+
+/// The depth a reference's file name states, as Mitsuba names its renders (`maxdepth-D`,
+/// `max_depth=D`, ...): pathlab's `-m` for it (Mitsuba's depth D counts the camera ray, so it is
+/// pathlab's D - 1; -1 and inf are unbounded).
+pub fn depth_from_name(path: &Path) -> Option<String> {
+    let name = path.file_stem()?.to_str()?.to_ascii_lowercase();
+    let at = ["maxdepth", "max_depth", "max-depth"]
+        .iter()
+        .find_map(|k| name.find(k).map(|i| i + k.len()))?;
+    let rest = &name[at..];
+    let rest = rest.strip_prefix(['-', '_', '=']).unwrap_or(rest);
+    if rest.starts_with("inf") || rest.starts_with("-1") {
+        return Some("inf".to_string());
+    }
+    let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+    let d: u32 = digits.parse().ok()?;
+    Some(d.saturating_sub(1).to_string())
+}
+
+/// Luminance of a colour (Rec. 709).
+fn luminance(c: glam::DVec3) -> f64 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// A warning when `reference` cannot be an image of what `film` renders: the image means,
+/// in luminance, differ by more than five of the render's standard errors (plus 0.1% of the
+/// mean for the reference's own error) — another scene, depth or exposure. Says which
+/// depth the reference's file name suggests. `depth` is the render's `-m` as written.
+pub fn reference_mismatch(
+    film: &Film,
+    reference: &[Vec3],
+    reference_path: &Path,
+    depth: &str,
+) -> Option<String> {
+    let ours = luminance(film.image_mean());
+    let se = luminance(film.image_mean_std_error());
+    let n = reference.len().max(1) as f64;
+    let theirs = luminance(reference.iter().map(|p| p.as_dvec3()).sum::<glam::DVec3>() / n);
+    let tolerance = (se * se + (1e-3 * theirs).powi(2)).sqrt();
+    let z = (ours - theirs) / tolerance.max(f64::MIN_POSITIVE);
+    if z.abs() <= 5.0 || !z.is_finite() {
+        return None;
+    }
+    let hint = match depth_from_name(reference_path) {
+        Some(d) if d != depth => format!("; its name suggests -m {d}"),
+        _ => String::new(),
+    };
+    Some(format!(
+        "{}: the reference's mean luminance {theirs:.5} is {:.0} standard errors from this render's {ours:.5} (at -m {depth}): is it the same scene, depth and exposure?{hint}",
+        reference_path.display(),
+        z.abs()
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn depths_from_mitsuba_file_names() {
+        let d = |s: &str| depth_from_name(Path::new(s));
+        assert_eq!(d("mean-maxdepth-2.exr").as_deref(), Some("1"));
+        assert_eq!(d("ref_max_depth=5.exr").as_deref(), Some("4"));
+        assert_eq!(d("mean-maxdepth-inf.exr").as_deref(), Some("inf"));
+        assert_eq!(d("cornell_maxdepth--1.exr").as_deref(), Some("inf"));
+        assert_eq!(d("reference.exr"), None);
+    }
+
+    #[test]
+    fn errors_of_equal_and_shifted_images() {
+        let a = vec![Vec3::ONE; 4];
+        let b = vec![Vec3::splat(1.5); 4];
+        assert_eq!(rmse(&a, &a), 0.0);
+        assert!((rmse(&a, &b) - 0.5).abs() < 1e-9);
+        assert!((relative_mse(&b, &a) - 0.25 / 1.01).abs() < 1e-9);
+    }
+}
