@@ -18,7 +18,8 @@ use std::path::PathBuf;
 /// Raw command-line arguments of `pathlab compare`.
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// The scene: a file (.xml Mitsuba 3, .dae the course's COLLADA, .obj, .ply, .gltf, .glb) or
+    /// The scene: a file (.xml Mitsuba 3, .pbrt pbrt-v4, .dae the course's COLLADA, .obj, .ply,
+    /// .gltf, .glb) or
     /// a built-in scene's name (cornell-box).
     #[arg(default_value = "cornell-box")]
     pub scene: String,

@@ -7,7 +7,8 @@ use serde_json::json;
 /// Raw command-line arguments of `pathlab info`.
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// The scene: a file (.xml Mitsuba 3, .dae the course's COLLADA, .obj, .ply, .gltf, .glb) or
+    /// The scene: a file (.xml Mitsuba 3, .pbrt pbrt-v4, .dae the course's COLLADA, .obj, .ply,
+    /// .gltf, .glb) or
     /// a built-in scene's name (cornell-box).
     pub scene: String,
     /// Print the summary as JSON on stdout.
@@ -17,8 +18,16 @@ pub struct InfoArgs {
 
 /// Runs `pathlab info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
+    let start = std::time::Instant::now();
     let desc = pathlab_scene::load(&args.scene)?;
+    let load_seconds = start.elapsed().as_secs_f64();
     let info = pathlab_scene::info::summarize(&desc);
+    // The renderer's own form of the scene: what rendering it holds in memory.
+    let scene = pathlab_render::scene::Scene::build(&desc)
+        .map_err(|e| anyhow::anyhow!("{}: cannot build the scene: {e}", args.scene))?;
+    let bytes = scene.geometry_bytes();
+    let per_triangle = (info.triangles > 0).then(|| bytes as f64 / info.triangles as f64);
+    let build_seconds = scene.stats().bvh_seconds;
     let (origin, target, vfov, [w, h]) = info.camera;
     if args.json {
         let out = json!({
@@ -36,6 +45,10 @@ pub fn run(args: &InfoArgs) -> Result<()> {
                 "resolution": [w, h],
             },
             "bounds": info.bounds.map(|(lo, hi)| [lo.to_array(), hi.to_array()]),
+            "geometry_bytes": bytes,
+            "bytes_per_triangle": per_triangle,
+            "load_seconds": load_seconds,
+            "bvh_build_seconds": build_seconds,
             "warnings": info.warnings,
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
@@ -74,6 +87,11 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         ),
         None => println!("  bounds     empty"),
     }
+    println!(
+        "  memory     {:.1} MiB of geometry and BVH{}; loaded in {load_seconds:.2} s, BVH built in {build_seconds:.2} s",
+        bytes as f64 / (1 << 20) as f64,
+        per_triangle.map_or(String::new(), |b| format!(" ({b:.0} bytes per triangle)"))
+    );
     for w in &info.warnings {
         println!("  warning    {w}");
     }

@@ -90,7 +90,8 @@ pub enum FresnelName {
 /// Raw command-line arguments of `pathlab render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The scene: a file (.xml Mitsuba 3, .dae the course's COLLADA, .obj, .ply, .gltf, .glb) or
+    /// The scene: a file (.xml Mitsuba 3, .pbrt pbrt-v4, .dae the course's COLLADA, .obj, .ply,
+    /// .gltf, .glb) or
     /// a built-in scene's name (cornell-box).
     #[arg(default_value = "cornell-box")]
     pub scene: String,

@@ -20,6 +20,8 @@ pub mod gltf_scene;
 pub mod info;
 pub mod meshfile;
 pub mod mitsuba;
+pub mod pbrt;
+mod ply_binary;
 pub mod spectrum;
 pub mod texture;
 mod xml;
@@ -63,7 +65,7 @@ pub enum Error {
         message: String,
     },
     /// The file's extension names no format pathlab reads.
-    #[error("{path}: unknown scene format (expected .xml, .dae, .obj, .ply, .gltf or .glb, or a built-in scene name: {known})")]
+    #[error("{path}: unknown scene format (expected .xml, .dae, .pbrt, .pbrt.gz, .obj, .ply, .gltf or .glb, or a built-in scene name: {known})")]
     UnknownFormat {
         /// The file.
         path: String,
@@ -110,6 +112,8 @@ pub fn load_with(source: &str, params: &[(String, String)]) -> Result<SceneDesc,
         Some("ply") => meshfile::load_ply(path),
         Some("xml") => return mitsuba::load_with(path, params),
         Some("gltf") | Some("glb") => gltf_scene::load(path),
+        Some("pbrt") => pbrt::load(path),
+        Some("gz") if source.to_ascii_lowercase().ends_with(".pbrt.gz") => pbrt::load(path),
         None if builtin::NAMES.contains(&source) => builtin::load(source),
         None if !path.exists() => builtin::load(source),
         _ => Err(Error::UnknownFormat {

@@ -364,9 +364,37 @@ fn ply_error(path: &Path, text: &str) -> Error {
 /// triangles).
 pub fn ply_mesh(path: &Path) -> Result<MeshDesc, Error> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut reader = std::io::BufReader::new(file);
+    ply_mesh_from(&mut std::io::BufReader::new(file), path)
+}
+
+/// [`ply_mesh`] from a reader of the file's bytes (`path` names it in messages).
+pub fn ply_mesh_from(reader: &mut impl std::io::BufRead, path: &Path) -> Result<MeshDesc, Error> {
+    let mut bytes = Vec::new();
+    reader
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::io(path, e))?;
+    let name = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("ply")
+        .to_string();
+    match crate::ply_binary::read(&bytes) {
+        Some(Ok(m)) => {
+            return Ok(MeshDesc {
+                name,
+                positions: m.positions,
+                indices: m.indices,
+                normals: m.normals,
+                uvs: m.uvs,
+                ..Default::default()
+            })
+        }
+        Some(Err(message)) => return Err(ply_error(path, &message)),
+        None => {}
+    }
+    let reader = &mut std::io::Cursor::new(bytes);
     let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut reader)
+        .read_ply(reader)
         .map_err(|e| ply_error(path, &e.to_string()))?;
     let err = |message: String| Error::Parse {
         path: path.display().to_string(),

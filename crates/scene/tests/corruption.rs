@@ -444,3 +444,73 @@ proptest! {
         exercise_file("case-n.gltf", text.as_bytes());
     }
 }
+
+/// A small pbrt-v4 scene using most of the syntax.
+fn pbrt_scene() -> String {
+    r#"LookAt 0 1 5  0 1 0  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "rgb" "integer xresolution" [ 8 ] "integer yresolution" [ 6 ]
+Sampler "sobol" "integer pixelsamples" 4
+Integrator "path" "integer maxdepth" [ 3 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 0.1 0.1 0.1 ]
+MakeNamedMaterial "metal" "string type" "conductor" "spectrum eta" "metal-Cu-eta" "spectrum k" "metal-Cu-k" "float roughness" 0.1
+Texture "t" "spectrum" "constant" "rgb value" [ 0.5 0.2 0.1 ]
+AttributeBegin
+  AreaLightSource "diffuse" "blackbody L" [ 4000 ] "float scale" 3
+  Translate 0 2 0
+  Shape "sphere" "float radius" 0.2
+AttributeEnd
+ObjectBegin "o"
+  NamedMaterial "metal"
+  Shape "trianglemesh" "point3 P" [ -1 0 -1 1 0 -1 1 0 1 -1 0 1 ] "integer indices" [ 0 1 2 0 2 3 ] "normal N" [ 0 1 0 0 1 0 0 1 0 0 1 0 ] "point2 uv" [ 0 0 1 0 1 1 0 1 ]
+ObjectEnd
+AttributeBegin Rotate 10 0 1 0 ObjectInstance "o" AttributeEnd
+Material "diffuse" "texture reflectance" "t"
+Shape "disk" "float radius" 0.5 "float height" 0.1
+Shape "bilinearmesh" "point3 P" [ 0 0 0 1 0 0 0 1 0 1 1 0 ]
+"#
+    .to_string()
+}
+
+#[test]
+fn the_pbrt_scene_loads() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("sample.pbrt");
+    std::fs::write(&path, pbrt_scene()).unwrap();
+    let desc = pathlab_scene::load(path.to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    assert_eq!((desc.meshes.len(), desc.spheres.len()), (3, 1));
+    render_tiny(desc);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, failure_persistence: None, rng_seed: RngSeed::Fixed(0x5eed_0006), ..ProptestConfig::default() })]
+
+    /// pbrt-v4 files truncated or bit-flipped (plain and gzip-compressed).
+    #[test]
+    fn pbrt_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6), gz in any::<bool>()) {
+        let bytes = corrupt(pbrt_scene().into_bytes(), cut, &flips);
+        if gz {
+            use std::io::Write;
+            let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+            e.write_all(&bytes).unwrap();
+            exercise_file("case.pbrt.gz", &corrupt(e.finish().unwrap(), 1.0, &flips[..flips.len().min(1)]));
+        } else {
+            exercise_file("case.pbrt", &bytes);
+        }
+    }
+
+    /// pbrt-v4 files whose numbers are mangled (sizes, indices, radii, counts).
+    #[test]
+    fn pbrt_numbers_mangled(edits in prop::collection::vec((0.0f64..1.0, 0usize..MANGLED.len()), 1..6)) {
+        let mut text = pbrt_scene();
+        for (pos, k) in edits {
+            let spans = number_spans(&text);
+            let (s, e) = spans[((pos * spans.len() as f64) as usize).min(spans.len() - 1)];
+            text.replace_range(s..e, MANGLED[k]);
+        }
+        exercise_file("case-n.pbrt", text.as_bytes());
+    }
+}

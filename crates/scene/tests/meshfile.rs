@@ -262,3 +262,117 @@ fn gltf_round_trips_and_renders() {
         "{msg}"
     );
 }
+
+#[test]
+fn binary_ply_reads_as_the_general_reader_reads_it() {
+    // The same box with normals and texture coordinates, little and big endian, with double
+    // positions and ushort indices: the direct binary reader must give what the general reader
+    // gives for the ASCII file (and for a file with an extra attribute, which only the general
+    // reader takes).
+    let verts = box_vertices();
+    let props = "property float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n";
+    let header = |format: &str, props: &str, index: &str| {
+        format!("ply\nformat {format} 1.0\ncomment test\nelement vertex 8\n{props}element face 6\nproperty list uchar {index} vertex_indices\nend_header\n")
+    };
+    let extra = |i: usize| {
+        [
+            0.5 * i as f32,
+            1.0,
+            0.0,
+            0.25 * i as f32,
+            1.0 - 0.1 * i as f32,
+        ]
+    };
+    let mut ascii = header("ascii", props, "int");
+    for (i, v) in verts.iter().enumerate() {
+        let e = extra(i);
+        ascii += &format!(
+            "{} {} {} {} {} {} {} {}\n",
+            v[0], v[1], v[2], e[0], e[1], e[2], e[3], e[4]
+        );
+    }
+    for q in QUADS {
+        ascii += &format!("4 {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    let binary = |little: bool| {
+        let mut b = header(
+            if little {
+                "binary_little_endian"
+            } else {
+                "binary_big_endian"
+            },
+            &props.replace(
+                "float x\nproperty float y\nproperty float z",
+                "double x\nproperty double y\nproperty double z",
+            ),
+            "ushort",
+        )
+        .into_bytes();
+        for (i, v) in verts.iter().enumerate() {
+            for c in v {
+                b.extend(if little {
+                    (*c as f64).to_le_bytes()
+                } else {
+                    (*c as f64).to_be_bytes()
+                });
+            }
+            for c in extra(i) {
+                b.extend(if little {
+                    c.to_le_bytes()
+                } else {
+                    c.to_be_bytes()
+                });
+            }
+        }
+        for q in QUADS {
+            b.push(4);
+            for i in q {
+                b.extend(if little {
+                    (i as u16).to_le_bytes()
+                } else {
+                    (i as u16).to_be_bytes()
+                });
+            }
+        }
+        b
+    };
+    let mesh = |name: &str, bytes: Vec<u8>| {
+        let path = scratch(name);
+        std::fs::write(&path, bytes).unwrap();
+        pathlab_scene::meshfile::ply_mesh(&path).unwrap()
+    };
+    let general = mesh("attrs_ascii.ply", ascii.into_bytes());
+    for (name, bytes) in [
+        ("attrs_le.ply", binary(true)),
+        ("attrs_be.ply", binary(false)),
+    ] {
+        let direct = mesh(name, bytes);
+        assert_eq!(direct.positions, general.positions, "{name}");
+        assert_eq!(direct.indices, general.indices, "{name}");
+        assert_eq!(direct.normals, general.normals, "{name}");
+        assert_eq!(direct.uvs, general.uvs, "{name}");
+        assert!(direct.attributes.is_empty() && general.attributes.is_empty());
+    }
+    // A property pathlab keeps as an attribute goes to the general reader.
+    let mut with_attr = ply_header("binary_little_endian", 8, 6)
+        .replace(
+            "property float z\n",
+            "property float z\nproperty float weight\n",
+        )
+        .into_bytes();
+    for v in verts {
+        for c in v {
+            with_attr.extend(c.to_le_bytes());
+        }
+        with_attr.extend(2.0f32.to_le_bytes());
+    }
+    for q in QUADS {
+        with_attr.push(4);
+        for i in q {
+            with_attr.extend((i as i32).to_le_bytes());
+        }
+    }
+    let m = mesh("attr_weight.ply", with_attr);
+    assert_eq!(m.attributes.len(), 1);
+    assert_eq!(m.attributes[0].name, "vertex_weight");
+}

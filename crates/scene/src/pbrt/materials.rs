@@ -1,0 +1,684 @@
+//! pbrt-v4's materials and textures as pathlab's, and its spectra as RGB.
+//!
+//! Spectra: `rgb` values are taken as they are (pbrt-v4's RGB illuminant spectra render as the
+//! same RGB in an sRGB film); `blackbody` and sampled or named emission spectra are scaled to
+//! luminance one, as pbrt-v4 normalises a light's spectrum (`scale /= SpectrumToPhotometric`);
+//! reflectances and indices of refraction are converted as Mitsuba's RGB variants convert
+//! them ([`crate::spectrum`]). Named metals are Mitsuba's RGB tables of the same data.
+
+use super::params::{Param, ParamList};
+use super::Builder;
+use crate::mitsuba::ior::named_conductor;
+use crate::spectrum::{blackbody_to_rgb, sampled_to_rgb, xyz_to_srgb, SpectrumKind};
+use crate::Error;
+use glam::{DVec3, Vec3};
+use pathlab_render::desc::{
+    FresnelModel, MaterialDesc, NormalDistribution, Rgb, TextureDesc, TextureFilter, WrapMode,
+};
+
+/// pbrt-v4's named glasses: their index at the sodium d line (587.6 nm).
+const GLASSES: &[(&str, f32)] = &[
+    ("glass-BK7", 1.5168),
+    ("glass-BAF10", 1.6700),
+    ("glass-FK51A", 1.4866),
+    ("glass-LASF9", 1.8503),
+    ("glass-F5", 1.6034),
+    ("glass-F10", 1.6120),
+    ("glass-F11", 1.6210),
+    ("glass-SF5", 1.6727),
+    ("glass-SF10", 1.7283),
+    ("glass-SF11", 1.7847),
+];
+
+/// Relative luminance of linear sRGB.
+fn luminance(c: DVec3) -> f64 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// What a spectrum parameter stands for.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Use {
+    /// A light's emission: spectra normalised to luminance one.
+    Illuminant,
+    /// A reflectance in [0, 1].
+    Albedo,
+    /// η or k.
+    Unbounded,
+}
+
+impl Builder {
+    /// A spectrum-valued parameter as RGB (`None` when absent).
+    pub(crate) fn spectrum(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        usage: Use,
+    ) -> Result<Option<Rgb>, Error> {
+        let Some(p) = params.get(name) else {
+            return Ok(None);
+        };
+        self.spectrum_of(p, usage).map(Some)
+    }
+
+    fn spectrum_of(&mut self, p: &Param, usage: Use) -> Result<Rgb, Error> {
+        let decl = format!("\"{} {}\" (line {})", p.ty, p.name, p.line);
+        let rgb = match (p.ty.as_str(), p.numbers(), p.strings()) {
+            ("rgb" | "color", Some(v), _) => {
+                if v.len() != 3 {
+                    return Err(
+                        self.error(format!("{decl}: expected 3 numbers, found {}", v.len()))
+                    );
+                }
+                DVec3::new(v[0], v[1], v[2])
+            }
+            ("blackbody", Some(v), _) => {
+                let t = v.first().copied().unwrap_or(0.0);
+                if t <= 0.0 {
+                    return Err(self.error(format!("{decl}: a temperature in kelvin > 0")));
+                }
+                let c = blackbody_to_rgb(t);
+                c / luminance(c).max(f64::MIN_POSITIVE)
+            }
+            ("spectrum", Some(v), _) => {
+                if v.len() < 2 || v.len() % 2 != 0 {
+                    return Err(self.error(format!(
+                        "{decl}: expected wavelength and value pairs, found {} numbers",
+                        v.len()
+                    )));
+                }
+                let pairs: Vec<(f64, f64)> = v.chunks(2).map(|c| (c[0], c[1])).collect();
+                if pairs.windows(2).any(|w| w[1].0 <= w[0].0) {
+                    return Err(self.error(format!("{decl}: wavelengths must increase")));
+                }
+                let kind = match usage {
+                    Use::Illuminant => SpectrumKind::Emission,
+                    Use::Albedo => SpectrumKind::Reflectance,
+                    Use::Unbounded => SpectrumKind::Unbounded,
+                };
+                let c = sampled_to_rgb(&pairs, kind);
+                if usage == Use::Illuminant {
+                    c / luminance(c).max(f64::MIN_POSITIVE)
+                } else {
+                    c
+                }
+            }
+            ("spectrum", _, Some(names)) => {
+                let name = names.first().cloned().unwrap_or_default();
+                self.named_spectrum(&name, &decl)?
+            }
+            (ty, _, _) => {
+                return Err(self.error(format!("{decl}: a '{ty}' where a spectrum was expected")))
+            }
+        };
+        Ok(rgb.as_vec3())
+    }
+
+    /// pbrt-v4's named spectra that pathlab knows.
+    fn named_spectrum(&mut self, name: &str, decl: &str) -> Result<DVec3, Error> {
+        if let Some(&(_, eta)) = GLASSES.iter().find(|(n, _)| *n == name) {
+            return Ok(DVec3::splat(eta as f64));
+        }
+        if let Some(metal) = name.strip_prefix("metal-") {
+            let (element, part) = metal
+                .rsplit_once('-')
+                .ok_or_else(|| self.error(format!("{decl}: unknown spectrum \"{name}\"")))?;
+            if let Some((eta, k)) = named_conductor(element) {
+                return Ok(match part {
+                    "eta" => DVec3::from(eta.map(f64::from)),
+                    "k" => DVec3::from(k.map(f64::from)),
+                    _ => return Err(self.error(format!("{decl}: unknown spectrum \"{name}\""))),
+                });
+            }
+        }
+        match name {
+            "stdillum-D65" => Ok(DVec3::ONE),
+            "stdillum-A" => {
+                let c = blackbody_to_rgb(2856.0);
+                Ok(c / luminance(c))
+            }
+            "stdillum-D50" => {
+                let c = xyz_to_srgb(DVec3::new(0.9642, 1.0, 0.8251));
+                Ok(c / luminance(c))
+            }
+            n if n.starts_with("stdillum-") || n.starts_with("illum-") => {
+                self.warn(format!("{decl}: the spectrum \"{n}\" is not tabulated; white light of the same luminance is used"));
+                Ok(DVec3::ONE)
+            }
+            _ => Err(self.error(format!(
+                "{decl}: unknown spectrum \"{name}\" (pathlab knows glass-*, metal-*-eta/-k of Mitsuba's metals, stdillum-D65/A/D50)"
+            ))),
+        }
+    }
+
+    /// A float parameter (first value) or `default`.
+    pub(crate) fn float(&self, params: &ParamList, name: &str, default: f64) -> Result<f64, Error> {
+        match params.get(name) {
+            None => Ok(default),
+            Some(p) => match p.numbers() {
+                Some([v, ..]) => Ok(*v),
+                _ => Err(self.error(format!(
+                    "\"{} {}\" (line {}): expected a number",
+                    p.ty, p.name, p.line
+                ))),
+            },
+        }
+    }
+
+    /// A bool parameter or `default`.
+    pub(crate) fn bool(
+        &self,
+        params: &ParamList,
+        name: &str,
+        default: bool,
+    ) -> Result<bool, Error> {
+        match params.get(name) {
+            None => Ok(default),
+            Some(p) => match &p.values {
+                super::params::Values::Bools(v) if !v.is_empty() => Ok(v[0]),
+                _ => Err(self.error(format!(
+                    "\"{} {}\" (line {}): expected true or false",
+                    p.ty, p.name, p.line
+                ))),
+            },
+        }
+    }
+
+    /// A string parameter.
+    pub(crate) fn string(&self, params: &ParamList, name: &str) -> Result<Option<String>, Error> {
+        match params.get(name) {
+            None => Ok(None),
+            Some(p) => match p.strings() {
+                Some([s, ..]) => Ok(Some(s.clone())),
+                _ => Err(self.error(format!(
+                    "\"{} {}\" (line {}): expected a string",
+                    p.ty, p.name, p.line
+                ))),
+            },
+        }
+    }
+
+    /// A colour that may be a texture: `"texture NAME"` or a spectrum.
+    fn color_texture(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        default: Rgb,
+    ) -> Result<TextureDesc, Error> {
+        if let Some(p) = params
+            .params
+            .iter()
+            .rev()
+            .find(|p| p.name == name && p.ty == "texture")
+        {
+            p.used.set(true);
+            let tex = p
+                .strings()
+                .and_then(|s| s.first())
+                .cloned()
+                .unwrap_or_default();
+            return match self.textures.get(&tex) {
+                Some(t) => Ok(t.clone()),
+                None => Err(self.error(format!(
+                    "\"texture {name}\" (line {}): no texture named \"{tex}\"",
+                    p.line
+                ))),
+            };
+        }
+        Ok(TextureDesc::Constant(
+            self.spectrum(params, name, Use::Albedo)?.unwrap_or(default),
+        ))
+    }
+
+    /// A number that may be a texture; textures other than constants are used by their mean
+    /// (with a warning).
+    fn float_value(&mut self, params: &ParamList, name: &str, default: f64) -> Result<f64, Error> {
+        if let Some(p) = params
+            .params
+            .iter()
+            .rev()
+            .find(|p| p.name == name && p.ty == "texture")
+        {
+            p.used.set(true);
+            let tex = p
+                .strings()
+                .and_then(|s| s.first())
+                .cloned()
+                .unwrap_or_default();
+            let Some(t) = self.textures.get(&tex).cloned() else {
+                return Err(self.error(format!(
+                    "\"texture {name}\" (line {}): no texture named \"{tex}\"",
+                    p.line
+                )));
+            };
+            if t.as_constant().is_none() {
+                self.warn(format!(
+                    "\"texture {name}\": a textured {name} is not supported; its mean is used"
+                ));
+            }
+            return Ok(t.mean().x as f64);
+        }
+        self.float(params, name, default)
+    }
+
+    /// `roughness`, `uroughness`, `vroughness` and `remaproughness` as (α_u, α_v).
+    fn roughness(&mut self, params: &ParamList) -> Result<(f32, f32), Error> {
+        let r = self.float_value(params, "roughness", 0.0)?;
+        let u = self.float_value(params, "uroughness", r)?;
+        let v = self.float_value(params, "vroughness", r)?;
+        let remap = self.bool(params, "remaproughness", true)?;
+        // pbrt-v4's TrowbridgeReitzDistribution::RoughnessToAlpha is √roughness; below
+        // α = 10⁻³ a surface is smooth.
+        let alpha = |x: f64| {
+            let a = if remap { x.max(0.0).sqrt() } else { x.max(0.0) } as f32;
+            if a < 1e-3 {
+                0.0
+            } else {
+                a
+            }
+        };
+        Ok((alpha(u), alpha(v)))
+    }
+
+    /// The index of refraction `eta` (a number or a named glass), default 1.5.
+    fn eta(&mut self, params: &ParamList) -> Result<f32, Error> {
+        match params.params.iter().rev().find(|p| p.name == "eta") {
+            Some(p) if p.ty == "float" => self.float(params, "eta", 1.5).map(|v| v as f32),
+            Some(_) => {
+                let c = self
+                    .spectrum(params, "eta", Use::Unbounded)?
+                    .unwrap_or(Vec3::splat(1.5));
+                Ok(c.x)
+            }
+            None => Ok(1.5),
+        }
+    }
+
+    /// `MakeNamedMaterial`: its `type` parameter names the material.
+    pub(crate) fn named_material(&mut self, name: &str, params: ParamList) -> Result<usize, Error> {
+        let kind = self.string(&params, "type")?.ok_or_else(|| {
+            self.error(format!("MakeNamedMaterial \"{name}\": no \"string type\""))
+        })?;
+        self.material(&kind, params)
+    }
+
+    /// A material of `kind` from `params`, added to the scene: its index.
+    pub(crate) fn material(&mut self, kind: &str, params: ParamList) -> Result<usize, Error> {
+        let params = match self.gs.defaults.get("material") {
+            Some(d) => params.with_defaults(d),
+            None => params,
+        };
+        let m = self.material_desc(kind, &params)?;
+        let m = match self.string(&params, "normalmap")? {
+            Some(file) if !file.is_empty() => {
+                let path = self.resolve(&file);
+                match crate::texture::load(&path, true) {
+                    Ok(image) => MaterialDesc::NormalMap {
+                        normals: TextureDesc::image(image),
+                        inner: Box::new(m),
+                    },
+                    Err(e) => {
+                        self.warn(format!("normal map: {e}; the surface normal is used"));
+                        m
+                    }
+                }
+            }
+            _ => m,
+        };
+        if params.has("displacement") {
+            params.get("displacement");
+            self.warn("Material: displacement is not supported; ignored");
+        }
+        self.warn_unused(&format!("Material \"{kind}\""), &params);
+        self.desc.materials.push(m);
+        Ok(self.desc.materials.len() - 1)
+    }
+
+    fn material_desc(&mut self, kind: &str, params: &ParamList) -> Result<MaterialDesc, Error> {
+        // `type` was read by MakeNamedMaterial.
+        params.get("type");
+        let two_sided = |m: MaterialDesc| MaterialDesc::TwoSided {
+            front: Box::new(m.clone()),
+            back: Box::new(m),
+        };
+        Ok(match kind {
+            "diffuse" => self.diffuse(params, "reflectance", 0.5)?,
+            "conductor" => {
+                let (au, av) = self.roughness(params)?;
+                let (eta, k) = match self.spectrum(params, "reflectance", Use::Albedo)? {
+                    // pbrt-v4: a conductor given by its reflectance r has η = 1 and
+                    // k = 2 √r / √(1 - r).
+                    Some(r) => {
+                        let r = r.clamp(Vec3::ZERO, Vec3::splat(0.9999));
+                        (
+                            Vec3::ONE,
+                            2.0 * r.map(f32::sqrt) / (Vec3::ONE - r).map(f32::sqrt),
+                        )
+                    }
+                    None => {
+                        let eta = self.spectrum(params, "eta", Use::Unbounded)?;
+                        let k = self.spectrum(params, "k", Use::Unbounded)?;
+                        let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
+                        (
+                            eta.unwrap_or(Vec3::from(cu_eta)),
+                            k.unwrap_or(Vec3::from(cu_k)),
+                        )
+                    }
+                };
+                let m = if au == av {
+                    MaterialDesc::Conductor {
+                        alpha: au,
+                        eta,
+                        k,
+                        distribution: NormalDistribution::Ggx,
+                    }
+                } else {
+                    MaterialDesc::RoughConductor {
+                        alpha_u: TextureDesc::value(au),
+                        alpha_v: TextureDesc::value(av),
+                        eta,
+                        k,
+                        specular: TextureDesc::value(1.0),
+                        distribution: NormalDistribution::Ggx,
+                    }
+                };
+                two_sided(m)
+            }
+            "dielectric" => {
+                let (au, av) = self.roughness(params)?;
+                if au != av {
+                    self.warn(
+                        "dielectric: anisotropic roughness is not supported; the mean α is used",
+                    );
+                }
+                MaterialDesc::Glass {
+                    reflectance: Rgb::ONE,
+                    transmittance: Rgb::ONE,
+                    roughness: 0.5 * (au + av),
+                    ior: self.eta(params)?,
+                    distribution: NormalDistribution::Ggx,
+                    fresnel: FresnelModel::Exact,
+                }
+            }
+            "thindielectric" => MaterialDesc::ThinGlass {
+                reflectance: Rgb::ONE,
+                transmittance: Rgb::ONE,
+                ior: self.eta(params)?,
+            },
+            "coateddiffuse" => {
+                let (au, av) = self.roughness(params)?;
+                let ior = self.eta(params)?;
+                let diffuse = self.color_texture(params, "reflectance", Rgb::splat(0.5))?;
+                for p in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
+                    params.get(p);
+                }
+                self.warn("coateddiffuse: approximated by a diffuse base under a dielectric coat with no scattering inside the layer (Mitsuba's plastic), not pbrt-v4's stochastic layers");
+                let m = if au == 0.0 && av == 0.0 {
+                    MaterialDesc::Plastic {
+                        diffuse: diffuse.mean(),
+                        specular: Rgb::ONE,
+                        ior,
+                        nonlinear: false,
+                    }
+                } else {
+                    MaterialDesc::RoughPlastic {
+                        diffuse,
+                        specular: Rgb::ONE,
+                        alpha: 0.5 * (au + av),
+                        ior,
+                        nonlinear: false,
+                        distribution: NormalDistribution::Ggx,
+                    }
+                };
+                two_sided(m)
+            }
+            "coatedconductor" => {
+                self.warn("coatedconductor: approximated by its conductor without the coat");
+                let r = self.float_value(params, "conductor.roughness", 0.0)?;
+                let remap = self.bool(params, "remaproughness", true)?;
+                let a = if remap { r.sqrt() } else { r } as f32;
+                let eta = self.spectrum(params, "conductor.eta", Use::Unbounded)?;
+                let k = self.spectrum(params, "conductor.k", Use::Unbounded)?;
+                let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
+                for p in [
+                    "interface.eta",
+                    "interface.roughness",
+                    "thickness",
+                    "albedo",
+                    "g",
+                    "maxdepth",
+                    "nsamples",
+                ] {
+                    params.get(p);
+                }
+                two_sided(MaterialDesc::Conductor {
+                    alpha: if a < 1e-3 { 0.0 } else { a },
+                    eta: eta.unwrap_or(Vec3::from(cu_eta)),
+                    k: k.unwrap_or(Vec3::from(cu_k)),
+                    distribution: NormalDistribution::Ggx,
+                })
+            }
+            "diffusetransmission" => {
+                params.get("transmittance");
+                self.warn("diffusetransmission: its transmission is not supported; rendered as its diffuse reflection");
+                self.diffuse(params, "reflectance", 0.25)?
+            }
+            "mix" => {
+                let names = params
+                    .get("materials")
+                    .and_then(|p| p.strings().map(<[String]>::to_vec))
+                    .unwrap_or_default();
+                if names.len() != 2 {
+                    return Err(self.error("mix: \"string materials\" must name two materials"));
+                }
+                let pick = |n: &str| -> Result<MaterialDesc, Error> {
+                    self.named_materials
+                        .get(n)
+                        .map(|&i| self.desc.materials[i].clone())
+                        .ok_or_else(|| self.error(format!("mix: no material named \"{n}\"")))
+                };
+                let (first, second) = (pick(&names[0])?, pick(&names[1])?);
+                // pbrt-v4 picks the second with probability `amount`: the same expectation
+                // as a blend.
+                let amount = self.float_value(params, "amount", 0.5)?;
+                MaterialDesc::Blend {
+                    weight: TextureDesc::value(amount.clamp(0.0, 1.0) as f32),
+                    first: Box::new(first),
+                    second: Box::new(second),
+                }
+            }
+            "interface" | "" | "none" => MaterialDesc::Mask {
+                opacity: TextureDesc::value(0.0),
+                inner: Box::new(MaterialDesc::Diffuse {
+                    reflectance: Rgb::ZERO,
+                    two_sided: true,
+                }),
+            },
+            other => {
+                self.warn(format!(
+                    "Material \"{other}\": not supported; rendered as diffuse 0.5"
+                ));
+                for p in &params.params {
+                    p.used.set(true);
+                }
+                MaterialDesc::Diffuse {
+                    reflectance: Rgb::splat(0.5),
+                    two_sided: true,
+                }
+            }
+        })
+    }
+
+    /// A two-sided Lambertian material from a (possibly textured) reflectance.
+    fn diffuse(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        default: f32,
+    ) -> Result<MaterialDesc, Error> {
+        let t = self.color_texture(params, name, Rgb::splat(default))?;
+        Ok(match t {
+            TextureDesc::Constant(c) => MaterialDesc::Diffuse {
+                reflectance: c.clamp(Rgb::ZERO, Rgb::ONE),
+                two_sided: true,
+            },
+            t => MaterialDesc::TexturedDiffuse {
+                texture: t,
+                scale: Rgb::ONE,
+                two_sided: true,
+            },
+        })
+    }
+
+    /// `Texture "name" "spectrum"|"float" "class" ...`.
+    pub(crate) fn texture(
+        &mut self,
+        name: String,
+        ty: &str,
+        class: &str,
+        params: ParamList,
+    ) -> Result<(), Error> {
+        if ty != "spectrum" && ty != "float" && ty != "color" {
+            return Err(self.error(format!(
+                "Texture \"{name}\": type \"{ty}\" (expected spectrum or float)"
+            )));
+        }
+        let tex = match class {
+            "constant" => TextureDesc::Constant(if ty == "float" {
+                Rgb::splat(self.float(&params, "value", 1.0)? as f32)
+            } else {
+                self.spectrum(&params, "value", Use::Albedo)?
+                    .unwrap_or(Rgb::ONE)
+            }),
+            "imagemap" => {
+                let file = self.string(&params, "filename")?.ok_or_else(|| {
+                    self.error(format!(
+                        "Texture \"{name}\": imagemap needs \"string filename\""
+                    ))
+                })?;
+                let path = self.resolve(&file);
+                let encoding = self
+                    .string(&params, "encoding")?
+                    .unwrap_or_else(|| "sRGB".into());
+                let raw = encoding == "linear" || ty == "float" && encoding != "sRGB";
+                if encoding.starts_with("gamma") {
+                    self.warn(format!(
+                        "Texture \"{name}\": encoding \"{encoding}\" read as sRGB"
+                    ));
+                }
+                let scale = self.float(&params, "scale", 1.0)? as f32;
+                let invert = self.bool(&params, "invert", false)?;
+                let filter = match self.string(&params, "filter")?.as_deref() {
+                    Some("point") => TextureFilter::Nearest,
+                    _ => TextureFilter::Bilinear,
+                };
+                let wrap = match self.string(&params, "wrap")?.as_deref() {
+                    Some("clamp") => WrapMode::Clamp,
+                    Some("black") => {
+                        self.warn(format!("Texture \"{name}\": wrap \"black\" read as clamp"));
+                        WrapMode::Clamp
+                    }
+                    _ => WrapMode::Repeat,
+                };
+                let su = self.float(&params, "uscale", 1.0)? as f32;
+                let sv = self.float(&params, "vscale", 1.0)? as f32;
+                let du = self.float(&params, "udelta", 0.0)? as f32;
+                let dv = self.float(&params, "vdelta", 0.0)? as f32;
+                if let Some(m) = self.string(&params, "mapping")? {
+                    if m != "uv" {
+                        self.warn(format!(
+                            "Texture \"{name}\": mapping \"{m}\" is not supported; uv is used"
+                        ));
+                    }
+                }
+                match crate::texture::load(&path, raw) {
+                    Ok(image) => {
+                        if invert || scale != 1.0 {
+                            self.warn(format!("Texture \"{name}\": scale and invert of image textures are not supported; ignored"));
+                        }
+                        TextureDesc::Image {
+                            image,
+                            filter,
+                            wrap,
+                            to_uv: glam::Affine2::from_scale_angle_translation(
+                                glam::Vec2::new(su, sv),
+                                0.0,
+                                glam::Vec2::new(du, dv),
+                            ),
+                        }
+                    }
+                    Err(e) => {
+                        self.warn(format!("Texture \"{name}\": {e}; a constant 0.5 is used"));
+                        TextureDesc::value(0.5)
+                    }
+                }
+            }
+            "scale" => {
+                let tex = self.texture_or_value(&params, "tex", ty)?;
+                let scale = self.texture_or_value(&params, "scale", ty)?;
+                match (tex.as_constant(), scale.as_constant()) {
+                    (Some(a), Some(b)) => TextureDesc::Constant(a * b),
+                    (None, Some(b)) if b == Rgb::ONE => tex,
+                    (Some(a), None) if a == Rgb::ONE => scale,
+                    _ => {
+                        self.warn(format!("Texture \"{name}\": a scaled image is not supported; the image alone is used"));
+                        if tex.as_constant().is_none() {
+                            tex
+                        } else {
+                            scale
+                        }
+                    }
+                }
+            }
+            "mix" => {
+                let a = self.texture_or_value(&params, "tex1", ty)?;
+                let b = self.texture_or_value(&params, "tex2", ty)?;
+                let amount = self.float(&params, "amount", 0.5)? as f32;
+                if a.as_constant().is_none()
+                    || b.as_constant().is_none()
+                    || params.has("amount")
+                        && params
+                            .params
+                            .iter()
+                            .any(|p| p.name == "amount" && p.ty == "texture")
+                {
+                    self.warn(format!("Texture \"{name}\": a mix of textures is not supported; their mean is used"));
+                }
+                TextureDesc::Constant(a.mean() * (1.0 - amount) + b.mean() * amount)
+            }
+            other => {
+                self.warn(format!(
+                    "Texture \"{name}\": \"{other}\" textures are not supported; a constant 0.5 is used"
+                ));
+                for p in &params.params {
+                    p.used.set(true);
+                }
+                TextureDesc::value(0.5)
+            }
+        };
+        self.warn_unused(&format!("Texture \"{name}\""), &params);
+        self.textures.insert(name, tex);
+        Ok(())
+    }
+
+    /// A texture parameter or a value of the texture's type (default 1).
+    fn texture_or_value(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        ty: &str,
+    ) -> Result<TextureDesc, Error> {
+        if params
+            .params
+            .iter()
+            .any(|p| p.name == name && p.ty == "texture")
+        {
+            return self.color_texture(params, name, Rgb::ONE);
+        }
+        Ok(TextureDesc::Constant(if ty == "float" {
+            Rgb::splat(self.float(params, name, 1.0)? as f32)
+        } else {
+            self.spectrum(params, name, Use::Albedo)?
+                .unwrap_or(Rgb::ONE)
+        }))
+    }
+}

@@ -1,0 +1,499 @@
+//! pbrt-v4's shapes as pathlab's triangle meshes and spheres.
+//!
+//! Orientation follows pbrt-v4: a triangle's surface normal is its winding's (the edges
+//! p0 - p2, p1 - p2 crossed) carried as a normal into the world, turned towards the mesh's
+//! shading normals where it has them, and reversed by `ReverseOrientation`; one-sided area
+//! lights emit on that side. pathlab takes the front of a triangle from its winding, so the
+//! winding is swapped where the two disagree.
+
+use super::materials::Use;
+use super::params::ParamList;
+use super::{Builder, GraphicsState};
+use crate::Error;
+use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
+use pathlab_render::desc::{Emission, MaterialDesc, MeshDesc, Rgb, SphereDesc, TextureDesc};
+use std::sync::Arc;
+
+/// Segments around a tessellated disk or cylinder: the area is right to 0.03%.
+const SEGMENTS: usize = 256;
+
+/// A mesh in the shape's own space.
+#[derive(Default)]
+struct ObjectMesh {
+    positions: Vec<DVec3>,
+    indices: Vec<u32>,
+    normals: Vec<DVec3>,
+    uvs: Vec<Vec2>,
+}
+
+impl Builder {
+    /// `Shape "kind" ...` with the graphics state `state`.
+    pub(crate) fn shape(
+        &mut self,
+        kind: &str,
+        params: ParamList,
+        state: &GraphicsState,
+    ) -> Result<(), Error> {
+        let m = self.world_fix * state.ctm;
+        if m.determinant().abs() < 1e-300 || !m.is_finite() {
+            return Err(self.error(format!("Shape \"{kind}\": its transform is singular")));
+        }
+        let material = self.shape_material(&params, state)?;
+        let emission = self.area_emission(state)?;
+        let mesh = match kind {
+            "sphere" => {
+                self.sphere(&params, m, material, emission, state)?;
+                self.warn_unused(&format!("Shape \"{kind}\""), &params);
+                return Ok(());
+            }
+            "trianglemesh" => self.triangle_mesh(&params)?,
+            "plymesh" => self.ply_mesh(&params)?,
+            "bilinearmesh" => self.bilinear_mesh(&params)?,
+            "loopsubdiv" => {
+                self.float(&params, "levels", 3.0)?;
+                self.warn("Shape \"loopsubdiv\": not subdivided; its control mesh is rendered");
+                self.triangle_mesh(&params)?
+            }
+            "disk" => self.disk(&params)?,
+            "cylinder" => self.cylinder(&params)?,
+            other => {
+                for p in &params.params {
+                    p.used.set(true);
+                }
+                self.warn(format!("Shape \"{other}\": not supported; skipped"));
+                return Ok(());
+            }
+        };
+        self.warn_unused(&format!("Shape \"{kind}\""), &params);
+        let mut out = place(mesh, m, state.reverse_orientation);
+        out.name = format!("{}:{} {kind}", self.file.display(), self.line);
+        out.material = material;
+        out.emission = emission;
+        self.desc.meshes.push(out);
+        Ok(())
+    }
+
+    /// The shape's material: the current one (pbrt's default diffuse 0.5 without one),
+    /// under a mask where the shape has an `alpha`.
+    fn shape_material(
+        &mut self,
+        params: &ParamList,
+        state: &GraphicsState,
+    ) -> Result<usize, Error> {
+        let base = match state.material {
+            Some(m) => m,
+            None => self.default_material(),
+        };
+        let alpha = match params.params.iter().rev().find(|p| p.name == "alpha") {
+            None => return Ok(base),
+            Some(p) if p.ty == "texture" => {
+                p.used.set(true);
+                let name = p
+                    .strings()
+                    .and_then(|s| s.first())
+                    .cloned()
+                    .unwrap_or_default();
+                match self.textures.get(&name) {
+                    Some(t) => t.clone(),
+                    None => {
+                        return Err(self.error(format!(
+                            "\"texture alpha\" (line {}): no texture named \"{name}\"",
+                            p.line
+                        )))
+                    }
+                }
+            }
+            Some(_) => TextureDesc::value(self.float(params, "alpha", 1.0)?.clamp(0.0, 1.0) as f32),
+        };
+        if alpha.as_constant() == Some(Rgb::ONE) {
+            return Ok(base);
+        }
+        let inner = self.desc.materials[base].clone();
+        self.desc.materials.push(MaterialDesc::Mask {
+            opacity: alpha,
+            inner: Box::new(inner),
+        });
+        Ok(self.desc.materials.len() - 1)
+    }
+
+    /// pbrt-v4's default material: diffuse, reflectance 0.5 (made once).
+    fn default_material(&mut self) -> usize {
+        if let Some(&m) = self.named_materials.get("\0default") {
+            return m;
+        }
+        self.desc.materials.push(MaterialDesc::Diffuse {
+            reflectance: Rgb::splat(0.5),
+            two_sided: true,
+        });
+        let m = self.desc.materials.len() - 1;
+        self.named_materials.insert("\0default".into(), m);
+        m
+    }
+
+    /// The emission of the current area light, if any.
+    fn area_emission(&mut self, state: &GraphicsState) -> Result<Option<Emission>, Error> {
+        let Some((kind, params, line)) = &state.area_light else {
+            return Ok(None);
+        };
+        let (params, line) = (params.clone(), *line);
+        let here = self.line;
+        self.line = line;
+        if kind != "diffuse" {
+            self.warn(format!(
+                "AreaLightSource \"{kind}\": not supported; the shape does not emit"
+            ));
+            self.line = here;
+            return Ok(None);
+        }
+        let l = self
+            .spectrum(&params, "L", Use::Illuminant)?
+            .unwrap_or(Vec3::ONE);
+        let scale = self.float(&params, "scale", 1.0)? as f32;
+        let two_sided = self.bool(&params, "twosided", false)?;
+        if params.has("power") {
+            params.get("power");
+            self.warn("AreaLightSource: \"power\" is not supported; L and scale are used");
+        }
+        if let Some(file) = self.string(&params, "filename")? {
+            self.warn(format!(
+                "AreaLightSource: image emission (\"{file}\") is not supported; L is used"
+            ));
+        }
+        self.warn_unused("AreaLightSource \"diffuse\"", &params);
+        self.line = here;
+        Ok(Some(Emission {
+            radiance: l * scale,
+            two_sided,
+        }))
+    }
+
+    fn param_numbers<'p>(
+        &self,
+        params: &'p ParamList,
+        name: &str,
+    ) -> Result<Option<&'p [f64]>, Error> {
+        match params.get(name) {
+            None => Ok(None),
+            Some(p) => p.numbers().map(Some).ok_or_else(|| {
+                self.error(format!(
+                    "\"{} {name}\" (line {}): expected numbers",
+                    p.ty, p.line
+                ))
+            }),
+        }
+    }
+
+    /// `P`, `N`, `uv` and `indices` as pbrt-v4's triangle and bilinear meshes give them.
+    fn mesh_arrays(&self, params: &ParamList, per_face: usize) -> Result<ObjectMesh, Error> {
+        let p = self
+            .param_numbers(params, "P")?
+            .ok_or_else(|| self.error("the mesh has no \"point3 P\""))?;
+        let positions: Vec<DVec3> = p
+            .chunks_exact(3)
+            .map(|c| DVec3::new(c[0], c[1], c[2]))
+            .collect();
+        let n = positions.len();
+        let indices: Vec<u32> = match self.param_numbers(params, "indices")? {
+            Some(v) => v
+                .iter()
+                .map(|&i| {
+                    if i < 0.0 || i >= n as f64 {
+                        Err(self.error(format!("index {i} out of range ({n} vertices)")))
+                    } else {
+                        Ok(i as u32)
+                    }
+                })
+                .collect::<Result<_, _>>()?,
+            None if n == per_face => (0..n as u32).collect(),
+            None => {
+                return Err(self.error(format!(
+                    "the mesh has {n} vertices and no \"integer indices\""
+                )))
+            }
+        };
+        if !indices.len().is_multiple_of(per_face) {
+            return Err(self.error(format!(
+                "{} indices are not a whole number of {}",
+                indices.len(),
+                if per_face == 3 {
+                    "triangles"
+                } else {
+                    "bilinear patches"
+                }
+            )));
+        }
+        let normals: Vec<DVec3> = match self.param_numbers(params, "N")? {
+            Some(v) => {
+                if v.len() != 3 * n {
+                    return Err(self.error(format!(
+                        "\"normal N\": {} normals for {n} vertices",
+                        v.len() / 3
+                    )));
+                }
+                v.chunks_exact(3)
+                    .map(|c| DVec3::new(c[0], c[1], c[2]))
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        let uv = match self.param_numbers(params, "uv")? {
+            Some(v) => Some(v),
+            None => self.param_numbers(params, "st")?,
+        };
+        let uvs: Vec<Vec2> = match uv {
+            Some(v) => {
+                if v.len() != 2 * n {
+                    return Err(self.error(format!(
+                        "\"point2 uv\": {} coordinates for {n} vertices",
+                        v.len() / 2
+                    )));
+                }
+                v.chunks_exact(2)
+                    .map(|c| Vec2::new(c[0] as f32, c[1] as f32))
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        if params.has("S") {
+            params.get("S");
+        }
+        for name in ["faceIndices", "emissionfilename"] {
+            if params.has(name) {
+                params.get(name);
+            }
+        }
+        Ok(ObjectMesh {
+            positions,
+            indices,
+            normals,
+            uvs,
+        })
+    }
+
+    fn triangle_mesh(&self, params: &ParamList) -> Result<ObjectMesh, Error> {
+        self.mesh_arrays(params, 3)
+    }
+
+    /// Bilinear patches (vertices p00, p10, p01, p11) as two triangles each.
+    fn bilinear_mesh(&mut self, params: &ParamList) -> Result<ObjectMesh, Error> {
+        let mut m = self.mesh_arrays(params, 4)?;
+        let quads = std::mem::take(&mut m.indices);
+        let mut curved = false;
+        for q in quads.chunks_exact(4) {
+            let [a, b, c, d] = [q[0], q[1], q[2], q[3]];
+            let p = |i: u32| m.positions[i as usize];
+            let n = (p(b) - p(a)).cross(p(c) - p(a));
+            curved |= n.length() > 0.0
+                && (p(d) - p(a)).dot(n.normalize()).abs() > 1e-6 * (p(d) - p(a)).length();
+            m.indices.extend([a, b, d, a, d, c]);
+        }
+        if curved {
+            self.warn(
+                "Shape \"bilinearmesh\": curved patches are rendered as two flat triangles each",
+            );
+        }
+        Ok(m)
+    }
+
+    /// A PLY file's mesh (read once per file; `.ply.gz` decompressed).
+    fn ply_mesh(&mut self, params: &ParamList) -> Result<ObjectMesh, Error> {
+        let file = self
+            .string(params, "filename")?
+            .ok_or_else(|| self.error("Shape \"plymesh\": no \"string filename\""))?;
+        if params.has("displacement") {
+            params.get("displacement");
+            params.get("edgelength");
+            self.warn("Shape \"plymesh\": displacement is not supported; ignored");
+        }
+        let path = self.resolve(&file);
+        let mesh = match self.ply_cache.get(&path) {
+            Some(m) => Arc::clone(m),
+            None => {
+                let gz = path
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("gz"));
+                let mesh = if gz {
+                    let bytes = super::read_bytes(&path)?;
+                    crate::meshfile::ply_mesh_from(&mut std::io::Cursor::new(bytes), &path)
+                } else {
+                    crate::meshfile::ply_mesh(&path)
+                };
+                let mesh = match mesh {
+                    Ok(m) => Arc::new(m),
+                    Err(crate::Error::Io { message, .. }) => {
+                        self.warn(format!(
+                            "Shape \"plymesh\": cannot read {} ({message}); the shape is skipped",
+                            path.display()
+                        ));
+                        Arc::new(MeshDesc::default())
+                    }
+                    Err(e) => return Err(e),
+                };
+                self.ply_cache.insert(path, Arc::clone(&mesh));
+                mesh
+            }
+        };
+        Ok(ObjectMesh {
+            positions: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
+            indices: mesh.indices.clone(),
+            normals: mesh.normals.iter().map(|n| n.as_dvec3()).collect(),
+            uvs: mesh.uvs.clone(),
+        })
+    }
+
+    /// A disk (or annulus) at height `height`, normal +z, as a fan of [`SEGMENTS`].
+    fn disk(&mut self, params: &ParamList) -> Result<ObjectMesh, Error> {
+        let h = self.float(params, "height", 0.0)?;
+        let r = self.float(params, "radius", 1.0)?;
+        let ri = self.float(params, "innerradius", 0.0)?;
+        let phi_max = self
+            .float(params, "phimax", 360.0)?
+            .clamp(0.0, 360.0)
+            .to_radians();
+        if !(r > 0.0 && ri >= 0.0 && ri < r) {
+            return Err(self.error(format!(
+                "Shape \"disk\": need 0 <= innerradius ({ri}) < radius ({r})"
+            )));
+        }
+        let mut m = ObjectMesh::default();
+        for i in 0..=SEGMENTS {
+            let phi = phi_max * i as f64 / SEGMENTS as f64;
+            let (s, c) = phi.sin_cos();
+            m.positions.push(DVec3::new(r * c, r * s, h));
+            m.positions.push(DVec3::new(ri * c, ri * s, h));
+            let u = (phi / phi_max) as f32;
+            m.uvs.push(Vec2::new(u, 0.0));
+            m.uvs.push(Vec2::new(u, 1.0));
+        }
+        for i in 0..SEGMENTS as u32 {
+            let (o0, i0, o1, i1) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+            // Counter-clockwise seen from +z.
+            m.indices.extend([o0, o1, i1, o0, i1, i0]);
+        }
+        Ok(m)
+    }
+
+    /// A cylinder about z from `zmin` to `zmax`, normals outwards, [`SEGMENTS`] around.
+    fn cylinder(&mut self, params: &ParamList) -> Result<ObjectMesh, Error> {
+        let r = self.float(params, "radius", 1.0)?;
+        let z0 = self.float(params, "zmin", -1.0)?;
+        let z1 = self.float(params, "zmax", 1.0)?;
+        let phi_max = self
+            .float(params, "phimax", 360.0)?
+            .clamp(0.0, 360.0)
+            .to_radians();
+        if !(r > 0.0 && z1 != z0) {
+            return Err(self.error("Shape \"cylinder\": need radius > 0 and zmin != zmax"));
+        }
+        let mut m = ObjectMesh::default();
+        for i in 0..=SEGMENTS {
+            let phi = phi_max * i as f64 / SEGMENTS as f64;
+            let (s, c) = phi.sin_cos();
+            for z in [z0.min(z1), z0.max(z1)] {
+                m.positions.push(DVec3::new(r * c, r * s, z));
+                m.normals.push(DVec3::new(c, s, 0.0));
+            }
+        }
+        for i in 0..SEGMENTS as u32 {
+            let (a, b, c, d) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+            m.indices.extend([a, c, d, a, d, b]);
+        }
+        Ok(m)
+    }
+
+    fn sphere(
+        &mut self,
+        params: &ParamList,
+        m: DMat4,
+        material: usize,
+        emission: Option<Emission>,
+        state: &GraphicsState,
+    ) -> Result<(), Error> {
+        let radius = self.float(params, "radius", 1.0)?;
+        if radius.is_nan() || radius <= 0.0 {
+            return Err(self.error(format!(
+                "Shape \"sphere\": radius {radius} must be positive"
+            )));
+        }
+        let zmin = self.float(params, "zmin", -radius)?;
+        let zmax = self.float(params, "zmax", radius)?;
+        let phimax = self.float(params, "phimax", 360.0)?;
+        if zmin > -radius || zmax < radius || phimax < 360.0 {
+            self.warn("Shape \"sphere\": partial spheres (zmin, zmax, phimax) are not supported; the whole sphere is rendered");
+        }
+        let axes = DMat3::from_mat4(m);
+        let scales = [
+            axes.x_axis.length(),
+            axes.y_axis.length(),
+            axes.z_axis.length(),
+        ];
+        if (scales[0] - scales[1]).abs() > 1e-4 * scales[0]
+            || (scales[0] - scales[2]).abs() > 1e-4 * scales[0]
+        {
+            self.warn(
+                "Shape \"sphere\": a non-uniform scale is not supported; the x scale is used",
+            );
+        }
+        if state.reverse_orientation && emission.is_some() {
+            self.warn(
+                "Shape \"sphere\": an emitting sphere with ReverseOrientation still emits outwards",
+            );
+        }
+        let rot = DMat3::from_cols(
+            axes.x_axis / scales[0],
+            axes.y_axis / scales[1],
+            axes.z_axis / scales[2],
+        );
+        self.desc.spheres.push(SphereDesc {
+            center: m.transform_point3(DVec3::ZERO).as_vec3(),
+            radius: (radius * scales[0]) as f32,
+            material,
+            emission,
+            to_object: rot.transpose().as_mat3(),
+            emission_texture: None,
+        });
+        Ok(())
+    }
+}
+
+/// The object-space mesh `o` in the world by `m`, wound so that its fronts are pbrt's
+/// surface normals (see the module notes).
+fn place(o: ObjectMesh, m: DMat4, reverse: bool) -> MeshDesc {
+    let normal_matrix = DMat3::from_mat4(m).inverse().transpose();
+    let positions: Vec<Vec3> = o
+        .positions
+        .iter()
+        .map(|&p| m.transform_point3(p).as_vec3())
+        .collect();
+    let sign = if reverse { -1.0 } else { 1.0 };
+    let normals: Vec<Vec3> = o
+        .normals
+        .iter()
+        .map(|&n| (sign * (normal_matrix * n)).normalize_or_zero().as_vec3())
+        .collect();
+    let mut indices = o.indices;
+    // Without shading normals, pbrt's normal is the winding's carried as a normal: the
+    // world winding agrees with it unless the transform reverses orientation, and
+    // ReverseOrientation reverses it.
+    let swap_all = (m.determinant() < 0.0) != reverse;
+    for t in indices.chunks_exact_mut(3) {
+        let swap = if normals.is_empty() {
+            swap_all
+        } else {
+            let p = |i: u32| positions[i as usize];
+            let w = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+            let n = normals[t[0] as usize] + normals[t[1] as usize] + normals[t[2] as usize];
+            w.dot(n) < 0.0
+        };
+        if swap {
+            t.swap(1, 2);
+        }
+    }
+    MeshDesc {
+        positions,
+        indices,
+        normals,
+        uvs: o.uvs,
+        ..Default::default()
+    }
+}

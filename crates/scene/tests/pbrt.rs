@@ -1,0 +1,335 @@
+//! pbrt-v4 scenes: the file syntax, pbrt's conventions (handedness, orientation, units of
+//! light), located errors, and Bitterli's scenes against Tungsten's reference renders.
+
+use glam::DVec3;
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::film::Film;
+use pathlab_render::image_io::read_exr_rgb;
+use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
+use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::scene::Scene;
+use pathlab_scene::Error;
+use std::path::{Path, PathBuf};
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/bitterli")
+        .join(name)
+}
+
+/// Writes `files` (name, text) to a scratch folder and loads the first.
+fn load_text(tag: &str, files: &[(&str, &str)]) -> Result<pathlab_render::desc::SceneDesc, Error> {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("pbrt")
+        .join(tag);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    pathlab_scene::load(dir.join(files[0].0).to_str().unwrap())
+}
+
+fn render_film(desc: &pathlab_render::desc::SceneDesc, spp: u32, seed: u64) -> Film {
+    let scene = Scene::build(desc).unwrap();
+    let integrator = IntegratorKind::Path(PathIntegrator {
+        max_depth: desc.hints.max_depth.unwrap_or(u32::MAX),
+        ..Default::default()
+    });
+    let settings = RenderSettings::new(spp, seed, SamplerKind::Independent);
+    render(&scene, &integrator, &settings, &|_| {}, &Default::default()).0
+}
+
+/// The mean of the left and right halves of an image.
+fn halves(film: &Film) -> (DVec3, DVec3) {
+    let (w, h) = (film.width(), film.height());
+    let mut sums = [DVec3::ZERO; 2];
+    for y in 0..h {
+        for x in 0..w {
+            sums[(2 * x / w) as usize] += film.pixel(x, y).mean();
+        }
+    }
+    let n = (w * h / 2) as f64;
+    (sums[0] / n, sums[1] / n)
+}
+
+/// A camera looking at a red quad at world x > 0 and a blue one at x < 0, with `camera` the
+/// camera's transform directives.
+fn two_quads(camera: &str) -> String {
+    format!(
+        r#"# Two quads either side of x = 0, lit by a uniform sky.
+{camera}
+Camera "perspective" "float fov" [ 60 ]
+Film "rgb" "integer xresolution" [ 32 ] "integer yresolution" 16
+Sampler "independent" "integer pixelsamples" 4
+Integrator "path" "integer maxdepth" [ 1 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+AttributeBegin
+  Material "diffuse" "rgb reflectance" [ 0.8 0 0 ]
+  Shape "trianglemesh" "point3 P" [ 0 -2 0  3 -2 0  3 2 0  0 2 0 ] "integer indices" [ 0 1 2 0 2 3 ]
+AttributeEnd
+AttributeBegin
+  Material "diffuse" "rgb reflectance" [ 0 0 0.8 ]
+  Translate -3 0 0
+  Shape "trianglemesh" "point3 P" [ 0 -2 0  3 -2 0  3 2 0  0 2 0 ] "integer indices" [ 0 1 2 0 2 3 ]
+AttributeEnd
+"#
+    )
+}
+
+#[test]
+fn lookat_cameras_see_the_world_as_pbrt_does() {
+    // pbrt's camera space is left-handed: looking down +z from z = -5 with y up, +x is on the
+    // image's right, so the red quad (x > 0) is on the right.
+    let desc = load_text(
+        "lookat",
+        &[("a.pbrt", &two_quads("LookAt 0 0 -5  0 0 0  0 1 0"))],
+    )
+    .unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let (left, right) = halves(&render_film(&desc, 4, 1));
+    assert!(
+        // The sky fills what the quads leave: compare red and blue within each half.
+        right.x > right.z + 0.2 && left.z > left.x + 0.2,
+        "{left} {right}"
+    );
+    // Blender's exports put a mirror in front of LookAt: the quads swap sides.
+    let desc = load_text(
+        "mirrored",
+        &[(
+            "a.pbrt",
+            &two_quads("Scale -1 1 1\nLookAt 0 0 -5  0 0 0  0 1 0"),
+        )],
+    )
+    .unwrap();
+    let (left, right) = halves(&render_film(&desc, 4, 1));
+    assert!(
+        left.x > left.z + 0.2 && right.z > right.x + 0.2,
+        "{left} {right}"
+    );
+}
+
+/// A one-sided emitting quad in the plane z = 0 whose winding faces +z, seen from `eye`.
+fn one_sided_light(eye: &str, extra: &str) -> String {
+    format!(
+        r#"LookAt {eye}  0 0 0  0 1 0
+Camera "perspective" "float fov" 10
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+WorldBegin
+AttributeBegin
+  {extra}
+  AreaLightSource "diffuse" "rgb L" [ 2 2 2 ]
+  Shape "trianglemesh" "point3 P" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] "integer indices" [ 0 1 2 0 2 3 ]
+AttributeEnd
+"#
+    )
+}
+
+#[test]
+fn one_sided_area_lights_emit_on_pbrts_side() {
+    let seen = |eye: &str, extra: &str| {
+        let desc = load_text("side", &[("a.pbrt", &one_sided_light(eye, extra))]).unwrap();
+        render_film(&desc, 1, 0).image_mean().x
+    };
+    // The winding (0, 1, 2) faces +z: seen from +z it shines, from -z it is black.
+    assert!((seen("0 0 5", "") - 2.0).abs() < 1e-3);
+    assert_eq!(seen("0 0 -5", ""), 0.0);
+    // ReverseOrientation turns the side; a two-sided light shines both ways.
+    assert_eq!(seen("0 0 5", "ReverseOrientation"), 0.0);
+    assert!((seen("0 0 -5", "ReverseOrientation") - 2.0).abs() < 1e-3);
+    // A mirror in z leaves the quad where it is but turns its normal (pbrt carries the
+    // object's normal through the transform as a normal): it now shines towards -z.
+    assert_eq!(seen("0 0 5", "Scale 1 1 -1"), 0.0);
+    assert!((seen("0 0 -5", "Scale 1 1 -1") - 2.0).abs() < 1e-3);
+    let two =
+        one_sided_light("0 0 -5", "").replace("[ 2 2 2 ]", "[ 2 2 2 ] \"bool twosided\" true");
+    let desc = load_text("two", &[("a.pbrt", &two)]).unwrap();
+    assert!((render_film(&desc, 1, 0).image_mean().x - 2.0).abs() < 1e-3);
+}
+
+#[test]
+fn the_file_syntax_includes_objects_and_named_things() {
+    let main = r#"
+LookAt 0 0 10  0 0 0  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
+Sampler "sobol" "integer pixelsamples" [ 8 ]
+Integrator "volpath" "integer maxdepth" [ 3 ]
+WorldBegin
+Include "materials.pbrt"
+Texture "checks" "spectrum" "constant" "rgb value" [ 0.2 0.4 0.6 ]
+MakeNamedMaterial "tex" "string type" "diffuse" "texture reflectance" "checks"
+ObjectBegin "ball"
+  NamedMaterial "gold"
+  Shape "sphere" "float radius" 0.5
+ObjectEnd
+AttributeBegin Translate -2 0 0 ObjectInstance "ball" AttributeEnd
+AttributeBegin Translate 2 0 0 ObjectInstance "ball" AttributeEnd
+Attribute "shape" "float radius" [ 0.25 ]
+NamedMaterial "tex"
+Shape "sphere"
+LightSource "point" "point3 from" [ 0 5 5 ] "blackbody I" [ 5500 ] "float power" [ 100 ]
+"#;
+    let materials = r#"# Materials, included.
+MakeNamedMaterial "gold" "string type" [ "conductor" ]
+  "spectrum eta" "metal-Au-eta" "spectrum k" "metal-Au-k" "float roughness" 0.01
+"#;
+    let desc = load_text(
+        "syntax",
+        &[("main.pbrt", main), ("materials.pbrt", materials)],
+    )
+    .unwrap();
+    assert_eq!(desc.spheres.len(), 3);
+    let xs: Vec<f32> = desc.spheres.iter().map(|s| s.center.x).collect();
+    assert!(xs.iter().any(|x| (x.abs() - 2.0).abs() < 1e-5), "{xs:?}");
+    assert!(
+        desc.spheres.iter().any(|s| (s.radius - 0.25).abs() < 1e-6),
+        "Attribute default radius"
+    );
+    assert_eq!(desc.hints.spp, Some(8));
+    assert_eq!(desc.hints.max_depth, Some(3));
+    assert_eq!(desc.resolution, [16, 16]);
+    // A blackbody light has luminance 1 before its power: 100 W over 4π sr.
+    let i = desc.point_lights[0].intensity;
+    let y = 0.2126 * i.x + 0.7152 * i.y + 0.0722 * i.z;
+    assert!(
+        (y - 100.0 / (4.0 * std::f32::consts::PI)).abs() < 1e-3 * y,
+        "{i}"
+    );
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    render_film(&desc, 1, 0);
+}
+
+#[test]
+fn bad_files_are_one_line_errors_with_file_and_line() {
+    let cases = [
+        ("WorldBegin\nAttributeBegin\nShape \"sphere\"\n", "never closed", 2),
+        ("WorldBegin\nAttributeEnd\n", "without a matching begin", 2),
+        ("WorldBegin\nFrobnicate 1 2\n", "unknown directive 'Frobnicate'", 2),
+        ("WorldBegin\nShape \"sphere\" \"float radius\" [ \"big\" ]\n", "the values do not fit", 2),
+        ("WorldBegin\nShape \"sphere\" \"real radius\" 1\n", "unknown parameter type 'real'", 2),
+        ("WorldBegin\nShape \"sphere\" \"float radius\" [ 1\n", "ends inside its [ ]", 2),
+        ("WorldBegin\nShape \"sphere\n", "runs past the end of its line", 2),
+        ("Translate 1 2\nWorldBegin\n", "expected 3 numbers, found 2", 1),
+        ("WorldBegin\nNamedMaterial \"nothing\"\n", "no material of that name", 2),
+        ("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 5 ]\n", "out of range", 2),
+        ("Camera \"perspective\"\n", "no WorldBegin", 0),
+        ("WorldBegin\nInclude \"missing.pbrt\"\n", "missing.pbrt", 0),
+        ("WorldBegin\nShape \"plymesh\" \"string filename\" \"no.ply\"\n", "", 0),
+    ];
+    for (i, (text, expected, line)) in cases.iter().enumerate() {
+        let result = load_text(&format!("bad{i}"), &[("bad.pbrt", text)]);
+        let Err(e) = result else {
+            // A missing PLY is a warning, the scene still loads.
+            let desc = result.unwrap();
+            assert!(
+                desc.warnings.iter().any(|w| w.contains("no.ply")),
+                "case {i}: {:?}",
+                desc.warnings
+            );
+            continue;
+        };
+        let msg = e.to_string();
+        assert!(
+            msg.contains(expected),
+            "case {i}: expected '{expected}' in: {msg}"
+        );
+        assert_eq!(msg.lines().count(), 1, "{msg}");
+        if *line > 0 {
+            assert!(
+                msg.contains(&format!("bad.pbrt:{line}:")),
+                "case {i}: {msg}"
+            );
+        }
+    }
+}
+
+#[test]
+fn gzip_scenes_and_meshes_load() {
+    use flate2::write::GzEncoder;
+    use std::io::Write;
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-gz");
+    std::fs::create_dir_all(&dir).unwrap();
+    let gz = |name: &str, bytes: &[u8]| {
+        let mut e = GzEncoder::new(Vec::new(), flate2::Compression::default());
+        e.write_all(bytes).unwrap();
+        std::fs::write(dir.join(name), e.finish().unwrap()).unwrap();
+    };
+    let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+    gz("quad.ply.gz", ply.as_bytes());
+    gz(
+        "scene.pbrt.gz",
+        b"WorldBegin\nShape \"plymesh\" \"string filename\" \"quad.ply.gz\"\n",
+    );
+    let desc = pathlab_scene::load(dir.join("scene.pbrt.gz").to_str().unwrap()).unwrap();
+    assert_eq!(desc.meshes.len(), 1);
+    assert_eq!(desc.meshes[0].indices.len(), 6, "the quad split in two");
+    std::fs::write(dir.join("broken.pbrt.gz"), b"\x1f\x8b\x08\x00garbage").unwrap();
+    let e = pathlab_scene::load(dir.join("broken.pbrt.gz").to_str().unwrap()).unwrap_err();
+    assert!(e.to_string().contains("not a valid gzip file"), "{e}");
+}
+
+/// Renders a Bitterli scene at a quarter of its resolution and compares it with Tungsten's
+/// reference reduced the same way: (image mean ratio per channel, relative MSE).
+fn against_tungsten(scene: &str, spp: u32) -> (DVec3, f64) {
+    let mut desc =
+        pathlab_scene::load(data(scene).join("scene-v4.pbrt").to_str().unwrap()).unwrap();
+    let (w, h, reference) = read_exr_rgb(&data(scene).join("tungsten-quarter.exr")).unwrap();
+    desc.resolution = [w, h];
+    // Averaging 4 x 4 blocks of the reference is a box filter at this resolution.
+    desc.filter = pathlab_render::desc::PixelFilter::Box;
+    let film = render_film(&desc, spp, 7);
+    let ours = film.mean_image();
+    let mean =
+        |img: &[glam::Vec3]| img.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / img.len() as f64;
+    let ratio = mean(&ours) / mean(&reference);
+    let rel = ours
+        .iter()
+        .zip(&reference)
+        .map(|(a, b)| {
+            let (a, b) = (a.as_dvec3(), b.as_dvec3());
+            ((a - b) * (a - b) / (b * b + DVec3::splat(0.01))).element_sum() / 3.0
+        })
+        .sum::<f64>()
+        / ours.len() as f64;
+    eprintln!("{scene} at {w}x{h}, {spp} spp: image mean / Tungsten's {ratio:.4}, relative MSE {rel:.4}; warnings {:?}", desc.warnings);
+    (ratio, rel)
+}
+
+#[test]
+fn bitterli_cornell_box_matches_tungsten() {
+    let desc =
+        pathlab_scene::load(data("cornell-box").join("scene-v4.pbrt").to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let (ratio, rel) = against_tungsten("cornell-box", 128);
+    assert!((ratio - DVec3::ONE).abs().max_element() < 0.03, "{ratio}");
+    assert!(rel < 0.02, "relative MSE {rel}");
+}
+
+#[test]
+#[ignore = "open: the plates reflect 2.5 times the light they do in Tungsten's render (see issue 16's note)"]
+fn bitterli_veach_mis_matches_tungsten() {
+    let (ratio, rel) = against_tungsten("veach-mis", 256);
+    assert!((ratio - DVec3::ONE).abs().max_element() < 0.03, "{ratio}");
+    assert!(rel < 0.02, "relative MSE {rel}");
+}
+
+#[test]
+#[ignore = "open: unidirectional paths reach its light through the lamp's glossy shade too rarely for the noise to fall below the bound in a minute"]
+fn bitterli_veach_bidir_matches_tungsten() {
+    let (ratio, rel) = against_tungsten("veach-bidir", 256);
+    assert!((ratio - DVec3::ONE).abs().max_element() < 0.03, "{ratio}");
+    assert!(rel < 0.02, "relative MSE {rel}");
+}
+
+#[test]
+fn bitterli_scenes_load_with_only_documented_warnings() {
+    for scene in ["cornell-box", "veach-mis", "veach-bidir"] {
+        let path = data(scene).join("scene-v4.pbrt");
+        let desc = pathlab_scene::load(path.to_str().unwrap()).unwrap();
+        for w in &desc.warnings {
+            assert!(w.contains("rendered by the path tracer"), "{scene}: {w}");
+        }
+        assert!(Path::new(&path).exists());
+    }
+}
