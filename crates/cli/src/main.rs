@@ -4,6 +4,7 @@ mod bench_cmd;
 mod compare_cmd;
 mod converge_cmd;
 mod expr;
+mod farm;
 mod image_cmd;
 mod images;
 mod info_cmd;
@@ -27,7 +28,7 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render a scene (default: the built-in Cornell box).
-    Render(render_cmd::RenderArgs),
+    Render(Box<render_cmd::RenderArgs>),
     /// Render a scene with several strategies side by side, with variance, RMSE and efficiency.
     Compare(compare_cmd::CompareArgs),
     /// Plot the error against a reference as samples and time grow, for several samplers.
@@ -42,6 +43,8 @@ enum Command {
     Convert(image_cmd::ConvertArgs),
     /// Compare two images of one size: RMSE, relative MSE, and a difference image.
     Diff(image_cmd::DiffArgs),
+    /// Add the films of a render's shards (`render --shard I/N -o PART.plf`) into its image.
+    Merge(farm::MergeArgs),
     /// Measure speed (not a test): BVH build and ray throughput against Embree's ray files.
     Bench(bench_cmd::BenchArgs),
 }
@@ -52,7 +55,12 @@ fn main() -> ExitCode {
         Err(e) => return argument_error(e),
     };
     let result = match &cli.command {
-        Command::Render(args) => render_cmd::run(args),
+        Command::Render(args) => match render_cmd::run(args) {
+            Ok(0) => Ok(()),
+            Ok(code) => return ExitCode::from(code),
+            Err(e) => Err(e),
+        },
+        Command::Merge(args) => farm::run_merge(args),
         Command::Info(args) => info_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
         Command::Converge(args) => converge_cmd::run(args),

@@ -13,12 +13,12 @@ use pathlab_render::integrator::{
     DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator, PathLighting,
 };
 use pathlab_render::progressive::{render_progressive, StopRule};
-use pathlab_render::render::{render, Adaptive, AdaptiveRule, RenderSettings};
+use pathlab_render::render::{render, render_from, Adaptive, AdaptiveRule, RenderSettings};
 use pathlab_render::scene::Scene;
 use serde_json::json;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 /// Which integrator renders the image.
@@ -219,6 +219,27 @@ pub struct RenderArgs {
     /// Extra outputs, comma-separated: variance, samples (EXR channels, or files next to a PNG).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub aov: Vec<Aov>,
+    /// Write the film's exact state to FILE (.plf) after passes, at most every
+    /// --checkpoint-every seconds, and when the render is stopped: `--resume FILE` goes on
+    /// from it to the same image, bit for bit.
+    #[arg(long, value_name = "FILE")]
+    pub checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (default 60).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 60.0,
+        allow_negative_numbers = true
+    )]
+    pub checkpoint_every: f64,
+    /// Go on from a checkpoint of this render (the same scene, flags and seed) to -s.
+    #[arg(long, value_name = "FILE")]
+    pub resume: Option<PathBuf>,
+    /// Render only the I-th (from 0) of N equal ranges of every pixel's samples: a whole-frame
+    /// image of spp/N samples per pixel. Write it as a film (-o PART.plf); `pathlab merge`
+    /// adds the N parts into the image one render would give, bit for bit.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
     /// No progress bar.
     #[arg(short = 'q', long)]
     pub quiet: bool,
@@ -282,6 +303,8 @@ fn parse_adaptive(values: &[String], rule: Option<RuleName>) -> Result<Adaptive>
 enum OutputFormat {
     Exr,
     Png,
+    /// The film's exact state (`pathlab_render::film_file`).
+    Film,
 }
 
 fn output_format(path: &Path) -> Result<OutputFormat> {
@@ -293,7 +316,11 @@ fn output_format(path: &Path) -> Result<OutputFormat> {
     {
         Some("exr") => Ok(OutputFormat::Exr),
         Some("png") => Ok(OutputFormat::Png),
-        _ => bail!("{}: the output must end in .exr or .png", path.display()),
+        Some("plf") => Ok(OutputFormat::Film),
+        _ => bail!(
+            "{}: the output must end in .exr or .png (or .plf for the film's exact state)",
+            path.display()
+        ),
     }
 }
 
@@ -375,9 +402,6 @@ pub(crate) fn si_prefixed(v: f64) -> String {
     format!("{scaled:.digits$}{prefix}")
 }
 
-/// Set by Ctrl-C: the render stops and writes what it has.
-static CANCEL: AtomicBool = AtomicBool::new(false);
-
 /// Flags that contradict each other or a value no image can show: an error, before anything
 /// is loaded; flags that the chosen integrator does not read: a warning each (returned).
 fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>> {
@@ -421,7 +445,9 @@ fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>>
 }
 
 /// Runs `pathlab render`.
-pub fn run(args: &RenderArgs) -> Result<()> {
+pub fn run(args: &RenderArgs) -> Result<u8> {
+    let signals = crate::farm::Signals::install();
+    let cancel: &AtomicBool = &signals.cancel;
     let cli_depth = args.max_depth.as_deref().map(parse_max_depth).transpose()?;
     for w in check_flags(args, cli_depth)? {
         if !args.quiet {
@@ -441,8 +467,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .iter()
         .map(|o| output_format(o))
         .collect::<Result<Vec<_>>>()?;
-    for o in &outputs {
+    for o in outputs.iter().chain(&args.checkpoint) {
         check_writable(o)?;
+    }
+    if args.shard.is_some() && !formats.contains(&OutputFormat::Film) {
+        bail!("--shard: write the part as a film (-o PART.plf) so that `pathlab merge` can add the parts exactly");
+    }
+    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
+        bail!(
+            "--checkpoint-every {}: must be a number of seconds >= 0",
+            args.checkpoint_every
+        );
     }
     let output = outputs[0].clone();
     let params = args
@@ -582,7 +617,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         if let Some(a) = settings.adaptive.as_mut() {
             // A short pilot for the image's mean luminance (its samples are not reused).
             let pilot = RenderSettings::new(4, args.seed.wrapping_add(1), sampler);
-            let (film, _) = render(&scene, &integrator, &pilot, &|_| {}, &CANCEL);
+            let (film, _) = render(&scene, &integrator, &pilot, &|_| {}, cancel);
             let m = film.image_mean();
             let image_luminance = 0.2126 * m.x + 0.7152 * m.y + 0.0722 * m.z;
             if image_luminance > 0.0 {
@@ -590,6 +625,51 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
         }
     }
+    if let Some(shard) = &args.shard {
+        if progressive || settings.adaptive.is_some() {
+            bail!("--shard splits a render of fixed samples per pixel; it cannot be combined with -a, --target-error or --time");
+        }
+        settings.sample_range = Some(crate::farm::shard_range(shard, spp)?);
+    }
+    if (args.checkpoint.is_some() || args.resume.is_some())
+        && (progressive || settings.adaptive.is_some())
+    {
+        bail!("--checkpoint and --resume work with renders of fixed samples per pixel, not with -a, --target-error or --time");
+    }
+    // What identifies this render: the scene as the renderer gets it and every setting that
+    // changes the image.
+    let range = settings.sample_range.unwrap_or([0, spp]);
+    let description = format!(
+        "{integrator_name:?} integrator, {} sampler, seed {}, crop {:?}",
+        sampler.name(),
+        args.seed,
+        settings.crop
+    )
+    .to_lowercase();
+    let key = crate::farm::render_key(
+        &desc,
+        &format!(
+            "{integrator:?}|{sampler:?}|{:?}|{:?}",
+            settings.crop, settings.adaptive
+        ),
+    );
+    let header = crate::farm::header(&desc, &key, &description, args.seed, spp, range);
+    let start_film = match &args.resume {
+        Some(path) => {
+            let (h, film) = pathlab_render::film_file::read(path)?;
+            crate::farm::check_matches(path, &h, &header)?;
+            if !args.quiet {
+                let n = film.pixels().iter().map(|p| p.count()).min().unwrap_or(0);
+                eprintln!(
+                    "resuming {}: every pixel holds at least {n} of {} samples",
+                    path.display(),
+                    range[1] - range[0]
+                );
+            }
+            Some(film)
+        }
+        None => None,
+    };
     let [w, h] = desc.resolution;
     let total = settings.crop.map_or(w as u64 * h as u64, |c| {
         (c[2] - c[0]) as u64 * (c[3] - c[1]) as u64
@@ -630,7 +710,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         b
     };
     let bar = Arc::new(bar);
-    let _ = ctrlc::set_handler(|| CANCEL.store(true, Ordering::Relaxed));
     let progress_bar = Arc::clone(&bar);
     let progress = move |n: u64| progress_bar.inc(n);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -650,7 +729,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             bar_pass.set_message(format!("pass {pass}: estimated relative RMSE {error:.4}"));
         };
         let (film, stats, report) = pool.install(|| {
-            render_progressive(&scene, &integrator, &settings, &stop, &report_pass, &CANCEL)
+            render_progressive(&scene, &integrator, &settings, &stop, &report_pass, cancel)
         });
         let error = report.error_history.last().copied().unwrap_or(f64::NAN);
         if !args.quiet {
@@ -662,13 +741,50 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         estimated_error = Some(error);
         (film, stats)
     } else {
-        pool.install(|| render(&scene, &integrator, &settings, &progress, &CANCEL))
+        let film0 = start_film.unwrap_or_else(|| pathlab_render::film::Film::new(w, h));
+        let mut last_checkpoint = std::time::Instant::now();
+        let mut checkpoint_error = None;
+        let mut after_pass =
+            |film: &pathlab_render::film::Film, _: &pathlab_render::render::RenderStats| {
+                if let Some(path) = &args.checkpoint {
+                    if last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every {
+                        if let Err(e) = pathlab_render::film_file::write(path, &header, film) {
+                            checkpoint_error.get_or_insert(e);
+                        }
+                        last_checkpoint = std::time::Instant::now();
+                    }
+                }
+            };
+        let result = pool.install(|| {
+            render_from(
+                &scene,
+                &integrator,
+                &settings,
+                film0,
+                &progress,
+                cancel,
+                &mut after_pass,
+            )
+        });
+        if let Some(e) = checkpoint_error {
+            return Err(e).context("cannot write the checkpoint");
+        }
+        if let Some(path) = &args.checkpoint {
+            pathlab_render::film_file::write(path, &header, &result.0)
+                .context("cannot write the checkpoint")?;
+        }
+        result
     };
     bar.finish_and_clear();
     if stats.cancelled {
+        let counts = film.sample_counts();
+        let (lo, hi) = counts.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &c| {
+            (lo.min(c), hi.max(c))
+        });
         eprintln!(
-            "interrupted: writing the {} samples done so far",
-            stats.samples
+            "interrupted: writing the image of the {} samples finished, {lo:.0} to {hi:.0} per pixel{}",
+            stats.samples,
+            if args.checkpoint.is_some() { " (and the checkpoint)" } else { "" }
         );
     }
     // The BVH view counts nodes (1 to a few hundred): a PNG shows them as a heat map scaled
@@ -679,6 +795,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             Some((_, hi)) if format == OutputFormat::Png => {
                 let counts: Vec<f32> = film.mean_image().iter().map(|v| v.x).collect();
                 write_heat_image(&film, &counts, hi, path)?;
+            }
+            _ if format == OutputFormat::Film => {
+                pathlab_render::film_file::write(path, &header, &film)?
             }
             _ => write_outputs(&film, path, format, args)?,
         }
@@ -749,7 +868,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "bvh_nodes": build.bvh_nodes,
             "triangles": build.triangles,
             "image_mean_rgb": [mean.x, mean.y, mean.z],
-            "nonfinite_samples_discarded": stats.nonfinite_samples,
+            "nonfinite_samples": stats.nonfinite_samples,
             "cancelled": stats.cancelled,
             "sampler": sampler.name(),
             "estimated_relative_rmse": estimated_error,
@@ -775,9 +894,57 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
         if stats.nonfinite_samples > 0 {
             eprintln!(
-                "warning: {} samples were NaN or infinite and were discarded",
+                "warning: {} samples were NaN or infinite and were counted as black",
                 stats.nonfinite_samples
             );
+        }
+    }
+    // Stopped by a signal: the shell's convention, 128 + the signal's number.
+    Ok(if !stats.cancelled {
+        0
+    } else if signals
+        .terminated
+        .load(std::sync::atomic::Ordering::Relaxed)
+    {
+        143
+    } else {
+        130
+    })
+}
+
+/// Writes `film` (of a whole render described by `header`) as `.exr` (the mean with
+/// `variance.R/G/B` and `samples.Y` layers), `.png` (sRGB after `exposure` stops) or `.plf`.
+pub fn write_film_image(
+    film: &Film,
+    path: &Path,
+    header: &pathlab_render::film_file::FilmHeader,
+    exposure: f32,
+) -> Result<()> {
+    let (w, h) = (film.width(), film.height());
+    match output_format(path)? {
+        OutputFormat::Film => pathlab_render::film_file::write(path, header, film)?,
+        OutputFormat::Png => {
+            write_png_with(path, w, h, &film.mean_image(), exposure, ToneMap::Srgb)?
+        }
+        OutputFormat::Exr => {
+            let variance = film.variance_image();
+            let channels: Vec<Vec<f32>> = (0..3)
+                .map(|c| variance.iter().map(|v| v[c]).collect())
+                .collect();
+            let samples = film.sample_counts();
+            let mut extra: Vec<ExtraChannel> = channels
+                .iter()
+                .zip(["variance.R", "variance.G", "variance.B"])
+                .map(|(values, name)| ExtraChannel {
+                    name: name.to_string(),
+                    values,
+                })
+                .collect();
+            extra.push(ExtraChannel {
+                name: "samples.Y".to_string(),
+                values: &samples,
+            });
+            write_exr(path, w, h, &film.mean_image(), &extra)?;
         }
     }
     Ok(())
@@ -828,6 +995,8 @@ fn write_outputs(
         .contains(&Aov::Samples)
         .then(|| film.sample_counts());
     match format {
+        // Written by the caller, which has the render's header.
+        OutputFormat::Film => {}
         OutputFormat::Exr => {
             let var_channels: Vec<Vec<f32>> = variance
                 .iter()

@@ -455,7 +455,7 @@ fn render_writes_png_exr_and_aovs_with_statistics() {
         "rays_per_second",
         "bvh_build_seconds",
         "bvh_nodes",
-        "nonfinite_samples_discarded",
+        "nonfinite_samples",
     ] {
         assert!(v[key].is_number(), "{key} missing");
     }
@@ -1383,4 +1383,267 @@ fn scale_and_fov_resize_and_reframe_any_scene() {
     assert_ne!(wide["image_mean_rgb"], narrow["image_mean_rgb"]);
     assert_one_line_error(&pathlab(&["render", "--scale", "0"]), "--scale 0");
     assert_one_line_error(&pathlab(&["render", "--fov", "200"]), "--fov 200");
+}
+
+#[test]
+fn shards_merge_into_the_single_render_to_the_bit_and_bad_sets_are_reported() {
+    let single = scratch("single.plf");
+    let run = |extra: &[&str], out: &PathBuf| {
+        let mut args = vec![
+            "render",
+            "-s",
+            "32",
+            "-r",
+            "48",
+            "32",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = pathlab(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    run(&[], &single);
+    let parts: Vec<PathBuf> = (0..4).map(|i| scratch(&format!("part{i}.plf"))).collect();
+    for (i, p) in parts.iter().enumerate() {
+        run(&["--shard", &format!("{i}/4")], p);
+    }
+    let merged = scratch("merged.plf");
+    let mut args: Vec<&str> = vec!["merge", merged.to_str().unwrap()];
+    args.extend(parts.iter().map(|p| p.to_str().unwrap()));
+    let o = pathlab(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        std::fs::read(&merged).unwrap(),
+        std::fs::read(&single).unwrap()
+    );
+    // The merged EXR carries the variance and sample-count layers.
+    let exr = scratch("merged.exr");
+    args[1] = exr.to_str().unwrap();
+    assert!(pathlab(&args).status.success());
+    assert_magic(&exr, EXR);
+    let p = |i: usize| parts[i].to_str().unwrap();
+    assert_one_line_error(
+        &pathlab(&["merge", "m.exr", p(0), p(1), p(3)]),
+        "samples 16..24 are missing",
+    );
+    assert_one_line_error(
+        &pathlab(&["merge", "m.exr", p(0), p(1), p(1), p(2), p(3)]),
+        "overlaps",
+    );
+    let other = scratch("other-seed.plf");
+    run(&["--shard", "2/4", "--seed", "9"], &other);
+    assert_one_line_error(
+        &pathlab(&["merge", "m.exr", p(0), p(1), other.to_str().unwrap(), p(3)]),
+        "not a part of the same render",
+    );
+    assert_one_line_error(
+        &pathlab(&["render", "--shard", "1/4", "-o", "x.exr"]),
+        "-o PART.plf",
+    );
+    assert_one_line_error(
+        &pathlab(&["render", "--shard", "4/4", "-o", "x.plf"]),
+        "need 0 <= I < N",
+    );
+}
+
+#[cfg(unix)]
+fn interrupt(args: &[&str], signal: &str, after: std::time::Duration) -> std::process::Output {
+    let child = Command::new(env!("CARGO_BIN_EXE_pathlab"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(after);
+    let status = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+#[cfg(unix)]
+fn a_stopped_render_writes_whole_passes_and_a_checkpoint_resumes_to_the_same_image() {
+    // Stopped at a moment the test does not choose precisely: every pixel holds whole passes
+    // (or one pass more), the image is an unbiased estimate, the exit status 130.
+    let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scene/tests/data/cornell-box/mean-maxdepth-2.exr");
+    let out = scratch("stopped.exr");
+    let ck = scratch("stopped.plf");
+    let o = interrupt(
+        &[
+            "render",
+            "-m",
+            "1",
+            "-s",
+            "100000",
+            "--sampler",
+            "independent",
+            "--aov",
+            "variance,samples",
+            "--checkpoint",
+            ck.to_str().unwrap(),
+            "--checkpoint-every",
+            "0",
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+            "--json",
+        ],
+        "-INT",
+        std::time::Duration::from_millis(1500),
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["cancelled"], true);
+    let lo = v["spp_range"][0].as_f64().unwrap();
+    let hi = v["spp_range"][1].as_f64().unwrap();
+    assert!(lo >= 1.0 && hi <= 2.0 * lo.max(1.0) + 64.0, "{lo} to {hi}");
+    // Unbiased: the image mean within 4 standard errors of the reference's.
+    let (w, h, mean) = pathlab_render::image_io::read_exr_rgb(&out).unwrap();
+    let (_, _, refm) = pathlab_render::image_io::read_exr_rgb(&reference).unwrap();
+    assert_eq!((w, h), (256, 256));
+    let avg = |img: &[glam::Vec3]| {
+        img.iter().map(|p| p.as_dvec3()).sum::<glam::DVec3>() / img.len() as f64
+    };
+    let (ours, theirs) = (avg(&mean), avg(&refm));
+    let var = read_exr_layer(&out, "variance.G");
+    let se = (var.iter().map(|&v| v as f64).sum::<f64>()).sqrt() / var.len() as f64;
+    let z = (ours.y - theirs.y) / se.max(1e-12);
+    assert!(z.abs() < 4.0, "image mean {ours} vs {theirs}: z {z}");
+    // A SIGTERM exits 143.
+    let o = interrupt(
+        &[
+            "render",
+            "-s",
+            "100000",
+            "-r",
+            "8",
+            "8",
+            "-o",
+            scratch("term.exr").to_str().unwrap(),
+            "-q",
+        ],
+        "-TERM",
+        std::time::Duration::from_millis(800),
+    );
+    assert_eq!(o.status.code(), Some(143));
+    // A checkpoint resumes to the image an uninterrupted render gives, bit for bit.
+    let ck2 = scratch("resume.plf");
+    let whole = scratch("whole.plf");
+    let args = |extra: &[&str]| {
+        let mut a = vec!["render", "-s", "2048", "-r", "64", "64", "-q"];
+        a.extend_from_slice(extra);
+        a.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let o = interrupt(
+        &args(&[
+            "--checkpoint",
+            ck2.to_str().unwrap(),
+            "--checkpoint-every",
+            "0",
+            "-o",
+            scratch("partial.exr").to_str().unwrap(),
+        ])
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>(),
+        "-INT",
+        std::time::Duration::from_millis(700),
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let resumed = scratch("resumed.plf");
+    let o = pathlab(
+        &args(&[
+            "--resume",
+            ck2.to_str().unwrap(),
+            "-o",
+            resumed.to_str().unwrap(),
+        ])
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = pathlab(
+        &args(&["-o", whole.to_str().unwrap()])
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert!(o.status.success());
+    assert_eq!(
+        std::fs::read(&resumed).unwrap(),
+        std::fs::read(&whole).unwrap()
+    );
+    // A checkpoint of another render, or a corrupt one, is refused.
+    assert_one_line_error(
+        &pathlab(&[
+            "render",
+            "-s",
+            "2048",
+            "-r",
+            "64",
+            "64",
+            "--seed",
+            "4",
+            "--resume",
+            ck2.to_str().unwrap(),
+            "-o",
+            "x.exr",
+        ]),
+        "seed",
+    );
+    let bad = scratch("bad.plf");
+    let mut bytes = std::fs::read(&ck2).unwrap();
+    let n = bytes.len();
+    bytes[n / 2] ^= 1;
+    std::fs::write(&bad, &bytes).unwrap();
+    assert_one_line_error(
+        &pathlab(&[
+            "render",
+            "-s",
+            "2048",
+            "-r",
+            "64",
+            "64",
+            "--resume",
+            bad.to_str().unwrap(),
+            "-o",
+            "x.exr",
+        ]),
+        "corrupt",
+    );
+}
+
+/// One channel of an EXR file, by name.
+fn read_exr_layer(path: &PathBuf, name: &str) -> Vec<f32> {
+    use exr::prelude::*;
+    let image = read_all_flat_layers_from_file(path).unwrap();
+    let layer = &image.layer_data[0];
+    let ch = layer
+        .channel_data
+        .list
+        .iter()
+        .find(|c| c.name.to_string() == name)
+        .unwrap_or_else(|| panic!("no channel {name}"));
+    match &ch.sample_data {
+        FlatSamples::F32(v) => v.clone(),
+        FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+        FlatSamples::U32(v) => v.iter().map(|&x| x as f32).collect(),
+    }
 }

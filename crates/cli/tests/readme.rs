@@ -1,6 +1,6 @@
 //! The README's tour, run as a new user runs it: every `pathlab ...` line of its `sh` blocks, in
 //! order, from a folder that sees the repository's files where the README says they are. To keep
-//! the suite fast, sample counts are lowered (`-s` to 2, `--max-spp` to 4, `-n` to at most
+//! the suite fast, sample counts are lowered (`-s` to 4, `--max-spp` to 4, `-n` to at most
 //! 10^6); every flag, file and subcommand is as written.
 
 use std::path::{Path, PathBuf};
@@ -58,7 +58,7 @@ fn tour(readme: &str) -> Vec<Vec<String>> {
 fn cheaper(mut args: Vec<String>) -> Vec<String> {
     for i in 1..args.len() {
         let value = match args[i - 1].as_str() {
-            "-s" | "--spp" => Some("2".to_string()),
+            "-s" | "--spp" => Some("4".to_string()),
             "--max-spp" => Some("4".to_string()),
             "-n" => args[i]
                 .parse::<u64>()
@@ -113,6 +113,6 @@ fn the_tour_parser_reads_quotes_and_comments() {
     );
     assert_eq!(
         cheaper(words("pathlab render -s 256 -n 5000000")),
-        ["pathlab", "render", "-s", "2", "-n", "1000000"]
+        ["pathlab", "render", "-s", "4", "-n", "1000000"]
     );
 }

@@ -43,6 +43,7 @@
 pub mod distribution;
 pub mod error;
 pub mod estimator;
+pub mod exact;
 pub mod lanes;
 pub mod quadrature;
 pub mod rng;

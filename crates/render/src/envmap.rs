@@ -129,6 +129,16 @@ impl EnvironmentMap {
         self.luminance_integral
     }
 
+    /// The local direction of grid point (column `i`, row `j`) of a `width` × `height` map:
+    /// u = (i + ½) / W, v = j / (H - 1) (see the module notes).
+    pub fn grid_direction(i: usize, j: usize, width: usize, height: usize) -> Vec3 {
+        let uv = Vec2::new(
+            (i as f32 + 0.5) / width as f32,
+            j as f32 / (height.max(2) - 1) as f32,
+        );
+        Self::uv_to_direction(uv).0
+    }
+
     /// Half a texel in u: grid column i sits at u = (i + ½) / W.
     fn half_texel(&self) -> f32 {
         0.5 / self.width as f32
@@ -141,7 +151,7 @@ impl EnvironmentMap {
     }
 
     /// The local direction of (u, v), and sin θ.
-    fn uv_to_direction(uv: Vec2) -> (Vec3, f32) {
+    pub fn uv_to_direction(uv: Vec2) -> (Vec3, f32) {
         let (sin_t, cos_t) = (uv.y * PI).sin_cos();
         let (sin_p, cos_p) = (uv.x * TAU).sin_cos();
         (

@@ -2,59 +2,78 @@
 
 use crate::desc::Rgb;
 use glam::{DVec3, Vec3};
-use pathlab_mc::estimator::RunningStats;
+use pathlab_mc::exact::{to_fixed, ExactStats};
 
-/// Statistics of one pixel's samples, per channel.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// Statistics of one pixel's samples: their count, and exact sums of each channel and of
+/// luminance and of their squares ([`pathlab_mc::exact`]): the same for any order in which
+/// samples arrive, so passes, resumed checkpoints and merged shards give the same image to the
+/// bit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PixelStats {
-    channels: [RunningStats; 3],
-    luminance: RunningStats,
+    n: u64,
+    /// Σ of R, G, B and luminance, fixed point.
+    sums: [i128; 4],
+    /// Σ of their squares, fixed point.
+    squares: [i128; 4],
 }
+
+/// Bytes of one pixel in [`PixelStats::to_bytes`].
+pub const PIXEL_BYTES: usize = 8 + 8 * 16;
 
 impl PixelStats {
     /// Adds a sample.
     #[inline]
     pub fn add(&mut self, l: Rgb) {
-        for (c, v) in self.channels.iter_mut().zip(l.to_array()) {
-            c.push(v as f64);
+        self.n += 1;
+        let lum = crate::light::luminance(l);
+        for (c, v) in [l.x, l.y, l.z, lum].into_iter().enumerate() {
+            let v = v as f64;
+            self.sums[c] = self.sums[c].saturating_add(to_fixed(v));
+            self.squares[c] = self.squares[c].saturating_add(to_fixed(v * v));
         }
-        self.luminance.push(crate::light::luminance(l) as f64);
+    }
+
+    /// Statistics of channel `c` (0, 1, 2: R, G, B; 3: luminance).
+    #[inline]
+    fn channel(&self, c: usize) -> ExactStats {
+        ExactStats::from_raw(self.n, self.sums[c], self.squares[c])
     }
 
     /// Statistics of the samples' luminance (the "illuminance" of the course's adaptive
     /// sampling).
-    pub fn luminance(&self) -> &RunningStats {
-        &self.luminance
+    pub fn luminance(&self) -> ExactStats {
+        self.channel(3)
     }
 
-    /// Combines with another set of samples of the same pixel.
+    /// Combines with another set of samples of the same pixel (exactly).
     pub fn merge(&mut self, o: &PixelStats) {
-        for (c, d) in self.channels.iter_mut().zip(&o.channels) {
-            c.merge(d);
+        self.n += o.n;
+        for c in 0..4 {
+            self.sums[c] = self.sums[c].saturating_add(o.sums[c]);
+            self.squares[c] = self.squares[c].saturating_add(o.squares[c]);
         }
-        self.luminance.merge(&o.luminance);
     }
 
     /// Number of samples.
     pub fn count(&self) -> u64 {
-        self.channels[0].count()
+        self.n
     }
 
     /// Mean radiance.
     pub fn mean(&self) -> DVec3 {
         DVec3::new(
-            self.channels[0].mean(),
-            self.channels[1].mean(),
-            self.channels[2].mean(),
+            self.channel(0).mean(),
+            self.channel(1).mean(),
+            self.channel(2).mean(),
         )
     }
 
     /// Sample variance of one sample, per channel.
     pub fn variance(&self) -> DVec3 {
         DVec3::new(
-            self.channels[0].variance(),
-            self.channels[1].variance(),
-            self.channels[2].variance(),
+            self.channel(0).variance(),
+            self.channel(1).variance(),
+            self.channel(2).variance(),
         )
     }
 
@@ -67,10 +86,35 @@ impl PixelStats {
             self.variance() / n as f64
         }
     }
+
+    /// The exact state, little-endian: count, then the sums, then the sums of squares.
+    pub fn to_bytes(&self, out: &mut Vec<u8>) {
+        out.extend(self.n.to_le_bytes());
+        for v in self.sums.iter().chain(&self.squares) {
+            out.extend(v.to_le_bytes());
+        }
+    }
+
+    /// The state [`PixelStats::to_bytes`] wrote (exactly [`PIXEL_BYTES`] bytes).
+    pub fn from_bytes(b: &[u8]) -> Option<PixelStats> {
+        if b.len() != PIXEL_BYTES {
+            return None;
+        }
+        let n = u64::from_le_bytes(b[..8].try_into().ok()?);
+        let mut v = [0i128; 8];
+        for (k, chunk) in b[8..].chunks_exact(16).enumerate() {
+            v[k] = i128::from_le_bytes(chunk.try_into().ok()?);
+        }
+        Some(PixelStats {
+            n,
+            sums: [v[0], v[1], v[2], v[3]],
+            squares: [v[4], v[5], v[6], v[7]],
+        })
+    }
 }
 
 /// An image of pixel statistics, row 0 at the top.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Film {
     width: u32,
     height: u32,

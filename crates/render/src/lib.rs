@@ -45,6 +45,7 @@ pub mod camera;
 pub mod desc;
 pub mod envmap;
 pub mod film;
+pub mod film_file;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;

@@ -105,7 +105,7 @@ pub fn render_progressive(
     };
     let start = Instant::now();
     let mut total: u64 = 0;
-    // Each pixel's next sample index (counts include discarded non-finite samples).
+    // Each pixel's next sample index (counts include non-finite samples, added as black).
     let mut next_index = vec![0u32; inside.len()];
     let max_total = stop.max_spp.max(1) as u64 * pixels as u64;
     loop {

@@ -25,6 +25,9 @@ pub struct RenderSettings {
     pub crop: Option<[u32; 4]>,
     /// Per-pixel adaptive sampling (`spp` is then the most a pixel takes).
     pub adaptive: Option<Adaptive>,
+    /// Only the sample indices `[start, end)` of every pixel (a shard of a render split
+    /// over machines); `None`: `[0, spp)`.
+    pub sample_range: Option<[u32; 2]>,
 }
 
 /// Per-pixel adaptive sampling: each pixel's sample count is chosen from its samples'
@@ -98,7 +101,7 @@ impl Adaptive {
     /// surface that scatters, so equal samples are the pixel's exact value.
     pub fn converged(
         &self,
-        luminance: &pathlab_mc::estimator::RunningStats,
+        luminance: &pathlab_mc::exact::ExactStats,
         deterministic: bool,
     ) -> bool {
         let n = luminance.count();
@@ -125,7 +128,7 @@ impl Adaptive {
     /// nothing.
     pub fn planned_samples(
         &self,
-        pilot: &pathlab_mc::estimator::RunningStats,
+        pilot: &pathlab_mc::exact::ExactStats,
         deterministic: bool,
         cap: u32,
     ) -> u32 {
@@ -154,6 +157,7 @@ impl RenderSettings {
             sampler,
             crop: None,
             adaptive: None,
+            sample_range: None,
         }
     }
 }
@@ -217,29 +221,78 @@ pub fn sample_pixel(
     (ok, bad)
 }
 
-/// Adds radiance `l` to `px` when it is finite (counting it in `ok`), else counts it in `bad`.
+/// Adds radiance `l` to `px` when it is finite (counting it in `ok`); a NaN or infinite
+/// sample is added as black and counted in `bad` (as pbrt does), so that a pixel's count is
+/// always the number of its sample indices done.
 #[inline]
 fn add_sample(px: &mut PixelStats, l: crate::desc::Rgb, ok: &mut u64, bad: &mut u64) {
     if l.is_finite() {
         px.add(l);
         *ok += 1;
     } else {
+        px.add(crate::desc::Rgb::ZERO);
         *bad += 1;
     }
 }
 
-/// Renders `scene` with `integrator`.
+/// Renders `scene` with `integrator` from an empty film.
 ///
-/// Each pixel's samples use the sampler positioned at (pixel, sample index), so the image is
-/// the same for the same seed whatever the thread count or tile order. `progress(samples)` is
-/// called from worker threads as tiles finish; when `cancel` becomes true, pixels not yet
-/// started are skipped and the film holds what was done (their sample count stays 0).
+/// Each pixel's samples use the sampler positioned at (pixel, sample index), and the film
+/// sums them exactly, so the image is the same for the same seed whatever the thread count,
+/// tile order or pass schedule. `progress(samples)` is called from worker threads as tiles
+/// finish; when `cancel` becomes true the render stops within a sample per thread and the
+/// film holds every sample finished (whole passes, and part of the last).
 pub fn render(
     scene: &Scene,
     integrator: &dyn Integrator,
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
     cancel: &AtomicBool,
+) -> (Film, RenderStats) {
+    let [width, height] = scene.camera().resolution();
+    render_from(
+        scene,
+        integrator,
+        settings,
+        Film::new(width, height),
+        progress,
+        cancel,
+        &mut |_, _| {},
+    )
+}
+
+/// The end of each pass: whole-frame passes of 1, 1, 2, 4, ... samples per pixel from
+/// `first`, then steady passes of `steady` samples, up to `end`.
+pub fn pass_ends(first: u32, end: u32, steady: u32) -> Vec<u32> {
+    let mut ends = Vec::new();
+    let (mut at, mut step) = (first, 1u32);
+    while at < end {
+        at = at.saturating_add(step).min(end);
+        ends.push(at);
+        // Each pass doubles the samples so far, up to the steady size.
+        step = (at - first).clamp(1, steady.max(1));
+    }
+    ends
+}
+
+/// Samples per pixel of a steady pass: 64, or more for small images, so that a pass holds at
+/// least about a million samples (passes stay cheap to schedule) and at most 4096 per pixel.
+fn steady_pass(pixels: u64) -> u32 {
+    (((1u64 << 20) / pixels.max(1)) as u32).clamp(64, 4096)
+}
+
+/// [`render`] continuing `film` (a checkpoint's, or an empty one): every pixel goes on from
+/// the samples it holds to the end of the settings' sample range, in whole-frame passes
+/// ([`pass_ends`]); after each finished pass `after_pass(film, stats so far)` is called (to
+/// write checkpoints). Adaptive sampling runs its own per-pixel batches instead.
+pub fn render_from(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    settings: &RenderSettings,
+    mut film: Film,
+    progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
+    after_pass: &mut dyn FnMut(&Film, &RenderStats),
 ) -> (Film, RenderStats) {
     let [width, height] = scene.camera().resolution();
     let [cx0, cy0, cx1, cy1] = settings
@@ -252,23 +305,41 @@ pub fn render(
         .flat_map(|y| (cx0..cx1).step_by(TILE_SIZE as usize).map(move |x| (x, y)))
         .collect();
     let start = Instant::now();
-    let results: Vec<TileResult> = tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let w = TILE_SIZE.min(cx1 - x0);
-            let h = TILE_SIZE.min(cy1 - y0);
-            let mut sampler = settings.sampler.build(settings.spp, settings.seed);
-            let mut out = TileResult {
-                x0,
-                y0,
-                w,
-                pixels: vec![PixelStats::default(); (w * h) as usize],
-                path: PathStats::default(),
-                samples: 0,
-                nonfinite: 0,
-                pilot: 0,
-            };
-            if let Some(adaptive) = settings.adaptive {
+    let mut stats = RenderStats::default();
+    let merge = |film: &mut Film, stats: &mut RenderStats, results: Vec<TileResult>| {
+        for t in &results {
+            for (i, p) in t.pixels.iter().enumerate() {
+                let (x, y) = (t.x0 + i as u32 % t.w, t.y0 + i as u32 / t.w);
+                film.pixel_mut(x, y).merge(p);
+            }
+            stats.samples += t.samples;
+            stats.nonfinite_samples += t.nonfinite;
+            stats.pilot_samples += t.pilot;
+            stats.rays += t.path.rays;
+            stats.nodes_visited += t.path.nodes_visited;
+        }
+    };
+    let new_tile = |x0: u32, y0: u32| {
+        let w = TILE_SIZE.min(cx1 - x0);
+        let h = TILE_SIZE.min(cy1 - y0);
+        let out = TileResult {
+            x0,
+            y0,
+            w,
+            pixels: vec![PixelStats::default(); (w * h) as usize],
+            path: PathStats::default(),
+            samples: 0,
+            nonfinite: 0,
+            pilot: 0,
+        };
+        (w, h, out)
+    };
+    if let Some(adaptive) = settings.adaptive {
+        let results: Vec<TileResult> = tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                let (w, h, mut out) = new_tile(x0, y0);
+                let mut sampler = settings.sampler.build(settings.spp, settings.seed);
                 let batch = adaptive.batch.max(1);
                 let mut pilot_sampler = (adaptive.rule == AdaptiveRule::TwoStage).then(|| {
                     let seed = settings.seed ^ Adaptive::PILOT_STREAM;
@@ -304,7 +375,7 @@ pub fn render(
                                 run(pilot_sampler, 0..batch, &mut pilot, &mut out.path);
                             out.pilot += n_pilot;
                             let n = adaptive.planned_samples(
-                                pilot.luminance(),
+                                &pilot.luminance(),
                                 deterministic,
                                 settings.spp,
                             );
@@ -314,7 +385,7 @@ pub fn render(
                         let mut i = 0;
                         let mut deterministic = true;
                         while i < settings.spp {
-                            if i > 0 && adaptive.converged(px.luminance(), deterministic) {
+                            if i > 0 && adaptive.converged(&px.luminance(), deterministic) {
                                 break;
                             }
                             let end = (i + batch).min(settings.spp);
@@ -325,47 +396,58 @@ pub fn render(
                         }
                     }
                 }
-            } else {
-                // The whole tile in one go, pixel after pixel, so that an integrator following
-                // several paths at once keeps them all busy to the tile's end. A cancelled
-                // render starts no further pixel.
-                let spp = settings.spp;
-                let mut samples = (0..w * h)
-                    .take_while(|_| !cancel.load(Ordering::Relaxed))
-                    .flat_map(|tag| {
-                        let pixel = [x0 + tag % w, y0 + tag / w];
-                        (0..spp).map(move |index| SampleRef { pixel, index, tag })
-                    });
-                let (mut ok, mut bad) = (0, 0);
-                let pixels = &mut out.pixels;
-                integrator.li_samples(
-                    scene,
-                    &mut sampler,
-                    &mut samples,
-                    &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
-                    &mut out.path,
-                );
-                out.samples += ok;
-                out.nonfinite += bad;
+                progress(w as u64 * h as u64 * settings.spp as u64);
+                out
+            })
+            .collect();
+        merge(&mut film, &mut stats, results);
+    } else {
+        let [first, end] = settings.sample_range.unwrap_or([0, settings.spp]);
+        let pixels = (cx1 - cx0) as u64 * (cy1 - cy0) as u64;
+        for pass_end in pass_ends(first, end, steady_pass(pixels)) {
+            if cancel.load(Ordering::Relaxed) {
+                break;
             }
-            // Progress counts the budget of every pixel done, also where adaptive sampling
-            // stopped early, so that the bar ends at 100%.
-            progress(w as u64 * h as u64 * settings.spp as u64);
-            out
-        })
-        .collect();
-    let mut film = Film::new(width, height);
-    let mut stats = RenderStats::default();
-    for t in &results {
-        for (i, p) in t.pixels.iter().enumerate() {
-            let (x, y) = (t.x0 + i as u32 % t.w, t.y0 + i as u32 / t.w);
-            film.pixel_mut(x, y).merge(p);
+            let film_now = &film;
+            let results: Vec<TileResult> = tiles
+                .par_iter()
+                .map(|&(x0, y0)| {
+                    let (w, h, mut out) = new_tile(x0, y0);
+                    let mut sampler = settings.sampler.build(settings.spp, settings.seed);
+                    // The tile's pixels one after another, each from the samples it holds to
+                    // the pass's end, so that an integrator following several paths at once
+                    // keeps them all busy to the tile's end. Cancelling stops at the next
+                    // sample.
+                    let mut samples = (0..w * h).flat_map(|tag| {
+                        let pixel = [x0 + tag % w, y0 + tag / w];
+                        let held = film_now.pixel(pixel[0], pixel[1]).count();
+                        let from = (first as u64 + held).min(pass_end as u64) as u32;
+                        (from..pass_end)
+                            .take_while(|_| !cancel.load(Ordering::Relaxed))
+                            .map(move |index| SampleRef { pixel, index, tag })
+                    });
+                    let (mut ok, mut bad) = (0, 0);
+                    let pixels = &mut out.pixels;
+                    integrator.li_samples(
+                        scene,
+                        &mut sampler,
+                        &mut samples,
+                        &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
+                        &mut out.path,
+                    );
+                    out.samples += ok;
+                    out.nonfinite += bad;
+                    progress(ok + bad);
+                    let _ = h;
+                    out
+                })
+                .collect();
+            merge(&mut film, &mut stats, results);
+            stats.seconds = start.elapsed().as_secs_f64();
+            if !cancel.load(Ordering::Relaxed) {
+                after_pass(&film, &stats);
+            }
         }
-        stats.samples += t.samples;
-        stats.nonfinite_samples += t.nonfinite;
-        stats.pilot_samples += t.pilot;
-        stats.rays += t.path.rays;
-        stats.nodes_visited += t.path.nodes_visited;
     }
     stats.seconds = start.elapsed().as_secs_f64();
     stats.cancelled = cancel.load(Ordering::Relaxed);
@@ -375,10 +457,10 @@ pub fn render(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pathlab_mc::estimator::RunningStats;
+    use pathlab_mc::exact::ExactStats;
 
-    fn stats(values: &[f64]) -> RunningStats {
-        let mut s = RunningStats::new();
+    fn stats(values: &[f64]) -> ExactStats {
+        let mut s = ExactStats::new();
         values.iter().for_each(|&v| s.push(v));
         s
     }

@@ -720,3 +720,68 @@ fn packets_match_one_path_at_a_time(scene: &Scene, bvh: bool) {
     let estimates = SamplerKind::ALL.len() * 4 * samples.len();
     assert!(lit * 10 > estimates, "{lit} of {estimates} found light");
 }
+
+#[test]
+fn passes_resumes_and_sample_ranges_give_the_same_film_to_the_bit() {
+    use pathlab_render::render::{pass_ends, render_from};
+    // The schedule: 1, 1, 2, 4, ... samples per pixel, then steady passes.
+    assert_eq!(pass_ends(0, 20, 4), vec![1, 2, 4, 8, 12, 16, 20]);
+    assert_eq!(pass_ends(8, 11, 64), vec![9, 10, 11]);
+    let desc = big_light();
+    let scene = Scene::build(&desc).unwrap();
+    for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
+        let settings = RenderSettings::new(37, 5, sampler);
+        let integrator = path(u32::MAX);
+        let whole = render(&scene, &integrator, &settings, &|_| {}, &Default::default()).0;
+        // Stopped after some passes (by the pass callback), then resumed from that film.
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let mut passes = 0;
+        let (part, stats) = render_from(
+            &scene,
+            &integrator,
+            &settings,
+            Film::new(24, 24),
+            &|_| {},
+            &stop,
+            &mut |_, _| {
+                passes += 1;
+                if passes == 3 {
+                    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+            },
+        );
+        assert!(stats.cancelled);
+        assert!(
+            part.pixels().iter().all(|p| p.count() == 4),
+            "three passes: 1 + 1 + 2"
+        );
+        let resumed = render_from(
+            &scene,
+            &integrator,
+            &settings,
+            part,
+            &|_| {},
+            &Default::default(),
+            &mut |_, _| {},
+        )
+        .0;
+        assert!(resumed == whole, "{sampler:?}: resumed film differs");
+        // Shards: disjoint sample ranges added together.
+        let mut merged = Film::new(24, 24);
+        for range in [[0, 10], [10, 11], [11, 37]] {
+            let s = RenderSettings {
+                sample_range: Some(range),
+                ..settings
+            };
+            let f = render(&scene, &integrator, &s, &|_| {}, &Default::default()).0;
+            assert!(f
+                .pixels()
+                .iter()
+                .all(|p| p.count() == (range[1] - range[0]) as u64));
+            for (a, b) in merged.pixels_mut().iter_mut().zip(f.pixels()) {
+                a.merge(b);
+            }
+        }
+        assert!(merged == whole, "{sampler:?}: merged shards differ");
+    }
+}

@@ -514,3 +514,53 @@ proptest! {
         exercise_file("case-n.pbrt", text.as_bytes());
     }
 }
+
+/// A small film file (the format of checkpoints and shards) to corrupt.
+fn film_file_bytes() -> Vec<u8> {
+    let mut film = pathlab_render::film::Film::new(5, 3);
+    for (i, p) in film.pixels_mut().iter_mut().enumerate() {
+        for k in 0..3 {
+            p.add(glam::Vec3::new(0.1 * (i + k) as f32, 0.5, 2.0));
+        }
+    }
+    let header = pathlab_render::film_file::FilmHeader {
+        resolution: [5, 3],
+        key: "0123456789abcdef".into(),
+        description: "a test film".into(),
+        seed: 1,
+        spp: 8,
+        range: [0, 8],
+        writer: "corruption suite".into(),
+    };
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("film.plf");
+    pathlab_render::film_file::write(&path, &header, &film).unwrap();
+    std::fs::read(path).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, failure_persistence: None, rng_seed: RngSeed::Fixed(0x5eed_0007), ..ProptestConfig::default() })]
+
+    /// Checkpoint and shard files truncated, bit-flipped, or with their sizes mangled: an
+    /// error (never a panic, never a huge allocation) unless the file is intact.
+    #[test]
+    fn film_files_truncated_flipped_or_resized(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..4), size in prop::option::of((0usize..3, any::<u64>()))) {
+        let original = film_file_bytes();
+        let mut bytes = corrupt(original.clone(), cut, &flips);
+        if let Some((which, v)) = size {
+            // The header length, the pixel count, or a pixel's sample count.
+            let at = [8usize, 12 + u32::from_le_bytes(original[8..12].try_into().unwrap()) as usize, original.len() / 2][which];
+            if at + 8 <= bytes.len() {
+                bytes[at..at + 8].copy_from_slice(&v.to_le_bytes());
+            }
+        }
+        let result = pathlab_render::film_file::parse(&bytes);
+        assert_memory_bound();
+        if bytes != original {
+            prop_assert!(result.is_err());
+        } else {
+            prop_assert!(result.is_ok());
+        }
+    }
+}

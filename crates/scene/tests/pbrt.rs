@@ -333,3 +333,51 @@ fn bitterli_scenes_load_with_only_documented_warnings() {
         assert!(Path::new(&path).exists());
     }
 }
+
+#[test]
+fn image_infinite_lights_map_equal_area_squares_and_normalise_illuminance() {
+    // A square map bright over its inner diamond (|u| + |v| <= 1 about the centre), which
+    // pbrt-v4's equal-area mapping sends to the upper hemisphere of the light's frame (z > 0),
+    // and black outside. Rotated so that the light's z is the world's y, it lights a white
+    // floor from above; "illuminance" π makes the floor's radiance ρ E / π = 1.
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-envmap");
+    std::fs::create_dir_all(&dir).unwrap();
+    let n = 64;
+    let texels: Vec<glam::Vec3> = (0..n * n)
+        .map(|k| {
+            let (i, j) = (k % n, k / n);
+            let u = 2.0 * (i as f32 + 0.5) / n as f32 - 1.0;
+            let v = 2.0 * (j as f32 + 0.5) / n as f32 - 1.0;
+            glam::Vec3::splat(if u.abs() + v.abs() <= 1.0 { 1.0 } else { 0.0 })
+        })
+        .collect();
+    pathlab_render::image_io::write_exr(&dir.join("sky.exr"), n as u32, n as u32, &texels, &[])
+        .unwrap();
+    let scene = |rotate: &str| {
+        format!(
+            r#"LookAt 0 3 0.001  0 0 0  0 1 0
+Camera "perspective" "float fov" 10
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+AttributeBegin
+  {rotate}
+  LightSource "infinite" "string filename" "sky.exr" "float illuminance" [ 3.14159265 ]
+AttributeEnd
+Material "diffuse" "rgb reflectance" [ 1 1 1 ]
+Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indices" [ 0 2 1 0 3 2 ]
+"#
+        )
+    };
+    std::fs::write(dir.join("up.pbrt"), scene("Rotate -90 1 0 0")).unwrap();
+    let desc = pathlab_scene::load(dir.join("up.pbrt").to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let l = render_film(&desc, 256, 3).image_mean();
+    assert!((l.x - 1.0).abs() < 0.02, "floor radiance {l}");
+    // Unrotated, the bright hemisphere is the light's z, which lies along the floor: it lights
+    // the floor from one side only, with half the cosine-weighted irradiance (by symmetry).
+    std::fs::write(dir.join("side.pbrt"), scene("")).unwrap();
+    let desc = pathlab_scene::load(dir.join("side.pbrt").to_str().unwrap()).unwrap();
+    let l = render_film(&desc, 256, 3).image_mean();
+    assert!((l.x - 0.5).abs() < 0.02, "floor radiance {l}");
+}

@@ -1,0 +1,268 @@
+//! A film's exact state in a file: the checkpoints of a render, and the parts of a render
+//! split over machines (shards).
+//!
+//! Layout (little-endian): the magic `PLFILM01`; a u32 length and that many bytes of header,
+//! `key=value` lines ([`FilmHeader`]); a u64 pixel count (width × height); each pixel's
+//! [`PixelStats::to_bytes`]; a u64 FNV-1a hash of everything before it. Files are written to
+//! a temporary name and renamed, so a file is either whole or absent; reading checks the
+//! sizes against the file's length before allocating, and the hash.
+
+use crate::film::{Film, PixelStats, PIXEL_BYTES};
+use std::io::Write;
+use std::path::Path;
+
+/// The file's first bytes.
+pub const MAGIC: &[u8; 8] = b"PLFILM01";
+
+/// Longest header read.
+const MAX_HEADER: usize = 1 << 20;
+
+/// What a film file says about the render it belongs to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FilmHeader {
+    /// Width and height in pixels.
+    pub resolution: [u32; 2],
+    /// Identifies the scene and every setting that changes the image (a hash, compared
+    /// as it is).
+    pub key: String,
+    /// The same in words, for messages.
+    pub description: String,
+    /// The render's seed.
+    pub seed: u64,
+    /// Samples per pixel of the whole render.
+    pub spp: u32,
+    /// The sample indices `[start, end)` this film covers when whole.
+    pub range: [u32; 2],
+    /// The program that wrote it.
+    pub writer: String,
+}
+
+/// Why a film file cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum FilmFileError {
+    /// The file could not be read or written.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// The file is not a whole film file.
+    #[error("{path}: not a pathlab film file: {message}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// 64-bit FNV-1a.
+pub fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+impl FilmHeader {
+    fn to_text(&self) -> String {
+        let one_line = |s: &str| s.replace(['\n', '\r'], " ");
+        format!(
+            "resolution={} {}\nkey={}\ndescription={}\nseed={}\nspp={}\nrange={} {}\nwriter={}\n",
+            self.resolution[0],
+            self.resolution[1],
+            one_line(&self.key),
+            one_line(&self.description),
+            self.seed,
+            self.spp,
+            self.range[0],
+            self.range[1],
+            one_line(&self.writer)
+        )
+    }
+
+    fn from_text(text: &str) -> Result<FilmHeader, String> {
+        let get = |k: &str| -> Result<&str, String> {
+            text.lines()
+                .find_map(|l| l.strip_prefix(k).and_then(|r| r.strip_prefix('=')))
+                .ok_or_else(|| format!("the header has no '{k}'"))
+        };
+        let pair = |k: &str| -> Result<[u32; 2], String> {
+            let v = get(k)?;
+            let mut it = v.split_whitespace().map(str::parse::<u32>);
+            match (it.next(), it.next(), it.next()) {
+                (Some(Ok(a)), Some(Ok(b)), None) => Ok([a, b]),
+                _ => Err(format!("'{k}={v}' is not two numbers")),
+            }
+        };
+        let number = |k: &str| -> Result<u64, String> {
+            let v = get(k)?;
+            v.parse().map_err(|_| format!("'{k}={v}' is not a number"))
+        };
+        Ok(FilmHeader {
+            resolution: pair("resolution")?,
+            key: get("key")?.to_string(),
+            description: get("description")?.to_string(),
+            seed: number("seed")?,
+            spp: u32::try_from(number("spp")?).map_err(|_| "spp out of range".to_string())?,
+            range: pair("range")?,
+            writer: get("writer")?.to_string(),
+        })
+    }
+}
+
+/// Writes `film` with `header` to `path` atomically (a temporary file renamed into place).
+pub fn write(path: &Path, header: &FilmHeader, film: &Film) -> Result<(), FilmFileError> {
+    let io = |e: std::io::Error| FilmFileError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let text = header.to_text();
+    let mut bytes = Vec::with_capacity(32 + text.len() + film.pixels().len() * PIXEL_BYTES);
+    bytes.extend(MAGIC);
+    bytes.extend((text.len() as u32).to_le_bytes());
+    bytes.extend(text.as_bytes());
+    bytes.extend((film.pixels().len() as u64).to_le_bytes());
+    for p in film.pixels() {
+        p.to_bytes(&mut bytes);
+    }
+    let hash = fnv1a(&bytes);
+    bytes.extend(hash.to_le_bytes());
+    let mut tmp_name = path.as_os_str().to_owned();
+    tmp_name.push(".tmp");
+    let tmp = std::path::PathBuf::from(tmp_name);
+    {
+        let mut f = std::fs::File::create(&tmp).map_err(io)?;
+        f.write_all(&bytes).map_err(io)?;
+        f.sync_all().map_err(io)?;
+    }
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+/// Reads a film file.
+pub fn read(path: &Path) -> Result<(FilmHeader, Film), FilmFileError> {
+    let bytes = std::fs::read(path).map_err(|e| FilmFileError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    parse(&bytes).map_err(|message| FilmFileError::Invalid {
+        path: path.display().to_string(),
+        message,
+    })
+}
+
+/// [`read`] from bytes.
+pub fn parse(bytes: &[u8]) -> Result<(FilmHeader, Film), String> {
+    if bytes.len() < 8 || &bytes[..8] != MAGIC {
+        return Err("wrong magic (expected PLFILM01)".into());
+    }
+    let u32_at = |at: usize| -> Result<u32, String> {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| "truncated".to_string())
+    };
+    let u64_at = |at: usize| -> Result<u64, String> {
+        let b = bytes
+            .get(at..at + 8)
+            .ok_or_else(|| "truncated".to_string())?;
+        Ok(u64::from_le_bytes(b.try_into().map_err(|_| "truncated")?))
+    };
+    let header_len = u32_at(8)? as usize;
+    if header_len > MAX_HEADER {
+        return Err(format!("a header of {header_len} bytes"));
+    }
+    let header_bytes = bytes
+        .get(12..12 + header_len)
+        .ok_or_else(|| "truncated in its header".to_string())?;
+    let text = std::str::from_utf8(header_bytes).map_err(|_| "a header that is not text")?;
+    let header = FilmHeader::from_text(text)?;
+    let at = 12 + header_len;
+    let count = u64_at(at)?;
+    let [w, h] = header.resolution;
+    if count != w as u64 * h as u64 || w == 0 || h == 0 {
+        return Err(format!("{count} pixels for a {w} x {h} image"));
+    }
+    let body = at + 8;
+    let expected = (count as usize)
+        .checked_mul(PIXEL_BYTES)
+        .and_then(|n| n.checked_add(body + 8))
+        .ok_or("sizes out of range")?;
+    if bytes.len() != expected {
+        return Err(format!(
+            "{} bytes where its sizes say {expected} (truncated or padded)",
+            bytes.len()
+        ));
+    }
+    let stored = u64_at(expected - 8)?;
+    if fnv1a(&bytes[..expected - 8]) != stored {
+        return Err("its contents do not match its checksum (corrupt)".into());
+    }
+    if header.range[0] > header.range[1] || header.range[1] > header.spp {
+        return Err(format!(
+            "sample range {}..{} outside 0..{}",
+            header.range[0], header.range[1], header.spp
+        ));
+    }
+    let mut film = Film::new(w, h);
+    for (p, chunk) in film
+        .pixels_mut()
+        .iter_mut()
+        .zip(bytes[body..expected - 8].chunks_exact(PIXEL_BYTES))
+    {
+        *p = PixelStats::from_bytes(chunk).ok_or("a pixel record of the wrong size")?;
+    }
+    Ok((header, film))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header() -> FilmHeader {
+        FilmHeader {
+            resolution: [3, 2],
+            key: "abc".into(),
+            description: "a test".into(),
+            seed: 7,
+            spp: 16,
+            range: [0, 16],
+            writer: "test".into(),
+        }
+    }
+
+    #[test]
+    fn films_round_trip_exactly_and_corruption_is_an_error() {
+        let mut film = Film::new(3, 2);
+        for (i, p) in film.pixels_mut().iter_mut().enumerate() {
+            for k in 0..=i {
+                p.add(glam::Vec3::new(0.1 * k as f32, 1e-7, 3e5));
+            }
+        }
+        let dir = std::env::temp_dir().join(format!("pathlab-film-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("f.plf");
+        write(&path, &header(), &film).unwrap();
+        let (h, back) = read(&path).unwrap();
+        assert_eq!(h, header());
+        assert_eq!(back, film);
+        let bytes = std::fs::read(&path).unwrap();
+        for cut in [0, 5, 12, 40, bytes.len() - 1] {
+            assert!(parse(&bytes[..cut]).is_err(), "cut {cut}");
+        }
+        for flip in [0, 9, 20, bytes.len() / 2, bytes.len() - 3] {
+            let mut b = bytes.clone();
+            b[flip] ^= 0x10;
+            assert!(parse(&b).is_err(), "flip {flip}");
+        }
+        // A huge declared header or pixel count is refused before any allocation.
+        let mut b = bytes.clone();
+        b[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(parse(&b).unwrap_err().contains("header of"));
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
