@@ -247,19 +247,22 @@ fn point_text(x: &[f64]) -> String {
 }
 
 impl Problem {
+    /// The integrand at a point.
+    fn integrand(&self, x: &[f64; MAX_DIMS]) -> f64 {
+        self.f.eval(&x[..self.domains.len()])
+    }
+
+    /// A point drawn from the proposal, and its density.
+    fn draw_point(&self, s: &mut pathlab_mc::sampler::AnySampler) -> ([f64; MAX_DIMS], f64) {
+        let mut x = [0.0; MAX_DIMS];
+        let pdf = self.proposal.draw(s, &mut x);
+        (x, pdf)
+    }
+
     /// The estimate from `n` samples of `kind` with `seed`.
     fn estimate(&self, kind: SamplerKind, n: u32, seed: u64) -> Estimate {
         let sampler = kind.build(n, seed);
-        integrate_parallel(
-            |x: &[f64; MAX_DIMS]| self.f.eval(&x[..self.domains.len()]),
-            &sampler,
-            |s| {
-                let mut x = [0.0; MAX_DIMS];
-                let pdf = self.proposal.draw(s, &mut x);
-                (x, pdf)
-            },
-            n,
-        )
+        integrate_parallel(|x| self.integrand(x), &sampler, |s| self.draw_point(s), n)
     }
 
     /// The estimate and a valid standard error for any sampler: independent samples use their
@@ -290,13 +293,9 @@ impl Problem {
     fn largest_share(&self, kind: SamplerKind, n: u32, seed: u64, mean: f64) -> f64 {
         let sampler = kind.build(n, seed);
         largest_term_share(
-            |x: &[f64; MAX_DIMS]| self.f.eval(&x[..self.domains.len()]),
+            |x| self.integrand(x),
             &sampler,
-            |s| {
-                let mut x = [0.0; MAX_DIMS];
-                let pdf = self.proposal.draw(s, &mut x);
-                (x, pdf)
-            },
+            |s| self.draw_point(s),
             n,
             mean,
         )

@@ -926,27 +926,41 @@ pub fn write_film_image(
         OutputFormat::Png => {
             write_png_with(path, w, h, &film.mean_image(), exposure, ToneMap::Srgb)?
         }
-        OutputFormat::Exr => {
-            let variance = film.variance_image();
-            let channels: Vec<Vec<f32>> = (0..3)
-                .map(|c| variance.iter().map(|v| v[c]).collect())
-                .collect();
-            let samples = film.sample_counts();
-            let mut extra: Vec<ExtraChannel> = channels
-                .iter()
-                .zip(["variance.R", "variance.G", "variance.B"])
-                .map(|(values, name)| ExtraChannel {
-                    name: name.to_string(),
-                    values,
-                })
-                .collect();
-            extra.push(ExtraChannel {
-                name: "samples.Y".to_string(),
-                values: &samples,
-            });
-            write_exr(path, w, h, &film.mean_image(), &extra)?;
-        }
+        OutputFormat::Exr => write_exr_layers(film, path, true, true)?,
     }
+    Ok(())
+}
+
+/// The film's mean as a linear EXR, with `variance.R/G/B` (of each pixel's mean) and
+/// `samples.Y` layers where asked.
+fn write_exr_layers(film: &Film, path: &Path, variance: bool, samples: bool) -> Result<()> {
+    let variance = variance.then(|| film.variance_image());
+    let channels: Vec<Vec<f32>> = variance
+        .iter()
+        .flat_map(|v| (0..3).map(move |c| v.iter().map(|p| p[c]).collect::<Vec<f32>>()))
+        .collect();
+    let counts = samples.then(|| film.sample_counts());
+    let mut extra: Vec<ExtraChannel> = channels
+        .iter()
+        .zip(["variance.R", "variance.G", "variance.B"])
+        .map(|(values, name)| ExtraChannel {
+            name: name.to_string(),
+            values,
+        })
+        .collect();
+    if let Some(s) = &counts {
+        extra.push(ExtraChannel {
+            name: "samples.Y".to_string(),
+            values: s,
+        });
+    }
+    write_exr(
+        path,
+        film.width(),
+        film.height(),
+        &film.mean_image(),
+        &extra,
+    )?;
     Ok(())
 }
 
@@ -997,27 +1011,7 @@ fn write_outputs(
     match format {
         // Written by the caller, which has the render's header.
         OutputFormat::Film => {}
-        OutputFormat::Exr => {
-            let var_channels: Vec<Vec<f32>> = variance
-                .iter()
-                .flat_map(|v| (0..3).map(move |c| v.iter().map(|p| p[c]).collect::<Vec<f32>>()))
-                .collect();
-            let mut extra: Vec<ExtraChannel> = var_channels
-                .iter()
-                .zip(["variance.R", "variance.G", "variance.B"])
-                .map(|(values, name)| ExtraChannel {
-                    name: name.to_string(),
-                    values,
-                })
-                .collect();
-            if let Some(s) = &samples {
-                extra.push(ExtraChannel {
-                    name: "samples.Y".to_string(),
-                    values: s,
-                });
-            }
-            write_exr(output, w, h, &mean, &extra)?;
-        }
+        OutputFormat::Exr => write_exr_layers(film, output, variance.is_some(), samples.is_some())?,
         OutputFormat::Png => {
             let tone = match args.tonemap {
                 ToneMapName::Srgb => ToneMap::Srgb,

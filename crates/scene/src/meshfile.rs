@@ -249,8 +249,16 @@ pub fn load_ply(path: &Path) -> Result<SceneDesc, Error> {
     standalone(path, desc)
 }
 
+/// The names PLY files give texture coordinates, in order of preference.
+pub(crate) const PLY_UV_NAMES: [(&str, &str); 4] = [
+    ("u", "v"),
+    ("s", "t"),
+    ("texture_u", "texture_v"),
+    ("texture_s", "texture_t"),
+];
+
 /// Vertex properties that are geometry, not attributes.
-const PLY_GEOMETRY: &[&str] = &[
+pub(crate) const PLY_GEOMETRY: &[&str] = &[
     "x",
     "y",
     "z",
@@ -436,14 +444,9 @@ pub fn ply_mesh_from(reader: &mut impl std::io::BufRead, path: &Path) -> Result<
         if let (Some(x), Some(y), Some(z)) = (scalar(v, "nx"), scalar(v, "ny"), scalar(v, "nz")) {
             normals.push(Vec3::new(x, y, z));
         }
-        let uv = [
-            ("u", "v"),
-            ("s", "t"),
-            ("texture_u", "texture_v"),
-            ("texture_s", "texture_t"),
-        ]
-        .iter()
-        .find_map(|(a, b)| Some(Vec2::new(scalar(v, a)?, scalar(v, b)?)));
+        let uv = PLY_UV_NAMES
+            .iter()
+            .find_map(|(a, b)| Some(Vec2::new(scalar(v, a)?, scalar(v, b)?)));
         if let Some(uv) = uv {
             uvs.push(uv);
         }

@@ -82,24 +82,6 @@ pub(crate) struct BinaryMesh {
     pub uvs: Vec<Vec2>,
 }
 
-/// Vertex properties this reader fills: position, normal and texture coordinates.
-const KNOWN: &[&str] = &[
-    "x",
-    "y",
-    "z",
-    "nx",
-    "ny",
-    "nz",
-    "u",
-    "v",
-    "s",
-    "t",
-    "texture_u",
-    "texture_v",
-    "texture_s",
-    "texture_t",
-];
-
 /// Reads `bytes` when they are a binary PLY of the simple kind: `None` when they are not
 /// (the general reader takes them), `Some(Err)` for a file of that kind that is broken.
 pub(crate) fn read(bytes: &[u8]) -> Option<Result<BinaryMesh, String>> {
@@ -161,7 +143,10 @@ pub(crate) fn read(bytes: &[u8]) -> Option<Result<BinaryMesh, String>> {
     for (name, _, props, list) in &elements {
         match name.as_str() {
             "vertex"
-                if list.is_none() && props.iter().all(|(n, _)| KNOWN.contains(&n.as_str())) => {}
+                if list.is_none()
+                    && props
+                        .iter()
+                        .all(|(n, _)| crate::meshfile::PLY_GEOMETRY.contains(&n.as_str())) => {}
             "face" if list.is_some() && props.is_empty() => {}
             _ => return None,
         }
@@ -201,14 +186,9 @@ fn decode(data: &[u8], little: bool, elements: &[Element]) -> Result<BinaryMesh,
                 return Err("the vertices lack x, y or z".into());
             };
             let normal = offset("nx").zip(offset("ny")).zip(offset("nz"));
-            let uv = [
-                ("u", "v"),
-                ("s", "t"),
-                ("texture_u", "texture_v"),
-                ("texture_s", "texture_t"),
-            ]
-            .iter()
-            .find_map(|(a, b)| offset(a).zip(offset(b)));
+            let uv = crate::meshfile::PLY_UV_NAMES
+                .iter()
+                .find_map(|(a, b)| offset(a).zip(offset(b)));
             mesh.positions.reserve_exact(n);
             if normal.is_some() {
                 mesh.normals.reserve_exact(n);

@@ -197,6 +197,36 @@ impl Builder {
         }
     }
 
+    /// The named texture a `"texture NAME"` parameter refers to (`None` when the parameter is
+    /// not a texture reference).
+    pub(crate) fn texture_param(
+        &self,
+        params: &ParamList,
+        name: &str,
+    ) -> Result<Option<TextureDesc>, Error> {
+        let Some(p) = params
+            .params
+            .iter()
+            .rev()
+            .find(|p| p.name == name && p.ty == "texture")
+        else {
+            return Ok(None);
+        };
+        p.used.set(true);
+        let tex = p
+            .strings()
+            .and_then(|s| s.first())
+            .cloned()
+            .unwrap_or_default();
+        match self.textures.get(&tex) {
+            Some(t) => Ok(Some(t.clone())),
+            None => Err(self.error(format!(
+                "\"texture {name}\" (line {}): no texture named \"{tex}\"",
+                p.line
+            ))),
+        }
+    }
+
     /// A colour that may be a texture: `"texture NAME"` or a spectrum.
     fn color_texture(
         &mut self,
@@ -204,25 +234,8 @@ impl Builder {
         name: &str,
         default: Rgb,
     ) -> Result<TextureDesc, Error> {
-        if let Some(p) = params
-            .params
-            .iter()
-            .rev()
-            .find(|p| p.name == name && p.ty == "texture")
-        {
-            p.used.set(true);
-            let tex = p
-                .strings()
-                .and_then(|s| s.first())
-                .cloned()
-                .unwrap_or_default();
-            return match self.textures.get(&tex) {
-                Some(t) => Ok(t.clone()),
-                None => Err(self.error(format!(
-                    "\"texture {name}\" (line {}): no texture named \"{tex}\"",
-                    p.line
-                ))),
-            };
+        if let Some(t) = self.texture_param(params, name)? {
+            return Ok(t);
         }
         Ok(TextureDesc::Constant(
             self.spectrum(params, name, Use::Albedo)?.unwrap_or(default),
@@ -232,24 +245,7 @@ impl Builder {
     /// A number that may be a texture; textures other than constants are used by their mean
     /// (with a warning).
     fn float_value(&mut self, params: &ParamList, name: &str, default: f64) -> Result<f64, Error> {
-        if let Some(p) = params
-            .params
-            .iter()
-            .rev()
-            .find(|p| p.name == name && p.ty == "texture")
-        {
-            p.used.set(true);
-            let tex = p
-                .strings()
-                .and_then(|s| s.first())
-                .cloned()
-                .unwrap_or_default();
-            let Some(t) = self.textures.get(&tex).cloned() else {
-                return Err(self.error(format!(
-                    "\"texture {name}\" (line {}): no texture named \"{tex}\"",
-                    p.line
-                )));
-            };
+        if let Some(t) = self.texture_param(params, name)? {
             if t.as_constant().is_none() {
                 self.warn(format!(
                     "\"texture {name}\": a textured {name} is not supported; its mean is used"

@@ -84,26 +84,12 @@ impl Builder {
             Some(m) => m,
             None => self.default_material(),
         };
-        let alpha = match params.params.iter().rev().find(|p| p.name == "alpha") {
-            None => return Ok(base),
-            Some(p) if p.ty == "texture" => {
-                p.used.set(true);
-                let name = p
-                    .strings()
-                    .and_then(|s| s.first())
-                    .cloned()
-                    .unwrap_or_default();
-                match self.textures.get(&name) {
-                    Some(t) => t.clone(),
-                    None => {
-                        return Err(self.error(format!(
-                            "\"texture alpha\" (line {}): no texture named \"{name}\"",
-                            p.line
-                        )))
-                    }
-                }
-            }
-            Some(_) => TextureDesc::value(self.float(params, "alpha", 1.0)?.clamp(0.0, 1.0) as f32),
+        if !params.has("alpha") {
+            return Ok(base);
+        }
+        let alpha = match self.texture_param(params, "alpha")? {
+            Some(t) => t,
+            None => TextureDesc::value(self.float(params, "alpha", 1.0)?.clamp(0.0, 1.0) as f32),
         };
         if alpha.as_constant() == Some(Rgb::ONE) {
             return Ok(base);

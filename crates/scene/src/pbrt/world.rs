@@ -554,7 +554,9 @@ mod tests {
         // points on its edges.
         let eighth = (n * n / 8) as f64;
         assert!(
-            octants.iter().all(|&o| (o as f64 - eighth).abs() < 2.0 * n as f64),
+            octants
+                .iter()
+                .all(|&o| (o as f64 - eighth).abs() < 2.0 * n as f64),
             "{octants:?}"
         );
     }
