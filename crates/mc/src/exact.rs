@@ -22,12 +22,18 @@ pub struct ExactStats {
     sum_sq: i128,
 }
 
-/// `x` in fixed point, rounded to nearest (saturating; NaN as 0).
+/// `x` in fixed point, rounded to nearest, halves away from zero (saturating; NaN as 0).
 #[inline]
 pub fn to_fixed(x: f64) -> i128 {
-    // Scaling by a power of two is exact; the float-to-int conversion rounds once and
-    // saturates at the i128 range.
-    (x * ONE).round() as i128
+    // Scaling by a power of two is exact. Below 2^52 adding ±½ and truncating rounds (one
+    // hardware conversion to i64, where i128 conversion and `round` are library calls);
+    // from 2^52 on the scaled value is already an integer.
+    let v = x * ONE;
+    if v.abs() < (1u64 << 52) as f64 {
+        (v + 0.5f64.copysign(v)) as i64 as i128
+    } else {
+        v as i128
+    }
 }
 
 /// A fixed-point value as `f64` (rounded to nearest).
@@ -141,6 +147,28 @@ mod tests {
         xs.iter().for_each(|&x| w.push(x));
         assert!((forward.mean() - w.mean()).abs() < 1e-12 * w.mean());
         assert!((forward.variance() - w.variance()).abs() < 1e-9 * w.variance());
+    }
+
+    #[test]
+    fn fixed_point_rounds_to_nearest() {
+        let unit = 1.0 / ONE;
+        for (x, want) in [
+            (0.0, 0i128),
+            (unit * 2.5, 3),
+            (-unit * 2.5, -3),
+            (unit * 2.4, 2),
+            (1.0, 1i128 << 48),
+            (-3.25, -(13i128 << 46)),
+            (1e10, (1e10 * ONE) as i128),
+            (f64::NAN, 0),
+        ] {
+            assert_eq!(to_fixed(x), want, "{x}");
+        }
+        assert_eq!(to_fixed(f64::INFINITY), i128::MAX);
+        // Every f32 from 2^-24 up is exact.
+        for x in [2f32.powi(-24), 0.3, 1234.5678, 3e7] {
+            assert_eq!(from_fixed(to_fixed(x as f64)), x as f64);
+        }
     }
 
     #[test]
