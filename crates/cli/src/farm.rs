@@ -24,13 +24,13 @@ impl std::fmt::Write for Hasher {
     }
 }
 
-/// A key for the scene and every setting that changes the image (`settings`, in words):
-/// checkpoints and shards are accepted only by a render with the same key.
+/// A key for the scene, every setting that changes the image (`settings`) and the program's
+/// version: checkpoints and shards are accepted only by a render with the same key.
 pub fn render_key(desc: &SceneDesc, settings: &str) -> String {
     let mut h = Hasher(0xcbf2_9ce4_8422_2325);
     // The scene as the renderer gets it (after every command-line change), then the
-    // settings.
-    let _ = write!(h, "{desc:?}|{settings}");
+    // settings, and the program's version (another version may sample differently).
+    let _ = write!(h, "{desc:?}|{settings}|{}", env!("CARGO_PKG_VERSION"));
     format!("{:016x}", h.0)
 }
 

@@ -281,6 +281,148 @@ fn steady_pass(pixels: u64) -> u32 {
     (((1u64 << 20) / pixels.max(1)) as u32).clamp(64, 4096)
 }
 
+/// Adaptive sampling in whole-frame rounds: with the two-stage rule a first pass draws every
+/// pixel's pilot and plans its count; then each round gives every pixel below its count one
+/// batch, and with the stopping rules a pixel whose samples say it has converged stops. Each
+/// pixel gets the same sample indices, in the same batches, as rendering it alone would give.
+#[allow(clippy::too_many_arguments)]
+fn render_adaptive(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    settings: &RenderSettings,
+    adaptive: Adaptive,
+    tiles: &[(u32, u32)],
+    new_tile: &(dyn Fn(u32, u32) -> (u32, u32, TileResult) + Sync),
+    film: &mut Film,
+    stats: &mut RenderStats,
+    merge: &dyn Fn(&mut Film, &mut RenderStats, Vec<TileResult>),
+    progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
+) {
+    let batch = adaptive.batch.max(1);
+    let width = film.width();
+    let index = |x: u32, y: u32| (y * width + x) as usize;
+    // Per pixel: the count it is to reach, and whether none of its samples so far met a
+    // scattering surface (see `Adaptive::converged`).
+    let mut target = vec![settings.spp; film.pixels().len()];
+    let mut fixed = vec![true; film.pixels().len()];
+    let two_stage = adaptive.rule == AdaptiveRule::TwoStage;
+    if two_stage {
+        let plans: Vec<(TileResult, Vec<u32>)> = tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                let (w, h, mut out) = new_tile(x0, y0);
+                let seed = settings.seed ^ Adaptive::PILOT_STREAM;
+                let mut pilot_sampler = settings.sampler.build(batch, seed);
+                let mut plan = vec![0u32; (w * h) as usize];
+                for k in 0..w * h {
+                    if cancel.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let pixel = [x0 + k % w, y0 + k / w];
+                    let mut pilot = PixelStats::default();
+                    let before = out.path.random_vertices;
+                    let (ok, bad) = sample_pixel(
+                        scene,
+                        integrator,
+                        &mut pilot_sampler,
+                        pixel,
+                        0..batch,
+                        &mut pilot,
+                        &mut out.path,
+                    );
+                    out.pilot += ok + bad;
+                    let deterministic = out.path.random_vertices == before;
+                    plan[k as usize] =
+                        adaptive.planned_samples(&pilot.luminance(), deterministic, settings.spp);
+                }
+                progress(out.pilot);
+                (out, plan)
+            })
+            .collect();
+        let mut results = Vec::with_capacity(plans.len());
+        for (t, plan) in plans {
+            for (k, &n) in plan.iter().enumerate() {
+                let (x, y) = (t.x0 + k as u32 % t.w, t.y0 + k as u32 / t.w);
+                target[index(x, y)] = n;
+            }
+            results.push(t);
+        }
+        merge(film, stats, results);
+    }
+    while !cancel.load(Ordering::Relaxed) {
+        let (film_now, target_now) = (&*film, &target);
+        let rounds: Vec<(TileResult, Vec<bool>)> = tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                let (w, h, mut out) = new_tile(x0, y0);
+                let mut sampler = settings.sampler.build(settings.spp, settings.seed);
+                let mut tile_fixed = vec![true; (w * h) as usize];
+                for k in 0..w * h {
+                    if cancel.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let (x, y) = (x0 + k % w, y0 + k / w);
+                    let held = film_now.pixel(x, y).count() as u32;
+                    let end = held.saturating_add(batch).min(target_now[index(x, y)]);
+                    if held >= end {
+                        continue;
+                    }
+                    let before = out.path.random_vertices;
+                    let (ok, bad) = sample_pixel(
+                        scene,
+                        integrator,
+                        &mut sampler,
+                        [x, y],
+                        held..end,
+                        &mut out.pixels[k as usize],
+                        &mut out.path,
+                    );
+                    out.samples += ok;
+                    out.nonfinite += bad;
+                    tile_fixed[k as usize] = out.path.random_vertices == before;
+                }
+                progress(out.samples + out.nonfinite);
+                let _ = h;
+                (out, tile_fixed)
+            })
+            .collect();
+        let mut worked = false;
+        let mut results = Vec::with_capacity(rounds.len());
+        for (t, tile_fixed) in rounds {
+            for (k, p) in t.pixels.iter().enumerate() {
+                if p.count() > 0 {
+                    worked = true;
+                    let (x, y) = (t.x0 + k as u32 % t.w, t.y0 + k as u32 / t.w);
+                    fixed[index(x, y)] &= tile_fixed[k];
+                }
+            }
+            results.push(t);
+        }
+        merge(film, stats, results);
+        if !worked {
+            break;
+        }
+        // The stopping rules: a pixel whose samples say it has converged stops there.
+        if !two_stage {
+            for &(x0, y0) in tiles {
+                let (w, h, _) = new_tile(x0, y0);
+                for y in y0..y0 + h {
+                    for x in x0..x0 + w {
+                        let i = index(x, y);
+                        let px = film.pixel(x, y);
+                        if px.count() < target[i] as u64
+                            && adaptive.converged(&px.luminance(), fixed[i])
+                        {
+                            target[i] = px.count() as u32;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// [`render`] continuing `film` (a checkpoint's, or an empty one): every pixel goes on from
 /// the samples it holds to the end of the settings' sample range, in whole-frame passes
 /// ([`pass_ends`]); after each finished pass `after_pass(film, stats so far)` is called (to
@@ -335,72 +477,10 @@ pub fn render_from(
         (w, h, out)
     };
     if let Some(adaptive) = settings.adaptive {
-        let results: Vec<TileResult> = tiles
-            .par_iter()
-            .map(|&(x0, y0)| {
-                let (w, h, mut out) = new_tile(x0, y0);
-                let mut sampler = settings.sampler.build(settings.spp, settings.seed);
-                let batch = adaptive.batch.max(1);
-                let mut pilot_sampler = (adaptive.rule == AdaptiveRule::TwoStage).then(|| {
-                    let seed = settings.seed ^ Adaptive::PILOT_STREAM;
-                    settings.sampler.build(batch, seed)
-                });
-                for y in y0..y0 + h {
-                    for x in x0..x0 + w {
-                        if cancel.load(Ordering::Relaxed) {
-                            continue;
-                        }
-                        let px = &mut out.pixels[((y - y0) * w + (x - x0)) as usize];
-                        let mut run = |sampler: &mut pathlab_mc::sampler::AnySampler,
-                                       range: std::ops::Range<u32>,
-                                       px: &mut PixelStats,
-                                       out_path: &mut PathStats|
-                         -> (u64, bool) {
-                            let before = out_path.random_vertices;
-                            let (ok, bad) = sample_pixel(
-                                scene,
-                                integrator,
-                                sampler,
-                                [x, y],
-                                range,
-                                px,
-                                out_path,
-                            );
-                            out.nonfinite += bad;
-                            (ok, out_path.random_vertices == before)
-                        };
-                        if let Some(pilot_sampler) = pilot_sampler.as_mut() {
-                            let mut pilot = PixelStats::default();
-                            let (n_pilot, deterministic) =
-                                run(pilot_sampler, 0..batch, &mut pilot, &mut out.path);
-                            out.pilot += n_pilot;
-                            let n = adaptive.planned_samples(
-                                &pilot.luminance(),
-                                deterministic,
-                                settings.spp,
-                            );
-                            out.samples += run(&mut sampler, 0..n, px, &mut out.path).0;
-                            continue;
-                        }
-                        let mut i = 0;
-                        let mut deterministic = true;
-                        while i < settings.spp {
-                            if i > 0 && adaptive.converged(&px.luminance(), deterministic) {
-                                break;
-                            }
-                            let end = (i + batch).min(settings.spp);
-                            let (ok, fixed) = run(&mut sampler, i..end, px, &mut out.path);
-                            out.samples += ok;
-                            deterministic &= fixed;
-                            i = end;
-                        }
-                    }
-                }
-                progress(w as u64 * h as u64 * settings.spp as u64);
-                out
-            })
-            .collect();
-        merge(&mut film, &mut stats, results);
+        render_adaptive(
+            scene, integrator, settings, adaptive, &tiles, &new_tile, &mut film, &mut stats,
+            &merge, progress, cancel,
+        );
     } else {
         let [first, end] = settings.sample_range.unwrap_or([0, settings.spp]);
         let pixels = (cx1 - cx0) as u64 * (cy1 - cy0) as u64;
