@@ -158,7 +158,7 @@ fn eight_samplers_drawing_together_draw_what_each_draws_alone() {
     let dims = [1, 2, 1, 2, 1];
     for kind in kinds() {
         for round in 0..200 {
-            let mut together: [AnySampler; LANES] = std::array::from_fn(|_| kind.build(64, 5));
+            let mut together: [AnySampler; PATH_LANES] = std::array::from_fn(|_| kind.build(64, 5));
             for s in &mut together {
                 let pixel = [rng.next_u32() % 7, rng.next_u32() % 5];
                 let index = if round % 10 == 0 {
@@ -170,7 +170,7 @@ fn eight_samplers_drawing_together_draw_what_each_draws_alone() {
             }
             let mut alone = together.clone();
             let lanes = rng.next_u32() & 0xff;
-            let mut out = [[0.0; LANES]; 7];
+            let mut out = [[0.0; PATH_LANES]; 7];
             AnySampler::next_lanes(&mut together, lanes, &dims, &mut out);
             for (lane, s) in alone.iter_mut().enumerate() {
                 if lanes & (1 << lane) == 0 {

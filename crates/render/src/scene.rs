@@ -1,6 +1,6 @@
 //! The renderable scene: flattened shapes, the BVH over them, materials, lights and camera.
 
-use crate::accel::{Bvh8, BvhParams, TriBlock, LANES, MAX_PRIMITIVES};
+use crate::accel::{Bvh8, BvhParams, TriBlock, MAX_PRIMITIVES, TRIS_PER_BLOCK};
 use crate::bsdf::{Material, ShadingPoint};
 use crate::camera::Camera;
 use crate::desc::{Emission, MaterialDesc, Rgb, SceneDesc, Visibility};
@@ -416,7 +416,7 @@ impl Scene {
         let mut bvh = Bvh8::build(
             &bounds,
             BvhParams {
-                leaf_block: LANES,
+                leaf_block: TRIS_PER_BLOCK,
                 // Measured against 1.0: 0.25 keeps the walls of a room in separate leaves (the
                 // Cornell box renders 12-17% faster); the blobs and maxplanck trace as fast as
                 // before, a soup of random triangles (smaller leaves) about 15% slower.

@@ -27,7 +27,7 @@ mod sobol;
 mod stratified;
 
 pub use independent::IndependentSampler;
-pub use sobol::{SobolSampler, LANES};
+pub use sobol::{SobolSampler, PATH_LANES};
 pub use stratified::{permutation_element, StratifiedSampler};
 
 use glam::Vec2;
@@ -156,10 +156,10 @@ impl AnySampler {
     /// numbers as those calls; Sobol samplers compute their scrambles for all lanes together
     /// ([`SobolSampler::next_lanes`]), the others draw one lane after another.
     pub fn next_lanes(
-        samplers: &mut [AnySampler; LANES],
+        samplers: &mut [AnySampler; PATH_LANES],
         lanes: u32,
         dims: &[u32],
-        out: &mut [[f32; LANES]],
+        out: &mut [[f32; PATH_LANES]],
     ) {
         if let [AnySampler::Sobol(a), AnySampler::Sobol(b), AnySampler::Sobol(c), AnySampler::Sobol(d), AnySampler::Sobol(e), AnySampler::Sobol(f), AnySampler::Sobol(g), AnySampler::Sobol(h)] =
             samplers
@@ -177,7 +177,7 @@ impl AnySampler {
 
 /// The requests `dims` of [`AnySampler::next_lanes`] for one sampler, into lane `lane` of `out`.
 #[inline]
-fn draw_lane<S: Sampler>(s: &mut S, lane: usize, dims: &[u32], out: &mut [[f32; LANES]]) {
+fn draw_lane<S: Sampler>(s: &mut S, lane: usize, dims: &[u32], out: &mut [[f32; PATH_LANES]]) {
     let mut k = 0;
     for &n in dims {
         if n == 1 {

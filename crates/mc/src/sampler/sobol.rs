@@ -148,8 +148,8 @@ fn padded_2d(sample_index: u32, seed: u32) -> [f32; 2] {
     [scrambled(n, 0, seed), scrambled(pascal_rev(n), 1, seed)]
 }
 
-/// Lanes that several samplers draw together.
-pub const LANES: usize = 8;
+/// Paths whose samplers draw together: the width of [`crate::lanes`]' lane types.
+pub const PATH_LANES: usize = crate::lanes::W;
 
 impl SobolSampler {
     /// Draws for eight samplers at once what each would give for the requests `dims` (1 for
@@ -158,15 +158,15 @@ impl SobolSampler {
     /// The same numbers as those calls (tested); the scrambles, which are most of the work,
     /// are computed for all lanes together, in vector registers.
     pub fn next_lanes(
-        samplers: &mut [&mut SobolSampler; LANES],
+        samplers: &mut [&mut SobolSampler; PATH_LANES],
         lanes: u32,
         dims: &[u32],
-        out: &mut [[f32; LANES]],
+        out: &mut [[f32; PATH_LANES]],
     ) {
-        let index: [u32; LANES] = std::array::from_fn(|lane| samplers[lane].index());
+        let index: [u32; PATH_LANES] = std::array::from_fn(|lane| samplers[lane].index());
         let mut k = 0;
         for &n in dims {
-            let mut seed = [0u32; LANES];
+            let mut seed = [0u32; PATH_LANES];
             for (lane, s) in samplers.iter_mut().enumerate() {
                 if lanes & (1 << lane) != 0 {
                     seed[lane] = s.seed_for(s.dimension);
@@ -187,7 +187,10 @@ impl SobolSampler {
 /// [`padded_1d`] (`N` = 1) or [`padded_2d`] (`N` = 2) for eight lanes: with AVX2 where the
 /// CPU has it (eight 32-bit multiplies per instruction), else in the baseline's SSE2.
 #[inline]
-fn padded_lanes<const N: usize>(index: &[u32; LANES], seed: &[u32; LANES]) -> [[f32; LANES]; N] {
+fn padded_lanes<const N: usize>(
+    index: &[u32; PATH_LANES],
+    seed: &[u32; PATH_LANES],
+) -> [[f32; PATH_LANES]; N] {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: `padded_lanes_avx2` requires AVX2, which this CPU has (just checked). Its
@@ -201,20 +204,20 @@ fn padded_lanes<const N: usize>(index: &[u32; LANES], seed: &[u32; LANES]) -> [[
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn padded_lanes_avx2<const N: usize>(
-    index: &[u32; LANES],
-    seed: &[u32; LANES],
-) -> [[f32; LANES]; N] {
+    index: &[u32; PATH_LANES],
+    seed: &[u32; PATH_LANES],
+) -> [[f32; PATH_LANES]; N] {
     padded_lanes_portable::<N>(index, seed)
 }
 
 /// [`padded_lanes`] as loops over the lanes, which the compiler vectorises.
 #[inline(always)]
 fn padded_lanes_portable<const N: usize>(
-    index: &[u32; LANES],
-    seed: &[u32; LANES],
-) -> [[f32; LANES]; N] {
-    let mut out = [[0.0; LANES]; N];
-    for lane in 0..LANES {
+    index: &[u32; PATH_LANES],
+    seed: &[u32; PATH_LANES],
+) -> [[f32; PATH_LANES]; N] {
+    let mut out = [[0.0; PATH_LANES]; N];
+    for lane in 0..PATH_LANES {
         if N == 1 {
             out[0][lane] = padded_1d(index[lane], seed[lane]);
         } else {

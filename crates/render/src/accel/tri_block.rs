@@ -10,8 +10,9 @@ use crate::geometry::Ray;
 use crate::lanes::{F8, V8};
 use crate::shape::Triangle;
 
-/// Lanes per block.
-pub const LANES: usize = 4;
+/// Triangles per leaf block, tested against a ray at once (the BVH's width is `Bvh8`'s 8,
+/// the path tracer's [`pathlab_mc::sampler::PATH_LANES`]).
+pub const TRIS_PER_BLOCK: usize = 4;
 
 /// Up to four triangles. Unused lanes have zero edges, which no ray hits (their determinant
 /// is zero).
@@ -19,11 +20,11 @@ pub const LANES: usize = 4;
 #[repr(C, align(16))]
 pub struct TriBlock {
     /// First vertex: `v0[axis][lane]`.
-    v0: [[f32; LANES]; 3],
+    v0: [[f32; TRIS_PER_BLOCK]; 3],
     /// Edge from the first to the second vertex.
-    e1: [[f32; LANES]; 3],
+    e1: [[f32; TRIS_PER_BLOCK]; 3],
     /// Edge from the first to the third vertex.
-    e2: [[f32; LANES]; 3],
+    e2: [[f32; TRIS_PER_BLOCK]; 3],
 }
 
 /// A lane's hit: distance and barycentrics of vertices 1 and 2.
@@ -41,24 +42,24 @@ pub struct BlockHit {
 
 /// Per-lane results of testing a block.
 struct LaneHits {
-    t: [f32; LANES],
-    b1: [f32; LANES],
-    b2: [f32; LANES],
+    t: [f32; TRIS_PER_BLOCK],
+    b1: [f32; TRIS_PER_BLOCK],
+    b2: [f32; TRIS_PER_BLOCK],
     /// Bit per lane that hits within the ray's extent.
     mask: u32,
 }
 
 impl TriBlock {
-    /// A block of `triangles` (at most [`LANES`]), the rest of the lanes unused.
+    /// A block of `triangles` (at most [`TRIS_PER_BLOCK`]), the rest of the lanes unused.
     pub fn new(triangles: &[Triangle]) -> TriBlock {
         assert!(
-            triangles.len() <= LANES,
-            "a block holds at most {LANES} triangles"
+            triangles.len() <= TRIS_PER_BLOCK,
+            "a block holds at most {TRIS_PER_BLOCK} triangles"
         );
         let mut b = TriBlock {
-            v0: [[0.0; LANES]; 3],
-            e1: [[0.0; LANES]; 3],
-            e2: [[0.0; LANES]; 3],
+            v0: [[0.0; TRIS_PER_BLOCK]; 3],
+            e1: [[0.0; TRIS_PER_BLOCK]; 3],
+            e2: [[0.0; TRIS_PER_BLOCK]; 3],
         };
         for (lane, tri) in triangles.iter().enumerate() {
             let (e1, e2) = (tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
@@ -89,11 +90,11 @@ impl TriBlock {
     #[inline(always)]
     fn test_lanes(&self, ray: &Ray) -> LaneHits {
         let (o, d) = (ray.o, ray.d);
-        let mut t = [0.0f32; LANES];
-        let mut b1 = [0.0f32; LANES];
-        let mut b2 = [0.0f32; LANES];
-        let mut ok = [false; LANES];
-        for lane in 0..LANES {
+        let mut t = [0.0f32; TRIS_PER_BLOCK];
+        let mut b1 = [0.0f32; TRIS_PER_BLOCK];
+        let mut b2 = [0.0f32; TRIS_PER_BLOCK];
+        let mut ok = [false; TRIS_PER_BLOCK];
+        for lane in 0..TRIS_PER_BLOCK {
             let e1 = [self.e1[0][lane], self.e1[1][lane], self.e1[2][lane]];
             let e2 = [self.e2[0][lane], self.e2[1][lane], self.e2[2][lane]];
             // pvec = d × e2, det = e1 · pvec (glam's cross and dot, term by term).
@@ -150,9 +151,9 @@ impl TriBlock {
         // SAFETY: SSE and SSE2, all these intrinsics need, are part of the x86-64 baseline;
         // the loads and stores go through `[f32; 4]`s, 16 bytes each, all they move.
         unsafe {
-            let load = |a: &[f32; LANES]| _mm_loadu_ps(a.as_ptr());
+            let load = |a: &[f32; TRIS_PER_BLOCK]| _mm_loadu_ps(a.as_ptr());
             let store = |v: __m128| {
-                let mut a = [0.0f32; LANES];
+                let mut a = [0.0f32; TRIS_PER_BLOCK];
                 _mm_storeu_ps(a.as_mut_ptr(), v);
                 a
             };
@@ -248,7 +249,7 @@ impl TriBlock {
     /// lane that hits it within `(t_min, nearest.t)` takes it as its nearest, with `slot`.
     #[inline(always)]
     pub fn nearest_for_rays(&self, lane: usize, slot: u32, rays: &RayLanes, nearest: &mut Nearest) {
-        let splat = |a: &[[f32; LANES]; 3]| V8 {
+        let splat = |a: &[[f32; TRIS_PER_BLOCK]; 3]| V8 {
             x: F8::splat(a[0][lane]),
             y: F8::splat(a[1][lane]),
             z: F8::splat(a[2][lane]),
@@ -302,7 +303,7 @@ impl TriBlock {
         nearest: &mut AvxNearest,
     ) {
         use std::arch::x86_64::*;
-        let splat = |a: &[[f32; LANES]; 3]| {
+        let splat = |a: &[[f32; TRIS_PER_BLOCK]; 3]| {
             [
                 _mm256_set1_ps(a[0][lane]),
                 _mm256_set1_ps(a[1][lane]),
@@ -505,7 +506,7 @@ mod tests {
     fn agrees_with_the_scalar_test_to_the_bit() {
         let mut rng = Pcg32::new(3, 5);
         for round in 0..20_000 {
-            let n = round % (LANES + 1);
+            let n = round % (TRIS_PER_BLOCK + 1);
             let mut tris = random_triangles(&mut rng, n);
             if n > 1 && round % 7 == 0 {
                 // Equal distances in two lanes, and a degenerate triangle.
@@ -551,10 +552,10 @@ mod tests {
     #[test]
     fn sse_and_lane_loops_give_the_same_bits() {
         let mut rng = Pcg32::new(11, 2);
-        let bits = |a: [f32; LANES]| a.map(f32::to_bits);
+        let bits = |a: [f32; TRIS_PER_BLOCK]| a.map(f32::to_bits);
         let specials = [0.0, -0.0, f32::INFINITY, f32::NAN, 1e-30];
         for round in 0..20_000 {
-            let tris = random_triangles(&mut rng, round % (LANES + 1));
+            let tris = random_triangles(&mut rng, round % (TRIS_PER_BLOCK + 1));
             let block = TriBlock::new(&tris);
             let o = random_point(&mut rng) * 3.0;
             let mut d = random_point(&mut rng) - o * 0.3;

@@ -4,7 +4,7 @@
 //! compiled twice, for AVX2 and for the target's baseline, the CPU choosing at run time.
 
 use super::{Prim, Scene};
-use crate::accel::{BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, LANES};
+use crate::accel::{BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, TRIS_PER_BLOCK};
 use crate::desc::Visibility;
 use crate::geometry::Ray;
 use crate::lanes::F8;
@@ -71,7 +71,7 @@ impl Hit {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BlockInfo {
     /// Leaf slot of each lane's primitive (`u32::MAX` for an unused lane).
-    slots: [u32; LANES],
+    slots: [u32; TRIS_PER_BLOCK],
     /// Lanes that hold other shapes than triangles.
     shapes: u8,
     /// Lanes seen by camera rays.
@@ -290,7 +290,7 @@ impl Scene {
 /// beyond a few dozen triangles the BVH culls more than testing them all costs.
 const SMALL_SCENE_BLOCKS: usize = 16;
 
-/// Packs the primitives of each of `bvh`'s leaves into blocks of [`LANES`] and renames the
+/// Packs the primitives of each of `bvh`'s leaves into blocks of [`TRIS_PER_BLOCK`] and renames the
 /// leaves' ranges from leaf slots to blocks.
 pub(super) fn leaf_blocks(
     bvh: &mut Bvh8,
@@ -302,15 +302,15 @@ pub(super) fn leaf_blocks(
     let mut info = Vec::with_capacity(prims.len() / 2 + 1);
     bvh.remap_leaves(|start, count| {
         let first = blocks.len() as u32;
-        for chunk_start in (start..start + count).step_by(LANES) {
-            let chunk = chunk_start..(chunk_start + LANES as u32).min(start + count);
+        for chunk_start in (start..start + count).step_by(TRIS_PER_BLOCK) {
+            let chunk = chunk_start..(chunk_start + TRIS_PER_BLOCK as u32).min(start + count);
             let mut lanes = BlockInfo {
-                slots: [u32::MAX; LANES],
+                slots: [u32::MAX; TRIS_PER_BLOCK],
                 shapes: 0,
                 camera: 0,
                 indirect: 0,
             };
-            let mut tris = [Triangle { p: [Vec3::ZERO; 3] }; LANES];
+            let mut tris = [Triangle { p: [Vec3::ZERO; 3] }; TRIS_PER_BLOCK];
             for (lane, slot) in chunk.enumerate() {
                 lanes.slots[lane] = slot;
                 match prims[slot as usize] {
