@@ -646,13 +646,21 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         settings.crop
     )
     .to_lowercase();
-    let key = crate::farm::render_key(
-        &desc,
-        &format!(
-            "{integrator:?}|{sampler:?}|{:?}|{:?}",
-            settings.crop, settings.adaptive
-        ),
-    );
+    // Hashing the whole scene takes time on large ones: only renders that read or write film
+    // files need the key.
+    let film_files =
+        args.checkpoint.is_some() || args.resume.is_some() || formats.contains(&OutputFormat::Film);
+    let key = if film_files {
+        crate::farm::render_key(
+            &desc,
+            &format!(
+                "{integrator:?}|{sampler:?}|{:?}|{:?}",
+                settings.crop, settings.adaptive
+            ),
+        )
+    } else {
+        String::new()
+    };
     let header = crate::farm::header(&desc, &key, &description, args.seed, spp, range);
     let start_film = match &args.resume {
         Some(path) => {

@@ -383,7 +383,6 @@ fn render_adaptive(
                     tile_fixed[k as usize] = out.path.random_vertices == before;
                 }
                 progress(out.samples + out.nonfinite);
-                let _ = h;
                 (out, tile_fixed)
             })
             .collect();
@@ -404,19 +403,11 @@ fn render_adaptive(
             break;
         }
         // The stopping rules: a pixel whose samples say it has converged stops there.
+        // (Pixels outside a crop hold no samples, so never count as converged.)
         if !two_stage {
-            for &(x0, y0) in tiles {
-                let (w, h, _) = new_tile(x0, y0);
-                for y in y0..y0 + h {
-                    for x in x0..x0 + w {
-                        let i = index(x, y);
-                        let px = film.pixel(x, y);
-                        if px.count() < target[i] as u64
-                            && adaptive.converged(&px.luminance(), fixed[i])
-                        {
-                            target[i] = px.count() as u32;
-                        }
-                    }
+            for (i, px) in film.pixels().iter().enumerate() {
+                if px.count() < target[i] as u64 && adaptive.converged(&px.luminance(), fixed[i]) {
+                    target[i] = px.count() as u32;
                 }
             }
         }
@@ -518,7 +509,6 @@ pub fn render_from(
                     out.samples += ok;
                     out.nonfinite += bad;
                     progress(ok + bad);
-                    let _ = h;
                     out
                 })
                 .collect();

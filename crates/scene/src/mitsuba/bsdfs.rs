@@ -41,6 +41,15 @@ pub(super) fn ior(ctx: &Ctx, b: Obj, name: &str, default: f32) -> Result<f32, Er
     }
 }
 
+/// A dielectric's `specular_reflectance` and `specular_transmittance` scales (default 1).
+fn specular_scales(ctx: &mut Ctx, b: Obj) -> Result<(Vec3, Vec3), Error> {
+    let mut scale = |name: &str| ctx.color(b, name, Vec3::ONE, SpectrumKind::Reflectance);
+    Ok((
+        scale("specular_reflectance")?,
+        scale("specular_transmittance")?,
+    ))
+}
+
 /// `int_ior / ext_ior`.
 fn relative_ior(ctx: &Ctx, b: Obj, int_default: f32) -> Result<f32, Error> {
     Ok(ior(ctx, b, "int_ior", int_default)? / ior(ctx, b, "ext_ior", AIR)?)
@@ -284,40 +293,24 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
                 distribution: distribution(ctx, b)?,
             }
         }
-        "thindielectric" => MaterialDesc::ThinGlass {
-            reflectance: ctx.color(
-                b,
-                "specular_reflectance",
-                Vec3::ONE,
-                SpectrumKind::Reflectance,
-            )?,
-            transmittance: ctx.color(
-                b,
-                "specular_transmittance",
-                Vec3::ONE,
-                SpectrumKind::Reflectance,
-            )?,
-            ior: relative_ior(ctx, b, BK7)?,
-        },
+        "thindielectric" => {
+            let (reflectance, transmittance) = specular_scales(ctx, b)?;
+            MaterialDesc::ThinGlass {
+                reflectance,
+                transmittance,
+                ior: relative_ior(ctx, b, BK7)?,
+            }
+        }
         "dielectric" | "roughdielectric" => {
             let (roughness, distribution) = if b.plugin == "roughdielectric" {
                 (alpha(ctx, b)?, distribution(ctx, b)?)
             } else {
                 (0.0, NormalDistribution::Beckmann)
             };
+            let (reflectance, transmittance) = specular_scales(ctx, b)?;
             MaterialDesc::Glass {
-                reflectance: ctx.color(
-                    b,
-                    "specular_reflectance",
-                    Vec3::ONE,
-                    SpectrumKind::Reflectance,
-                )?,
-                transmittance: ctx.color(
-                    b,
-                    "specular_transmittance",
-                    Vec3::ONE,
-                    SpectrumKind::Reflectance,
-                )?,
+                reflectance,
+                transmittance,
                 roughness,
                 ior: relative_ior(ctx, b, BK7)?,
                 distribution,
