@@ -12,7 +12,9 @@ use pathlab_render::image_io::{write_exr, write_png_with, write_rgb8, ExtraChann
 use pathlab_render::integrator::{
     DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator, PathLighting,
 };
-use pathlab_render::progressive::{render_progressive, StopRule};
+use pathlab_render::progressive::{
+    estimated_relative_rmse, render_progressive_from, ProgressiveReport, StopRule,
+};
 use pathlab_render::render::{render, render_from, Adaptive, AdaptiveRule, RenderSettings};
 use pathlab_render::scene::Scene;
 use serde_json::json;
@@ -232,7 +234,8 @@ pub struct RenderArgs {
         allow_negative_numbers = true
     )]
     pub checkpoint_every: f64,
-    /// Go on from a checkpoint of this render (the same scene, flags and seed) to -s.
+    /// Go on from a checkpoint of this render (the same scene, flags and seed) to -s (or, with
+    /// --target-error/--time, to the target or for the time; with -a, to each pixel's count).
     #[arg(long, value_name = "FILE")]
     pub resume: Option<PathBuf>,
     /// Render only the I-th (from 0) of N equal ranges of every pixel's samples: a whole-frame
@@ -632,9 +635,11 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         settings.sample_range = Some(crate::farm::shard_range(shard, spp)?);
     }
     if (args.checkpoint.is_some() || args.resume.is_some())
-        && (progressive || settings.adaptive.is_some())
+        && settings
+            .adaptive
+            .is_some_and(|a| a.rule != AdaptiveRule::TwoStage)
     {
-        bail!("--checkpoint and --resume work with renders of fixed samples per pixel, not with -a, --target-error or --time");
+        bail!("--checkpoint and --resume: the course and neyman adaptive rules decide on every sample a pixel has drawn, which a film does not keep; use the default two-stage rule");
     }
     // What identifies this render: the scene as the renderer gets it and every setting that
     // changes the image.
@@ -654,14 +659,17 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         crate::farm::render_key(
             &desc,
             &format!(
-                "{integrator:?}|{sampler:?}|{:?}|{:?}",
+                "{integrator:?}|{sampler:?}|{:?}|{:?}|progressive {progressive}",
                 settings.crop, settings.adaptive
             ),
         )
     } else {
         String::new()
     };
-    let header = crate::farm::header(&desc, &key, &description, args.seed, spp, range);
+    // A progressive render's film holds up to its cap (and resumes only under the same cap).
+    let header_spp = if progressive { stop_cap } else { spp };
+    let range = if progressive { [0, stop_cap] } else { range };
+    let header = crate::farm::header(&desc, &key, &description, args.seed, header_spp, range);
     let start_film = match &args.resume {
         Some(path) => {
             let (h, film) = pathlab_render::film_file::read(path)?;
@@ -725,6 +733,20 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         .build()
         .context("cannot start the worker threads")?;
     let threads = pool.current_num_threads();
+    let film0 = start_film.unwrap_or_else(|| pathlab_render::film::Film::new(w, h));
+    // Checkpoints after finished passes, at most every --checkpoint-every seconds.
+    let mut last_checkpoint = std::time::Instant::now();
+    let mut checkpoint_error = None;
+    let mut checkpoint = |film: &pathlab_render::film::Film| {
+        if let Some(path) = &args.checkpoint {
+            if last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every {
+                if let Err(e) = pathlab_render::film_file::write(path, &header, film) {
+                    checkpoint_error.get_or_insert(e);
+                }
+                last_checkpoint = std::time::Instant::now();
+            }
+        }
+    };
     let mut estimated_error = None;
     let (film, stats) = if progressive {
         let stop = StopRule {
@@ -733,13 +755,26 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
             max_spp: stop_cap,
         };
         let bar_pass = Arc::clone(&bar);
-        let report_pass = move |pass: u32, error: f64| {
+        let mut after_pass = |film: &pathlab_render::film::Film,
+                              _: &pathlab_render::render::RenderStats,
+                              pass: u32,
+                              error: f64| {
             bar_pass.set_message(format!("pass {pass}: estimated relative RMSE {error:.4}"));
+            checkpoint(film);
         };
         let (film, stats, report) = pool.install(|| {
-            render_progressive(&scene, &integrator, &settings, &stop, &report_pass, cancel)
+            render_progressive_from(
+                &scene,
+                &integrator,
+                &settings,
+                &stop,
+                film0,
+                &|_| {},
+                cancel,
+                &mut after_pass,
+            )
         });
-        let error = report.error_history.last().copied().unwrap_or(f64::NAN);
+        let error = estimate_or_last(&film, &report);
         if !args.quiet {
             eprintln!(
                 "progressive: {} passes, stopped by {}; estimated relative RMSE {error:.4}",
@@ -749,21 +784,11 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         estimated_error = Some(error);
         (film, stats)
     } else {
-        let film0 = start_film.unwrap_or_else(|| pathlab_render::film::Film::new(w, h));
-        let mut last_checkpoint = std::time::Instant::now();
-        let mut checkpoint_error = None;
         let mut after_pass =
             |film: &pathlab_render::film::Film, _: &pathlab_render::render::RenderStats| {
-                if let Some(path) = &args.checkpoint {
-                    if last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every {
-                        if let Err(e) = pathlab_render::film_file::write(path, &header, film) {
-                            checkpoint_error.get_or_insert(e);
-                        }
-                        last_checkpoint = std::time::Instant::now();
-                    }
-                }
+                checkpoint(film)
             };
-        let result = pool.install(|| {
+        pool.install(|| {
             render_from(
                 &scene,
                 &integrator,
@@ -773,16 +798,15 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
                 cancel,
                 &mut after_pass,
             )
-        });
-        if let Some(e) = checkpoint_error {
-            return Err(e).context("cannot write the checkpoint");
-        }
-        if let Some(path) = &args.checkpoint {
-            pathlab_render::film_file::write(path, &header, &result.0)
-                .context("cannot write the checkpoint")?;
-        }
-        result
+        })
     };
+    if let Some(e) = checkpoint_error {
+        return Err(e).context("cannot write the checkpoint");
+    }
+    if let Some(path) = &args.checkpoint {
+        pathlab_render::film_file::write(path, &header, &film)
+            .context("cannot write the checkpoint")?;
+    }
     bar.finish_and_clear();
     if stats.cancelled {
         let counts = film.sample_counts();
@@ -918,6 +942,16 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
     } else {
         130
     })
+}
+
+/// The estimated relative RMSE after the last pass, or of the film when no pass finished
+/// (stopped at once, or a resumed film already at its target).
+fn estimate_or_last(film: &pathlab_render::film::Film, report: &ProgressiveReport) -> f64 {
+    report
+        .error_history
+        .last()
+        .copied()
+        .unwrap_or_else(|| estimated_relative_rmse(film))
 }
 
 /// Writes `film` (of a whole render described by `header`) as `.exr` (the mean with

@@ -1647,3 +1647,86 @@ fn read_exr_layer(path: &PathBuf, name: &str) -> Vec<f32> {
         FlatSamples::U32(v) => v.iter().map(|&x| x as f32).collect(),
     }
 }
+
+#[test]
+#[cfg(unix)]
+fn progressive_and_adaptive_renders_checkpoint_and_resume_to_the_same_image() {
+    // `pathlab render -r SIZE SIZE -q EXTRA...`, which must succeed.
+    let render = |size: &str, extra: &[&str]| {
+        let mut a = vec!["render", "-r", size, size, "-q"];
+        a.extend_from_slice(extra);
+        let o = pathlab(&a);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        o
+    };
+    let same = |a: &PathBuf, b: &PathBuf| {
+        assert!(
+            std::fs::read(a).unwrap() == std::fs::read(b).unwrap(),
+            "{a:?} and {b:?} differ"
+        );
+    };
+    let (a, b) = (scratch("resumed-a.plf"), scratch("resumed-b.plf"));
+    let (a_s, b_s) = (a.to_str().unwrap(), b.to_str().unwrap());
+    // --target-error: a render stopped at one target and resumed to a lower one gives the
+    // image of a render to the lower target, bit for bit.
+    let ck = scratch("progressive.plf");
+    let ck_s = ck.to_str().unwrap();
+    render(
+        "32",
+        &["--target-error", "0.05", "--checkpoint", ck_s, "-o", a_s],
+    );
+    render(
+        "32",
+        &["--target-error", "0.03", "--resume", ck_s, "-o", a_s],
+    );
+    render("32", &["--target-error", "0.03", "-o", b_s]);
+    same(&a, &b);
+    // --time goes on from a checkpoint too (where it stops depends on the time).
+    let o = render(
+        "32",
+        &["--time", "0.3", "--resume", ck_s, "--json", "-o", a_s],
+    );
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["estimated_relative_rmse"].as_f64().unwrap() <= 0.05);
+    // Adaptive (two-stage): stopped by SIGINT mid-render and resumed, the same image.
+    let ck = scratch("adaptive.plf");
+    let ck_s = ck.to_str().unwrap();
+    let partial = scratch("adaptive-partial.exr");
+    let adaptive = ["-a", "-s", "1024"];
+    let o = interrupt(
+        &[
+            &["render", "-r", "48", "48", "-q"][..],
+            &adaptive,
+            &["--checkpoint", ck_s, "-o", partial.to_str().unwrap()],
+        ]
+        .concat(),
+        "-INT",
+        std::time::Duration::from_millis(500),
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    render(
+        "48",
+        &[&adaptive[..], &["--resume", ck_s, "-o", a_s]].concat(),
+    );
+    render("48", &[&adaptive[..], &["-o", b_s]].concat());
+    same(&a, &b);
+    // The stopping rules decide on samples a film does not keep: refused, saying why.
+    assert_one_line_error(
+        &pathlab(&[
+            "render",
+            "-a",
+            "--adaptive-rule",
+            "course",
+            "--checkpoint",
+            ck_s,
+            "-o",
+            "x.exr",
+        ]),
+        "two-stage",
+    );
+}

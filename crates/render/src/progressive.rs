@@ -10,6 +10,9 @@
 //! proportion to σ_i, and every pixel gets at least one sample per pass, so that no pixel
 //! whose first samples happened to agree (σ_i = 0) is left behind for good.
 //!
+//! The passes are the render loop's own ([`crate::render`]'s whole-frame passes of tiles), so
+//! a progressive render is stopped, checkpointed and resumed as a fixed one is.
+//!
 //! The estimate is exact in expectation for independent samples; for stratified or Sobol
 //! samples the per-pixel sample variance overstates the error, so the render stops later than
 //! needed (never earlier).
@@ -21,11 +24,10 @@
 //! image mean is low by about 2.5 combined standard errors (2.6e-4 relative); uniform sampling
 //! has no such bias. The per-pass uniform half and the neighbourhood σ keep it small.
 
-use crate::film::{Film, PixelStats};
-use crate::integrator::{Integrator, PathStats};
-use crate::render::{sample_pixel, RenderSettings, RenderStats};
+use crate::film::Film;
+use crate::integrator::Integrator;
+use crate::render::{Frame, RenderSettings, RenderStats};
 use crate::scene::Scene;
-use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -75,8 +77,8 @@ pub fn estimated_relative_rmse(film: &Film) -> f64 {
     }
 }
 
-/// Renders in passes until `stop` says so. `settings.spp` is ignored (the stop rule's
-/// `max_spp` caps the average); `settings.adaptive` too.
+/// Renders in passes until `stop` says so, from an empty film; `progress(pass, estimated
+/// error)` after each pass. See [`render_progressive_from`].
 pub fn render_progressive(
     scene: &Scene,
     integrator: &dyn Integrator,
@@ -86,17 +88,44 @@ pub fn render_progressive(
     cancel: &AtomicBool,
 ) -> (Film, RenderStats, ProgressiveReport) {
     let [width, height] = scene.camera().resolution();
-    // The pixels to render: the crop window, or all.
-    let [cx0, cy0, cx1, cy1] = settings
-        .crop
-        .map_or([0, 0, width, height], |[x0, y0, x1, y1]| {
-            [x0.min(width), y0.min(height), x1.min(width), y1.min(height)]
-        });
+    render_progressive_from(
+        scene,
+        integrator,
+        settings,
+        stop,
+        Film::new(width, height),
+        &|_| {},
+        cancel,
+        &mut |_, _, pass, error| progress(pass, error),
+    )
+}
+
+/// Renders in whole-frame passes (the same pass routine as every render) until `stop` says
+/// so, continuing `film` (a checkpoint's, or an empty one). `settings.spp` is ignored (the
+/// stop rule's `max_spp` caps the average); `settings.adaptive` too. `progress(samples)` as
+/// tiles finish; `after_pass(film, stats, pass, estimated error)` after each finished pass.
+///
+/// Each pass's allocation is a function of the film alone, so going on from a film written
+/// after a pass gives, with the same stop rule, the image of the uninterrupted render bit for
+/// bit (a time limit counts from this call, so it stops wherever the time runs out).
+#[allow(clippy::too_many_arguments)]
+pub fn render_progressive_from(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    settings: &RenderSettings,
+    stop: &StopRule,
+    mut film: Film,
+    progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
+    after_pass: &mut dyn FnMut(&Film, &RenderStats, u32, f64),
+) -> (Film, RenderStats, ProgressiveReport) {
+    let frame = Frame::new(scene, integrator, settings);
+    let (width, height) = (film.width(), film.height());
     let inside: Vec<bool> = (0..height)
-        .flat_map(|y| (0..width).map(move |x| (cx0..cx1).contains(&x) && (cy0..cy1).contains(&y)))
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| frame.covers(x, y))
         .collect();
-    let pixels = inside.iter().filter(|&&i| i).count().max(1);
-    let mut film = Film::new(width, height);
+    let pixels = frame.pixel_count().max(1);
     let mut stats = RenderStats::default();
     let mut report = ProgressiveReport {
         passes: 0,
@@ -104,55 +133,58 @@ pub fn render_progressive(
         stopped_by: "max-spp",
     };
     let start = Instant::now();
-    let mut total: u64 = 0;
-    // Each pixel's next sample index (counts include non-finite samples, added as black).
-    let mut next_index = vec![0u32; inside.len()];
-    let max_total = stop.max_spp.max(1) as u64 * pixels as u64;
+    // Samples the film holds (non-finite ones count, added as black), and those of this call.
+    let mut total: u64 = film.pixels().iter().map(|p| p.count()).sum();
+    let mut this_run: u64 = 0;
+    let max_total = stop.max_spp.max(1) as u64 * pixels;
     loop {
+        if cancel.load(Ordering::Relaxed) {
+            report.stopped_by = "cancelled";
+            break;
+        }
         // This pass's budget: the first pass FIRST_PASS_SPP per pixel, then as many samples as
-        // so far (doubling), within the cap and, given the rate so far, the time left.
+        // so far (doubling), within the cap and, given this call's rate so far, the time left.
         let mut budget = if total == 0 {
-            FIRST_PASS_SPP as u64 * pixels as u64
+            FIRST_PASS_SPP as u64 * pixels
         } else {
             total
         };
         budget = budget.min(max_total.saturating_sub(total));
-        if let (Some(limit), true) = (stop.time_limit, total > 0) {
-            let elapsed = start.elapsed().as_secs_f64();
-            let rate = total as f64 / elapsed.max(1e-9);
-            let left = (limit - elapsed).max(0.0);
-            budget = budget.min((rate * left) as u64).max(pixels as u64);
+        if let Some(limit) = stop.time_limit {
+            if this_run == 0 {
+                // No rate measured yet (a resumed film may hold many samples): a short pass.
+                budget = budget.min(FIRST_PASS_SPP as u64 * pixels);
+            } else {
+                let elapsed = start.elapsed().as_secs_f64();
+                let rate = this_run as f64 / elapsed.max(1e-9);
+                let left = (limit - elapsed).max(0.0);
+                budget = budget.min((rate * left) as u64).max(pixels);
+            }
         }
         if budget == 0 {
             break;
         }
         let alloc = allocate(&film, &inside, budget, total == 0);
-        let (pass, counts) = run_pass(
-            scene,
-            integrator,
-            settings,
-            &film,
-            &next_index,
-            &alloc,
+        let before = stats.samples + stats.nonfinite_samples;
+        frame.pass(
+            &mut film,
+            &mut stats,
+            &|x, y, held| (held as u32).saturating_add(alloc[(y * width + x) as usize]),
+            progress,
             cancel,
         );
-        film.pixels_mut().copy_from_slice(&pass);
-        for (n, a) in next_index.iter_mut().zip(&alloc) {
-            *n += a;
-        }
-        stats.samples += counts.0;
-        stats.nonfinite_samples += counts.1;
-        stats.rays += counts.2.rays;
-        stats.nodes_visited += counts.2.nodes_visited;
-        total += alloc.iter().map(|&a| a as u64).sum::<u64>();
-        report.passes += 1;
-        let error = estimated_relative_rmse(&film);
-        report.error_history.push(error);
-        progress(report.passes, error);
+        let done = stats.samples + stats.nonfinite_samples - before;
+        total += done;
+        this_run += done;
+        stats.seconds = start.elapsed().as_secs_f64();
         if cancel.load(Ordering::Relaxed) {
             report.stopped_by = "cancelled";
             break;
         }
+        report.passes += 1;
+        let error = estimated_relative_rmse(&film);
+        report.error_history.push(error);
+        after_pass(&film, &stats, report.passes, error);
         if stop.target_error.is_some_and(|t| error <= t) {
             report.stopped_by = "target";
             break;
@@ -245,56 +277,4 @@ fn allocate(film: &Film, inside: &[bool], budget: u64, first: bool) -> Vec<u32> 
             (floor_of(i) + n).min(u32::MAX as f64 / 2.0) as u32
         })
         .collect()
-}
-
-/// One pass: pixel i takes the samples `next[i] .. next[i] + alloc[i]`.
-fn run_pass(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    settings: &RenderSettings,
-    film: &Film,
-    next: &[u32],
-    alloc: &[u32],
-    cancel: &AtomicBool,
-) -> (Vec<PixelStats>, (u64, u64, PathStats)) {
-    let w = film.width();
-    let rows: Vec<(Vec<PixelStats>, u64, u64, PathStats)> = (0..film.height())
-        .into_par_iter()
-        .map(|y| {
-            let mut sampler = settings.sampler.build(settings.spp, settings.seed);
-            let mut path = PathStats::default();
-            let (mut ok, mut bad) = (0, 0);
-            let row: Vec<PixelStats> = (0..w)
-                .map(|x| {
-                    let i = (y * w + x) as usize;
-                    let mut px = film.pixels()[i];
-                    if !cancel.load(Ordering::Relaxed) {
-                        let range = next[i]..next[i] + alloc[i];
-                        let (a, b) = sample_pixel(
-                            scene,
-                            integrator,
-                            &mut sampler,
-                            [x, y],
-                            range,
-                            &mut px,
-                            &mut path,
-                        );
-                        ok += a;
-                        bad += b;
-                    }
-                    px
-                })
-                .collect();
-            (row, ok, bad, path)
-        })
-        .collect();
-    let mut out = Vec::with_capacity(alloc.len());
-    let mut totals = (0, 0, PathStats::default());
-    for (row, ok, bad, path) in rows {
-        out.extend(row);
-        totals.0 += ok;
-        totals.1 += bad;
-        totals.2.merge(&path);
-    }
-    (out, totals)
 }

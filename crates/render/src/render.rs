@@ -285,33 +285,36 @@ fn steady_pass(pixels: u64) -> u32 {
 /// pixel's pilot and plans its count; then each round gives every pixel below its count one
 /// batch, and with the stopping rules a pixel whose samples say it has converged stops. Each
 /// pixel gets the same sample indices, in the same batches, as rendering it alone would give.
-#[allow(clippy::too_many_arguments)]
+///
+/// Continuing a film: the two-stage plan is drawn again (its pilot is a stream of its own, so
+/// the counts are the same) and every pixel goes on to its count, so the image is the one an
+/// uninterrupted render gives. The stopping rules cannot know whether the samples a film
+/// already holds met a scattering surface, so such pixels never count as unable to vary.
 fn render_adaptive(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    settings: &RenderSettings,
+    frame: &Frame,
     adaptive: Adaptive,
-    tiles: &[(u32, u32)],
-    new_tile: &(dyn Fn(u32, u32) -> (u32, u32, TileResult) + Sync),
     film: &mut Film,
     stats: &mut RenderStats,
-    merge: &dyn Fn(&mut Film, &mut RenderStats, Vec<TileResult>),
     progress: &(dyn Fn(u64) + Sync),
     cancel: &AtomicBool,
+    after_round: &mut dyn FnMut(&Film, &RenderStats),
 ) {
+    let settings = frame.settings;
     let batch = adaptive.batch.max(1);
     let width = film.width();
     let index = |x: u32, y: u32| (y * width + x) as usize;
     // Per pixel: the count it is to reach, and whether none of its samples so far met a
     // scattering surface (see `Adaptive::converged`).
     let mut target = vec![settings.spp; film.pixels().len()];
-    let mut fixed = vec![true; film.pixels().len()];
+    let mut fixed: Vec<bool> = film.pixels().iter().map(|p| p.count() == 0).collect();
     let two_stage = adaptive.rule == AdaptiveRule::TwoStage;
+    let start = Instant::now();
     if two_stage {
-        let plans: Vec<(TileResult, Vec<u32>)> = tiles
+        let plans: Vec<(TileResult, Vec<u32>)> = frame
+            .tiles
             .par_iter()
             .map(|&(x0, y0)| {
-                let (w, h, mut out) = new_tile(x0, y0);
+                let (w, h, mut out) = frame.new_tile(x0, y0);
                 let seed = settings.seed ^ Adaptive::PILOT_STREAM;
                 let mut pilot_sampler = settings.sampler.build(batch, seed);
                 let mut plan = vec![0u32; (w * h) as usize];
@@ -323,8 +326,8 @@ fn render_adaptive(
                     let mut pilot = PixelStats::default();
                     let before = out.path.random_vertices;
                     let (ok, bad) = sample_pixel(
-                        scene,
-                        integrator,
+                        frame.scene,
+                        frame.integrator,
                         &mut pilot_sampler,
                         pixel,
                         0..batch,
@@ -348,14 +351,15 @@ fn render_adaptive(
             }
             results.push(t);
         }
-        merge(film, stats, results);
+        Frame::merge(film, stats, results);
     }
     while !cancel.load(Ordering::Relaxed) {
         let (film_now, target_now) = (&*film, &target);
-        let rounds: Vec<(TileResult, Vec<bool>)> = tiles
+        let rounds: Vec<(TileResult, Vec<bool>)> = frame
+            .tiles
             .par_iter()
             .map(|&(x0, y0)| {
-                let (w, h, mut out) = new_tile(x0, y0);
+                let (w, h, mut out) = frame.new_tile(x0, y0);
                 let mut sampler = settings.sampler.build(settings.spp, settings.seed);
                 let mut tile_fixed = vec![true; (w * h) as usize];
                 for k in 0..w * h {
@@ -370,8 +374,8 @@ fn render_adaptive(
                     }
                     let before = out.path.random_vertices;
                     let (ok, bad) = sample_pixel(
-                        scene,
-                        integrator,
+                        frame.scene,
+                        frame.integrator,
                         &mut sampler,
                         [x, y],
                         held..end,
@@ -398,7 +402,7 @@ fn render_adaptive(
             }
             results.push(t);
         }
-        merge(film, stats, results);
+        Frame::merge(film, stats, results);
         if !worked {
             break;
         }
@@ -411,50 +415,66 @@ fn render_adaptive(
                 }
             }
         }
+        stats.seconds = start.elapsed().as_secs_f64();
+        if !cancel.load(Ordering::Relaxed) {
+            after_round(film, stats);
+        }
     }
 }
 
-/// [`render`] continuing `film` (a checkpoint's, or an empty one): every pixel goes on from
-/// the samples it holds to the end of the settings' sample range, in whole-frame passes
-/// ([`pass_ends`]); after each finished pass `after_pass(film, stats so far)` is called (to
-/// write checkpoints). Adaptive sampling runs its own per-pixel batches instead.
-pub fn render_from(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    settings: &RenderSettings,
-    mut film: Film,
-    progress: &(dyn Fn(u64) + Sync),
-    cancel: &AtomicBool,
-    after_pass: &mut dyn FnMut(&Film, &RenderStats),
-) -> (Film, RenderStats) {
-    let [width, height] = scene.camera().resolution();
-    let [cx0, cy0, cx1, cy1] = settings
-        .crop
-        .map_or([0, 0, width, height], |[x0, y0, x1, y1]| {
-            [x0.min(width), y0.min(height), x1.min(width), y1.min(height)]
-        });
-    let tiles: Vec<(u32, u32)> = (cy0..cy1)
-        .step_by(TILE_SIZE as usize)
-        .flat_map(|y| (cx0..cx1).step_by(TILE_SIZE as usize).map(move |x| (x, y)))
-        .collect();
-    let start = Instant::now();
-    let mut stats = RenderStats::default();
-    let merge = |film: &mut Film, stats: &mut RenderStats, results: Vec<TileResult>| {
-        for t in &results {
-            for (i, p) in t.pixels.iter().enumerate() {
-                let (x, y) = (t.x0 + i as u32 % t.w, t.y0 + i as u32 / t.w);
-                film.pixel_mut(x, y).merge(p);
-            }
-            stats.samples += t.samples;
-            stats.nonfinite_samples += t.nonfinite;
-            stats.pilot_samples += t.pilot;
-            stats.rays += t.path.rays;
-            stats.nodes_visited += t.path.nodes_visited;
+/// The pixels a render covers (its crop window, or the whole image) cut into tiles, and the
+/// one routine that adds samples to them: every mode (fixed spp, adaptive rounds, the
+/// progressive passes of `--time`/`--target-error`) renders in whole-frame passes through it.
+pub(crate) struct Frame<'a> {
+    scene: &'a Scene,
+    integrator: &'a dyn Integrator,
+    settings: &'a RenderSettings,
+    /// `[x0, y0, x1, y1]` of the pixels rendered.
+    window: [u32; 4],
+    tiles: Vec<(u32, u32)>,
+}
+
+impl<'a> Frame<'a> {
+    pub(crate) fn new(
+        scene: &'a Scene,
+        integrator: &'a dyn Integrator,
+        settings: &'a RenderSettings,
+    ) -> Self {
+        let [width, height] = scene.camera().resolution();
+        let window = settings
+            .crop
+            .map_or([0, 0, width, height], |[x0, y0, x1, y1]| {
+                [x0.min(width), y0.min(height), x1.min(width), y1.min(height)]
+            });
+        let [cx0, cy0, cx1, cy1] = window;
+        let tiles = (cy0..cy1)
+            .step_by(TILE_SIZE as usize)
+            .flat_map(|y| (cx0..cx1).step_by(TILE_SIZE as usize).map(move |x| (x, y)))
+            .collect();
+        Frame {
+            scene,
+            integrator,
+            settings,
+            window,
+            tiles,
         }
-    };
-    let new_tile = |x0: u32, y0: u32| {
-        let w = TILE_SIZE.min(cx1 - x0);
-        let h = TILE_SIZE.min(cy1 - y0);
+    }
+
+    /// Whether pixel `[x, y]` is rendered.
+    pub(crate) fn covers(&self, x: u32, y: u32) -> bool {
+        let [x0, y0, x1, y1] = self.window;
+        (x0..x1).contains(&x) && (y0..y1).contains(&y)
+    }
+
+    /// How many pixels are rendered.
+    pub(crate) fn pixel_count(&self) -> u64 {
+        let [x0, y0, x1, y1] = self.window;
+        (x1 - x0) as u64 * (y1 - y0) as u64
+    }
+
+    fn new_tile(&self, x0: u32, y0: u32) -> (u32, u32, TileResult) {
+        let w = TILE_SIZE.min(self.window[2] - x0);
+        let h = TILE_SIZE.min(self.window[3] - y0);
         let out = TileResult {
             x0,
             y0,
@@ -466,53 +486,104 @@ pub fn render_from(
             pilot: 0,
         };
         (w, h, out)
-    };
+    }
+
+    /// Adds each tile's samples to the film and its counts to the statistics.
+    fn merge(film: &mut Film, stats: &mut RenderStats, results: Vec<TileResult>) {
+        for t in &results {
+            for (i, p) in t.pixels.iter().enumerate() {
+                let (x, y) = (t.x0 + i as u32 % t.w, t.y0 + i as u32 / t.w);
+                film.pixel_mut(x, y).merge(p);
+            }
+            stats.samples += t.samples;
+            stats.nonfinite_samples += t.nonfinite;
+            stats.pilot_samples += t.pilot;
+            stats.rays += t.path.rays;
+            stats.nodes_visited += t.path.nodes_visited;
+        }
+    }
+
+    /// One whole-frame pass: pixel `[x, y]` holding `held` samples takes the sample indices
+    /// from `range start + held` up to `end(x, y, held)` (none if that is not beyond), tile
+    /// by tile on the thread pool; the film gets them when the pass is done. Cancelling stops
+    /// at the next sample and keeps those finished.
+    pub(crate) fn pass(
+        &self,
+        film: &mut Film,
+        stats: &mut RenderStats,
+        end: &(dyn Fn(u32, u32, u64) -> u32 + Sync),
+        progress: &(dyn Fn(u64) + Sync),
+        cancel: &AtomicBool,
+    ) {
+        let first = self.settings.sample_range.map_or(0, |r| r[0]);
+        let film_now = &*film;
+        let results: Vec<TileResult> = self
+            .tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                let (w, h, mut out) = self.new_tile(x0, y0);
+                let mut sampler = self
+                    .settings
+                    .sampler
+                    .build(self.settings.spp, self.settings.seed);
+                // The tile's pixels one after another, each from the samples it holds to its
+                // end, so that an integrator following several paths at once keeps them all
+                // busy to the tile's end.
+                let mut samples = (0..w * h).flat_map(|tag| {
+                    let pixel = [x0 + tag % w, y0 + tag / w];
+                    let held = film_now.pixel(pixel[0], pixel[1]).count();
+                    let to = end(pixel[0], pixel[1], held);
+                    let from = (first as u64 + held).min(to as u64) as u32;
+                    (from..to)
+                        .take_while(|_| !cancel.load(Ordering::Relaxed))
+                        .map(move |index| SampleRef { pixel, index, tag })
+                });
+                let (mut ok, mut bad) = (0, 0);
+                let pixels = &mut out.pixels;
+                self.integrator.li_samples(
+                    self.scene,
+                    &mut sampler,
+                    &mut samples,
+                    &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
+                    &mut out.path,
+                );
+                out.samples += ok;
+                out.nonfinite += bad;
+                progress(ok + bad);
+                out
+            })
+            .collect();
+        Self::merge(film, stats, results);
+    }
+}
+
+/// [`render`] continuing `film` (a checkpoint's, or an empty one): every pixel goes on from
+/// the samples it holds to the end of the settings' sample range, in whole-frame passes
+/// ([`pass_ends`]); after each finished pass `after_pass(film, stats so far)` is called (to
+/// write checkpoints). Adaptive sampling runs in rounds of per-pixel batches instead.
+pub fn render_from(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    settings: &RenderSettings,
+    mut film: Film,
+    progress: &(dyn Fn(u64) + Sync),
+    cancel: &AtomicBool,
+    after_pass: &mut dyn FnMut(&Film, &RenderStats),
+) -> (Film, RenderStats) {
+    let frame = Frame::new(scene, integrator, settings);
+    let start = Instant::now();
+    let mut stats = RenderStats::default();
     if let Some(adaptive) = settings.adaptive {
         render_adaptive(
-            scene, integrator, settings, adaptive, &tiles, &new_tile, &mut film, &mut stats,
-            &merge, progress, cancel,
+            &frame, adaptive, &mut film, &mut stats, progress, cancel, after_pass,
         );
     } else {
         let [first, end] = settings.sample_range.unwrap_or([0, settings.spp]);
-        let pixels = (cx1 - cx0) as u64 * (cy1 - cy0) as u64;
-        for pass_end in pass_ends(first, end, steady_pass(pixels)) {
+        for pass_end in pass_ends(first, end, steady_pass(frame.pixel_count())) {
             if cancel.load(Ordering::Relaxed) {
                 break;
             }
-            let film_now = &film;
-            let results: Vec<TileResult> = tiles
-                .par_iter()
-                .map(|&(x0, y0)| {
-                    let (w, h, mut out) = new_tile(x0, y0);
-                    let mut sampler = settings.sampler.build(settings.spp, settings.seed);
-                    // The tile's pixels one after another, each from the samples it holds to
-                    // the pass's end, so that an integrator following several paths at once
-                    // keeps them all busy to the tile's end. Cancelling stops at the next
-                    // sample.
-                    let mut samples = (0..w * h).flat_map(|tag| {
-                        let pixel = [x0 + tag % w, y0 + tag / w];
-                        let held = film_now.pixel(pixel[0], pixel[1]).count();
-                        let from = (first as u64 + held).min(pass_end as u64) as u32;
-                        (from..pass_end)
-                            .take_while(|_| !cancel.load(Ordering::Relaxed))
-                            .map(move |index| SampleRef { pixel, index, tag })
-                    });
-                    let (mut ok, mut bad) = (0, 0);
-                    let pixels = &mut out.pixels;
-                    integrator.li_samples(
-                        scene,
-                        &mut sampler,
-                        &mut samples,
-                        &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
-                        &mut out.path,
-                    );
-                    out.samples += ok;
-                    out.nonfinite += bad;
-                    progress(ok + bad);
-                    out
-                })
-                .collect();
-            merge(&mut film, &mut stats, results);
+            frame.pass(&mut film, &mut stats, &|_, _, _| pass_end, progress, cancel);
             stats.seconds = start.elapsed().as_secs_f64();
             if !cancel.load(Ordering::Relaxed) {
                 after_pass(&film, &stats);

@@ -785,3 +785,110 @@ fn passes_resumes_and_sample_ranges_give_the_same_film_to_the_bit() {
         assert!(merged == whole, "{sampler:?}: merged shards differ");
     }
 }
+
+/// Runs `go(cancel, after_pass)` with a pass callback that stops the render after `n` passes
+/// and keeps the film as that pass left it.
+fn film_after_passes(
+    n: u32,
+    go: impl FnOnce(&std::sync::atomic::AtomicBool, &mut dyn FnMut(&Film)),
+) -> Film {
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let mut passes = 0;
+    let mut kept = None;
+    go(&stop, &mut |film| {
+        passes += 1;
+        if passes == n {
+            kept = Some(film.clone());
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+    });
+    kept.expect("the render ran that many passes")
+}
+
+#[test]
+fn progressive_and_adaptive_renders_resume_to_the_same_film_to_the_bit() {
+    use pathlab_render::progressive::{render_progressive, render_progressive_from, StopRule};
+    use pathlab_render::render::{render_from, Adaptive};
+    let desc = big_light();
+    let scene = Scene::build(&desc).unwrap();
+    let integrator = path(u32::MAX);
+    let settings = RenderSettings::new(1, 9, SamplerKind::Independent);
+    // --target-error: the allocation of each pass is a function of the film.
+    let stop = StopRule {
+        target_error: Some(0.06),
+        time_limit: None,
+        max_spp: 1 << 12,
+    };
+    let (whole, _, report) = render_progressive(
+        &scene,
+        &integrator,
+        &settings,
+        &stop,
+        &|_, _| {},
+        &Default::default(),
+    );
+    assert_eq!(report.stopped_by, "target", "{report:?}");
+    assert!(report.passes >= 3, "{report:?}");
+    let counts = |f: &Film| f.pixels().iter().map(|p| p.count()).collect::<Vec<_>>();
+    assert!(
+        counts(&whole).windows(2).any(|w| w[0] != w[1]),
+        "the passes are spent unevenly"
+    );
+    let part = film_after_passes(2, |cancel, keep| {
+        render_progressive_from(
+            &scene,
+            &integrator,
+            &settings,
+            &stop,
+            Film::new(24, 24),
+            &|_| {},
+            cancel,
+            &mut |f, _, _, _| keep(f),
+        );
+    });
+    let (resumed, _, again) = render_progressive_from(
+        &scene,
+        &integrator,
+        &settings,
+        &stop,
+        part,
+        &|_| {},
+        &Default::default(),
+        &mut |_, _, _, _| {},
+    );
+    assert_eq!(again.passes + 2, report.passes);
+    assert!(resumed == whole, "resumed progressive film differs");
+    // Adaptive, two-stage rule: the plan is drawn again from its own stream.
+    let settings = RenderSettings {
+        adaptive: Some(Adaptive {
+            batch: 4,
+            ..Adaptive::DEFAULT
+        }),
+        ..RenderSettings::new(64, 9, SamplerKind::Sobol)
+    };
+    let (whole, _) = render(&scene, &integrator, &settings, &|_| {}, &Default::default());
+    assert!(counts(&whole).windows(2).any(|w| w[0] != w[1]));
+    let part = film_after_passes(2, |cancel, keep| {
+        render_from(
+            &scene,
+            &integrator,
+            &settings,
+            Film::new(24, 24),
+            &|_| {},
+            cancel,
+            &mut |f, _| keep(f),
+        );
+    });
+    assert!(counts(&part) != counts(&whole));
+    let resumed = render_from(
+        &scene,
+        &integrator,
+        &settings,
+        part,
+        &|_| {},
+        &Default::default(),
+        &mut |_, _| {},
+    )
+    .0;
+    assert!(resumed == whole, "resumed adaptive film differs");
+}
