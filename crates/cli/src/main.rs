@@ -81,6 +81,22 @@ fn main() -> ExitCode {
     }
 }
 
+/// The first paragraph of clap's message as one line: "the following required arguments were
+/// not provided:" keeps the arguments listed under it.
+fn first_paragraph(text: &str) -> String {
+    let lines: Vec<&str> = text
+        .lines()
+        .skip_while(|l| l.trim().is_empty())
+        .take_while(|l| !l.trim().is_empty())
+        .map(str::trim)
+        .collect();
+    if lines.is_empty() {
+        "error: invalid arguments".to_string()
+    } else {
+        lines.join(" ")
+    }
+}
+
 /// A command line clap refused: help and version as clap prints them; any other error as one
 /// line (its first), as every other error is.
 fn argument_error(e: clap::Error) -> ExitCode {
@@ -89,12 +105,7 @@ fn argument_error(e: clap::Error) -> ExitCode {
         | ErrorKind::DisplayVersion
         | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => e.exit(),
         _ => {
-            let text = e.to_string();
-            let first = text
-                .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("error: invalid arguments");
-            eprintln!("{} (see --help)", first.trim_end());
+            eprintln!("{} (see --help)", first_paragraph(&e.to_string()));
             ExitCode::from(2)
         }
     }

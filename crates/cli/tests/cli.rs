@@ -1730,3 +1730,12 @@ fn progressive_and_adaptive_renders_checkpoint_and_resume_to_the_same_image() {
         "two-stage",
     );
 }
+
+#[test]
+fn refused_command_lines_are_one_line_errors_that_name_the_argument() {
+    let o = pathlab(&["diff", "a.exr"]);
+    assert_one_line_error(&o, "required arguments were not provided: <B>");
+    assert_eq!(o.status.code(), Some(2));
+    assert_one_line_error(&pathlab(&["render", "--bogus"]), "'--bogus'");
+    assert_one_line_error(&pathlab(&["render", "-s", "x"]), "'--spp <SPP>'");
+}

@@ -72,7 +72,12 @@ impl Builder {
                 DVec3::new(v[0], v[1], v[2])
             }
             ("blackbody", Some(v), _) => {
-                let t = v.first().copied().unwrap_or(0.0);
+                let &[t] = v else {
+                    return Err(self.error(format!(
+                        "{decl}: expected one temperature, found {} numbers",
+                        v.len()
+                    )));
+                };
                 if t <= 0.0 {
                     return Err(self.error(format!("{decl}: a temperature in kelvin > 0")));
                 }
@@ -103,8 +108,13 @@ impl Builder {
                 }
             }
             ("spectrum", _, Some(names)) => {
-                let name = names.first().cloned().unwrap_or_default();
-                self.named_spectrum(&name, &decl)?
+                let [name] = names else {
+                    return Err(self.error(format!(
+                        "{decl}: expected one spectrum name, found {}",
+                        names.len()
+                    )));
+                };
+                self.named_spectrum(name, &decl)?
             }
             (ty, _, _) => {
                 return Err(self.error(format!("{decl}: a '{ty}' where a spectrum was expected")))
@@ -150,12 +160,19 @@ impl Builder {
         }
     }
 
-    /// A float parameter (first value) or `default`.
+    /// A float parameter (exactly one value, as pbrt-v4 requires) or `default`.
     pub(crate) fn float(&self, params: &ParamList, name: &str, default: f64) -> Result<f64, Error> {
         match params.get(name) {
             None => Ok(default),
             Some(p) => match p.numbers() {
-                Some([v, ..]) => Ok(*v),
+                Some([v]) => Ok(*v),
+                Some(v) if v.len() > 1 => Err(self.error(format!(
+                    "\"{} {}\" (line {}): expected one number, found {}",
+                    p.ty,
+                    p.name,
+                    p.line,
+                    v.len()
+                ))),
                 _ => Err(self.error(format!(
                     "\"{} {}\" (line {}): expected a number",
                     p.ty, p.name, p.line
@@ -174,9 +191,9 @@ impl Builder {
         match params.get(name) {
             None => Ok(default),
             Some(p) => match &p.values {
-                super::params::Values::Bools(v) if !v.is_empty() => Ok(v[0]),
+                super::params::Values::Bools(v) if v.len() == 1 => Ok(v[0]),
                 _ => Err(self.error(format!(
-                    "\"{} {}\" (line {}): expected true or false",
+                    "\"{} {}\" (line {}): expected one true or false",
                     p.ty, p.name, p.line
                 ))),
             },
@@ -188,9 +205,9 @@ impl Builder {
         match params.get(name) {
             None => Ok(None),
             Some(p) => match p.strings() {
-                Some([s, ..]) => Ok(Some(s.clone())),
+                Some([s]) => Ok(Some(s.clone())),
                 _ => Err(self.error(format!(
-                    "\"{} {}\" (line {}): expected a string",
+                    "\"{} {}\" (line {}): expected one string",
                     p.ty, p.name, p.line
                 ))),
             },
@@ -213,11 +230,15 @@ impl Builder {
             return Ok(None);
         };
         p.used.set(true);
-        let tex = p
-            .strings()
-            .and_then(|s| s.first())
-            .cloned()
-            .unwrap_or_default();
+        let tex = match p.strings() {
+            Some([t]) => t.clone(),
+            _ => {
+                return Err(self.error(format!(
+                    "\"texture {name}\" (line {}): expected one texture name",
+                    p.line
+                )))
+            }
+        };
         match self.textures.get(&tex) {
             Some(t) => Ok(Some(t.clone())),
             None => Err(self.error(format!(
