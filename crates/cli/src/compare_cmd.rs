@@ -222,7 +222,7 @@ fn write_side_by_side(rows: &[Row], path: &std::path::Path) -> Result<()> {
             }
         }
     }
-    crate::plot::register_font();
+    pathlab_lab::plot::register_font();
     {
         let root = BitMapBackend::with_buffer(&mut buf, (tw, th)).into_drawing_area();
         for (k, r) in rows.iter().enumerate() {

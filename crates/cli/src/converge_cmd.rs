@@ -1,9 +1,9 @@
 //! `pathlab converge`: how the error against a reference falls with samples and with time, for
 //! independent and Sobol sampling and for uniform and error-driven sample allocation.
 
-use crate::plot::{self, RmseCurve};
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use pathlab_lab::plot::{self, RmseCurve};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::film::Film;
 use pathlab_render::image_io::read_exr_rgb;

@@ -1,17 +1,14 @@
-//! `pathlab integrate`: Monte Carlo estimate of an integral over a box.
+//! `pathlab integrate`: the arguments and the report of [`pathlab_lab::integrate`] (a Monte
+//! Carlo estimate of an integral over a box, with its error and a convergence study).
 
-use crate::expr::{parse_constant, Expression, MAX_DIMS};
-use crate::plot;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use glam::Vec2;
-use pathlab_mc::distribution::{PiecewiseConstant1D, PiecewiseConstant2D};
-use pathlab_mc::estimator::{
-    integrate_parallel, largest_term_share, looks_heavy_tailed, Estimate, RunningStats,
-};
-use pathlab_mc::sampler::{AnySampler, Sampler, SamplerKind};
+use pathlab_lab::expr::parse_constant;
+use pathlab_lab::integrate::{convergence, point_text, Integral};
+use pathlab_lab::plot;
+use pathlab_mc::estimator::looks_heavy_tailed;
+use pathlab_mc::sampler::SamplerKind;
 use pathlab_mc::stats::z_test;
-use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -66,59 +63,6 @@ pub struct IntegrateArgs {
     pub json: bool,
 }
 
-/// How points are drawn: uniformly in the box, or from a tabulated importance density.
-enum Proposal {
-    Uniform {
-        lo: Vec<f64>,
-        size: Vec<f64>,
-        pdf: f64,
-    },
-    Table1D(PiecewiseConstant1D),
-    Table2D(PiecewiseConstant2D),
-}
-
-impl Proposal {
-    /// Draws a point into `x` and returns its density.
-    #[inline]
-    fn draw(&self, s: &mut AnySampler, x: &mut [f64; MAX_DIMS]) -> f64 {
-        match self {
-            Proposal::Uniform { lo, size, pdf } => {
-                let d = lo.len();
-                let mut i = 0;
-                while i + 1 < d {
-                    let u = s.next_2d();
-                    x[i] = lo[i] + size[i] * u.x as f64;
-                    x[i + 1] = lo[i + 1] + size[i + 1] * u.y as f64;
-                    i += 2;
-                }
-                if i < d {
-                    x[i] = lo[i] + size[i] * s.next_1d() as f64;
-                }
-                *pdf
-            }
-            Proposal::Table1D(t) => {
-                let smp = t.sample(s.next_1d());
-                x[0] = smp.x as f64;
-                smp.pdf as f64
-            }
-            Proposal::Table2D(t) => {
-                let (p, pdf) = t.sample(s.next_2d());
-                x[0] = p.x as f64;
-                x[1] = p.y as f64;
-                pdf as f64
-            }
-        }
-    }
-}
-
-/// Checked settings of a run.
-struct Problem {
-    f: Expression,
-    domains: Vec<(f64, f64)>,
-    proposal: Proposal,
-    warnings: Vec<String>,
-}
-
 fn parse_domain(text: &str) -> Result<(f64, f64)> {
     let parts: Vec<&str> = text.split(',').collect();
     if parts.len() != 2 {
@@ -135,203 +79,12 @@ fn parse_domain(text: &str) -> Result<(f64, f64)> {
     Ok((a, b))
 }
 
-fn build_problem(args: &IntegrateArgs) -> Result<Problem> {
-    if args.domain.len() > MAX_DIMS {
-        bail!(
-            "at most {MAX_DIMS} dimensions are supported, got {}",
-            args.domain.len()
-        );
-    }
-    let domains = args
-        .domain
-        .iter()
-        .map(|d| parse_domain(d))
-        .collect::<Result<Vec<_>>>()?;
-    let dims = domains.len();
-    let f = Expression::parse(&args.expression, dims, "the integrand")?;
-    let mut warnings = Vec::new();
-    let proposal = match &args.importance {
-        None => {
-            let lo: Vec<f64> = domains.iter().map(|d| d.0).collect();
-            let size: Vec<f64> = domains.iter().map(|d| d.1 - d.0).collect();
-            let volume: f64 = size.iter().product();
-            Proposal::Uniform {
-                lo,
-                size,
-                pdf: 1.0 / volume,
-            }
-        }
-        Some(text) => {
-            if dims > 2 {
-                bail!(
-                    "--importance tabulates its density on a grid and supports 1 or 2 \
-                     dimensions; this domain has {dims}"
-                );
-            }
-            let res = args.importance_res;
-            if !(1..=4096).contains(&res) {
-                bail!("--importance-res must be between 1 and 4096, got {res}");
-            }
-            let g = Expression::parse(text, dims, "the --importance density")?;
-            let cells = if dims == 1 { res } else { res * res };
-            let mut values = Vec::with_capacity(cells);
-            for c in 0..cells {
-                let (i, j) = (c % res, c / res);
-                let mut x = [0.0; 2];
-                x[0] = domains[0].0 + (i as f64 + 0.5) / res as f64 * (domains[0].1 - domains[0].0);
-                if dims == 2 {
-                    x[1] = domains[1].0
-                        + (j as f64 + 0.5) / res as f64 * (domains[1].1 - domains[1].0);
-                }
-                let v = g.eval(&x[..dims]);
-                if !v.is_finite() || v < 0.0 {
-                    bail!(
-                        "the --importance density must be finite and >= 0, but \"{text}\" is {v} \
-                         at {}",
-                        point_text(&x[..dims])
-                    );
-                }
-                values.push(v as f32);
-            }
-            let zeros = values.iter().filter(|&&v| v == 0.0).count();
-            if zeros == values.len() {
-                bail!("the --importance density \"{text}\" is zero everywhere on the domain");
-            }
-            if zeros > 0 {
-                warnings.push(format!(
-                    "the --importance density is zero on {zeros} of {} grid cells: the estimate \
-                     only covers the region where it is positive",
-                    values.len()
-                ));
-            }
-            if dims == 1 {
-                Proposal::Table1D(PiecewiseConstant1D::new(
-                    &values,
-                    domains[0].0 as f32,
-                    domains[0].1 as f32,
-                )?)
-            } else {
-                Proposal::Table2D(PiecewiseConstant2D::new(
-                    &values,
-                    res,
-                    res,
-                    Vec2::new(domains[0].0 as f32, domains[1].0 as f32),
-                    Vec2::new(domains[0].1 as f32, domains[1].1 as f32),
-                )?)
-            }
-        }
-    };
-    Ok(Problem {
-        f,
-        domains,
-        proposal,
-        warnings,
-    })
-}
-
-fn point_text(x: &[f64]) -> String {
-    let names: Vec<String> = if x.len() <= 4 {
-        ["x", "y", "z", "w"][..x.len()]
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
-    } else {
-        (1..=x.len()).map(|i| format!("x{i}")).collect()
-    };
-    let parts: Vec<String> = names
-        .iter()
-        .zip(x)
-        .map(|(n, v)| format!("{n} = {v}"))
-        .collect();
-    parts.join(", ")
-}
-
-impl Problem {
-    /// The integrand at a point.
-    fn integrand(&self, x: &[f64; MAX_DIMS]) -> f64 {
-        self.f.eval(&x[..self.domains.len()])
-    }
-
-    /// A point drawn from the proposal, and its density.
-    fn draw_point(&self, s: &mut pathlab_mc::sampler::AnySampler) -> ([f64; MAX_DIMS], f64) {
-        let mut x = [0.0; MAX_DIMS];
-        let pdf = self.proposal.draw(s, &mut x);
-        (x, pdf)
-    }
-
-    /// The estimate from `n` samples of `kind` with `seed`.
-    fn estimate(&self, kind: SamplerKind, n: u32, seed: u64) -> Estimate {
-        let sampler = kind.build(n, seed);
-        integrate_parallel(|x| self.integrand(x), &sampler, |s| self.draw_point(s), n)
-    }
-
-    /// The estimate and a valid standard error for any sampler: independent samples use their
-    /// sample variance; stratified and Sobol use `reps` independent randomisations (seeds) of
-    /// `n / reps` samples each, the standard error being that of the mean of the replicates.
-    fn estimate_with_error(&self, kind: SamplerKind, n: u32, reps: u32, seed: u64) -> Estimate {
-        if kind == SamplerKind::Independent || reps < 2 {
-            return self.estimate(kind, n, seed);
-        }
-        let per = (n / reps).max(1);
-        let means: Vec<f64> = (0..reps)
-            .into_par_iter()
-            .map(|r| {
-                self.estimate(kind, per, seed.wrapping_add(r as u64 * 0x9e37_79b9))
-                    .mean
-            })
-            .collect();
-        let mut stats = RunningStats::new();
-        means.iter().for_each(|&m| stats.push(m));
-        let mut e = stats.estimate();
-        e.n = per as u64 * reps as u64;
-        e.variance *= per as f64; // variance of one term, for comparability
-        e
-    }
-
-    /// The share of the sample variance carried by the largest of the terms f/p (see
-    /// [`largest_term_share`]).
-    fn largest_share(&self, kind: SamplerKind, n: u32, seed: u64, mean: f64) -> f64 {
-        let sampler = kind.build(n, seed);
-        largest_term_share(
-            |x| self.integrand(x),
-            &sampler,
-            |s| self.draw_point(s),
-            n,
-            mean,
-        )
-    }
-
-    /// Finds a sample point where the integrand is not finite (for the error message).
-    fn find_non_finite(&self, kind: SamplerKind, n: u32, seed: u64) -> Option<[f64; MAX_DIMS]> {
-        let mut s = kind.build(n, seed);
-        (0..n).find_map(|i| {
-            s.start_pixel_sample([0, 0], i, 0);
-            let mut x = [0.0; MAX_DIMS];
-            let pdf = self.proposal.draw(&mut s, &mut x);
-            (pdf > 0.0 && !self.f.eval(&x[..self.domains.len()]).is_finite()).then_some(x)
-        })
-    }
-
-    fn domain_text(&self) -> String {
-        let parts: Vec<String> = self
-            .domains
-            .iter()
-            .map(|(a, b)| format!("[{}, {}]", fmt_num(*a), fmt_num(*b)))
-            .collect();
-        parts.join(" x ")
-    }
-}
-
 fn percent(v: f64) -> String {
     if v >= 1e-3 || v == 0.0 {
         format!("{:.3}%", 100.0 * v)
     } else {
         format!("{:.2e}%", 100.0 * v)
     }
-}
-
-fn fmt_num(v: f64) -> String {
-    format!("{}", (v * 1e9).round() / 1e9)
 }
 
 /// Runs `pathlab integrate`.
@@ -359,7 +112,22 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
         .as_deref()
         .map(|t| parse_constant(t).with_context(|| format!("--exact {t}")))
         .transpose()?;
-    let problem = build_problem(args)?;
+    let domains = args
+        .domain
+        .iter()
+        .map(|d| parse_domain(d))
+        .collect::<Result<Vec<_>>>()?;
+    let problem = Integral::new(
+        &args.expression,
+        domains,
+        args.importance.as_deref().map(|g| (g, args.importance_res)),
+    )
+    .map_err(|e| match &args.importance {
+        // Name the flags behind the importance density's errors.
+        Some(_) if e.to_string().contains("importance grid") => e.context("--importance-res"),
+        Some(_) if e.to_string().contains("importance") => e.context("--importance"),
+        _ => e,
+    })?;
     for w in &problem.warnings {
         eprintln!("warning: {w}");
     }
@@ -391,7 +159,7 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
     }
 
     let convergence = match &args.convergence {
-        Some(path) => Some(convergence(
+        Some(path) => Some(convergence_report(
             &problem,
             n,
             args.reps.max(4),
@@ -477,9 +245,9 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
     Ok(())
 }
 
-/// Estimates at N = 2^k for each sampler, `reps` independent randomisations each; plots them.
-fn convergence(
-    problem: &Problem,
+/// The convergence study of the three samplers, plotted to `path`, as JSON.
+fn convergence_report(
+    problem: &Integral,
     n: u32,
     reps: u32,
     seed: u64,
@@ -487,69 +255,14 @@ fn convergence(
     path: &std::path::Path,
 ) -> Result<Value> {
     let format = plot::Format::from_path(path)?;
-    let max_k = (n as f64).log2().floor() as u32;
-    let min_k = 4.min(max_k);
-    let ks: Vec<u32> = (min_k..=max_k).collect();
-    let jobs: Vec<(usize, u32, u32)> = SamplerKind::ALL
-        .iter()
-        .enumerate()
-        .flat_map(|(si, _)| {
-            ks.iter()
-                .flat_map(move |&k| (0..reps).map(move |r| (si, k, r)))
-        })
-        .collect();
-    let results: Vec<f64> = jobs
-        .par_iter()
-        .map(|&(si, k, r)| {
-            let seed = seed.wrapping_add(1 + r as u64 * 7919);
-            problem.estimate(SamplerKind::ALL[si], 1 << k, seed).mean
-        })
-        .collect();
-    // The reference for the error: the exact value, or the pooled mean of the largest runs.
-    let reference = exact.unwrap_or_else(|| {
-        let largest: Vec<f64> = jobs
-            .iter()
-            .zip(&results)
-            .filter(|((_, k, _), _)| *k == max_k)
-            .map(|(_, &m)| m)
-            .collect();
-        largest.iter().sum::<f64>() / largest.len() as f64
-    });
-    let mut series = Vec::new();
-    for (si, kind) in SamplerKind::ALL.iter().enumerate() {
-        let mut points = Vec::new();
-        for &k in &ks {
-            let vals: Vec<f64> = jobs
-                .iter()
-                .zip(&results)
-                .filter(|((s, kk, _), _)| *s == si && *kk == k)
-                .map(|(_, &m)| m)
-                .collect();
-            let mut st = RunningStats::new();
-            vals.iter().for_each(|&v| st.push(v));
-            let rmse = (vals.iter().map(|v| (v - reference).powi(2)).sum::<f64>()
-                / vals.len() as f64)
-                .sqrt();
-            points.push(plot::ConvergencePoint {
-                n: (1u64 << k) as f64,
-                estimate: vals[0],
-                ci_half: 1.96 * st.std_dev(),
-                rmse,
-            });
-        }
-        series.push(plot::ConvergenceSeries {
-            name: kind.name().to_string(),
-            slope: plot::fitted_slope(&points),
-            points,
-        });
-    }
+    let study = convergence(problem, n, reps, seed, exact);
     let title = format!("∫ {} over {}", problem.f.text(), problem.domain_text());
-    plot::convergence(path, format, &title, &series, exact, exact.is_some())?;
+    plot::convergence(path, format, &title, &study.series, exact, exact.is_some())?;
     Ok(json!({
-        "reference": reference,
+        "reference": study.reference,
         "reference_is_exact": exact.is_some(),
         "replications": reps,
-        "series": series.iter().map(|s| json!({
+        "series": study.series.iter().map(|s| json!({
             "sampler": s.name,
             "fitted_slope": s.slope,
             "n": s.points.iter().map(|p| p.n).collect::<Vec<_>>(),

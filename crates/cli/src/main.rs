@@ -3,13 +3,11 @@
 mod bench_cmd;
 mod compare_cmd;
 mod converge_cmd;
-mod expr;
 mod farm;
 mod image_cmd;
 mod images;
 mod info_cmd;
 mod integrate;
-mod plot;
 mod render_cmd;
 mod sample;
 

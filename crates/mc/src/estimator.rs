@@ -294,6 +294,41 @@ pub fn looks_heavy_tailed(share: f64, n: u64) -> bool {
     share > 0.05 && share > 10.0 * ln * ln / n as f64
 }
 
+/// The estimate from independent randomisations (replicates) of a sampler whose samples are
+/// not independent (stratified, Sobol): `means` are the replicates' estimates, each of
+/// `per_replicate` samples. The estimate is their mean, its standard error and interval those
+/// of a mean of `means.len()` independent values (Student's t with R - 1 degrees of freedom);
+/// `n` counts every sample and `variance` is scaled to one sample's (R × per_replicate × se²)
+/// so that it compares with an independent sampler's.
+pub fn replicate_estimate(means: &[f64], per_replicate: u64) -> Estimate {
+    let mut stats = RunningStats::new();
+    means.iter().for_each(|&m| stats.push(m));
+    let mut e = stats.estimate();
+    e.n = per_replicate * means.len() as u64;
+    e.variance *= per_replicate as f64;
+    e
+}
+
+/// The least-squares slope of ln(error) against ln(n) over the points `(n, error)` with a
+/// positive, finite error and n > 0: the order of convergence an experiment shows (-1/2 for
+/// plain Monte Carlo, steeper for quasi-Monte Carlo). NaN with fewer than two such points.
+pub fn loglog_slope(points: impl IntoIterator<Item = (f64, f64)>) -> f64 {
+    let pts: Vec<(f64, f64)> = points
+        .into_iter()
+        .filter(|&(n, e)| n > 0.0 && e > 0.0 && e.is_finite())
+        .map(|(n, e)| (n.ln(), e.ln()))
+        .collect();
+    if pts.len() < 2 {
+        return f64::NAN;
+    }
+    let k = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / k;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / k;
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
 #[cfg(test)]
 mod tests {
     use crate::sampler::IndependentSampler;
@@ -367,5 +402,30 @@ mod tests {
         let half = 4.302_652_729_911_275 / 3f64.sqrt();
         assert!((e.ci95_half_width() - half).abs() < 1e-9);
         assert!(e.ci95_contains(2.0));
+    }
+
+    #[test]
+    fn loglog_slope_recovers_a_power_law() {
+        let pts = (0..8).map(|k| {
+            let n = 16.0 * 2f64.powi(k);
+            (n, 3.0 * n.powf(-0.5))
+        });
+        assert!((loglog_slope(pts) + 0.5).abs() < 1e-12);
+        assert!(loglog_slope([(1.0, 1.0)]).is_nan());
+        assert!(loglog_slope([(1.0, 0.0), (2.0, f64::NAN)]).is_nan());
+    }
+
+    #[test]
+    fn replicates_give_the_standard_error_of_their_mean() {
+        let means = [1.0, 2.0, 3.0, 4.0];
+        let e = replicate_estimate(&means, 100);
+        assert_eq!(e.n, 400);
+        assert_eq!(e.mean, 2.5);
+        // Sample variance of the replicates 5/3; se² = (5/3)/4.
+        assert!((e.std_error - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
+        assert!((e.variance - 100.0 * 5.0 / 3.0).abs() < 1e-9);
+        // t with 3 degrees of freedom, not 1.96.
+        let half = 3.182_446_305_284_263 * e.std_error;
+        assert!((e.ci95.1 - e.mean - half).abs() < 1e-9);
     }
 }

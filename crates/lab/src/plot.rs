@@ -532,24 +532,10 @@ pub struct ConvergenceSeries {
     pub points: Vec<ConvergencePoint>,
 }
 
-/// Least-squares slope of log(rmse) against log(n), over the points with a positive error.
+/// Least-squares slope of log(rmse) against log(n), over the points with a positive error
+/// ([`pathlab_mc::estimator::loglog_slope`]).
 pub fn fitted_slope(points: &[ConvergencePoint]) -> f64 {
-    let pts: Vec<(f64, f64)> = points
-        .iter()
-        .filter(|p| p.rmse > 0.0 && p.rmse.is_finite())
-        .map(|p| (p.n.ln(), p.rmse.ln()))
-        .collect();
-    if pts.len() < 2 {
-        return f64::NAN;
-    }
-    let k = pts.len() as f64;
-    let (mx, my) = (
-        pts.iter().map(|p| p.0).sum::<f64>() / k,
-        pts.iter().map(|p| p.1).sum::<f64>() / k,
-    );
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    sxy / sxx
+    pathlab_mc::estimator::loglog_slope(points.iter().map(|p| (p.n, p.rmse)))
 }
 
 const SERIES_COLOURS: [RGBColor; 3] = [
