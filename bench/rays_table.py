@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Table of pathlab / Embree ratios from the files bench/run.sh writes: MESH.embree.K.txt
-(embree_bench's output) and MESH.pathlab.K.json (`pathlab bench rays --json`) for runs K = 1..N
+(embree_bench's output) and MESH.pathlab.K.json (`pathlab-bench rays --json`) for runs K = 1..N
 taken in turns; each rate is the median over the runs. Usage: rays_table.py WORK N MESH..."""
 import json, re, statistics, sys
 

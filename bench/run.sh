@@ -16,9 +16,10 @@ work="$root/target/bench"
 what="${1:-all}"
 mkdir -p "$work"
 cd "$root"
-# The obvhs feature adds that crate's BVH as a second baseline to `pathlab bench rays`.
-cargo build --release --quiet -p pathlab --features obvhs
+# The obvhs feature adds that crate's BVH as a second baseline to `pathlab-bench rays`.
+cargo build --release --quiet -p pathlab -p pathlab-bench --features pathlab-bench/obvhs
 pathlab="$root/target/release/pathlab"
+bench="$root/target/release/pathlab-bench"
 
 apt_install() {
     local sudo=""
@@ -37,7 +38,7 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
         meshes+=("$name")
     done
     for scene in maxplanck CBbunny; do
-        [ -e "$work/$scene.obj" ] || "$pathlab" bench obj "$root/crates/scene/tests/data/cs184/$scene.dae" "$work/$scene.obj" >/dev/null
+        [ -e "$work/$scene.obj" ] || "$bench" obj "$root/crates/scene/tests/data/cs184/$scene.dae" "$work/$scene.obj" >/dev/null
         meshes+=("$scene")
     done
     threads="$(nproc)"
@@ -47,7 +48,7 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
     for m in "${meshes[@]}"; do
         for rep in $(seq "$reps"); do
             "$work/embree_bench" "$work/$m.obj" "$threads" "$work/$m.rays" > "$work/$m.embree.$rep.txt"
-            "$pathlab" bench rays "$work/$m.obj" "$work/$m.rays" --repeat 5 --json > "$work/$m.pathlab.$rep.json"
+            "$bench" rays "$work/$m.obj" "$work/$m.rays" --repeat 5 --json > "$work/$m.pathlab.$rep.json"
         done
     done
     python3 "$root/bench/rays_table.py" "$work" "$reps" "${meshes[@]}"

@@ -1,17 +1,13 @@
-//! `pathlab compare`: render one scene with several strategies, side by side, with the numbers
-//! that say which converges fastest.
+//! `pathlab compare`: the arguments and the table of [`pathlab_lab::compare`] (one scene with
+//! several strategies, side by side, with the numbers that say which converges fastest).
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use pathlab_lab::compare::{compare, strategy, write_side_by_side};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::film::Film;
-use pathlab_render::image_io::{read_exr_rgb, write_rgb8, ToneMap};
-use pathlab_render::integrator::{
-    DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator, PathLighting,
-};
-use pathlab_render::render::{render, RenderSettings};
+use pathlab_render::image_io::read_exr_rgb;
+use pathlab_render::render::RenderSettings;
 use pathlab_render::scene::Scene;
-use plotters::prelude::*;
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -58,38 +54,6 @@ pub struct CompareArgs {
     pub json: bool,
 }
 
-struct Row {
-    name: String,
-    seconds: f64,
-    variance: f64,
-    rmse: Option<f64>,
-    film: Film,
-}
-
-fn integrator(name: &str, max_depth: u32) -> Result<IntegratorKind> {
-    let lighting = match name {
-        "path" => Some(PathLighting::Mis),
-        "path-bsdf" => Some(PathLighting::Bsdf),
-        "path-light" => Some(PathLighting::Light),
-        _ => None,
-    };
-    if let Some(lighting) = lighting {
-        return Ok(IntegratorKind::Path(PathIntegrator {
-            max_depth,
-            lighting,
-            ..Default::default()
-        }));
-    }
-    let strategy: DirectStrategy = name
-        .parse()
-        .map_err(|e: String| anyhow::anyhow!("--strategies: {e}"))?;
-    Ok(IntegratorKind::Direct(DirectIntegrator {
-        strategy,
-        samples: 1,
-        ..Default::default()
-    }))
-}
-
 /// Runs `pathlab compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
     if args.spp == 0 {
@@ -98,10 +62,14 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     if args.strategies.is_empty() {
         bail!("--strategies: name at least one");
     }
-    let integrators = args
+    let strategies = args
         .strategies
         .iter()
-        .map(|s| integrator(s.trim(), args.max_depth))
+        .map(|s| {
+            let name = s.trim().to_string();
+            let integrator = strategy(&name, args.max_depth).context("--strategies")?;
+            Ok((name, integrator))
+        })
         .collect::<Result<Vec<_>>>()?;
     let mut desc = pathlab_scene::load(&args.scene)?;
     crate::render_cmd::apply_resolution(&mut desc, args.resolution.as_deref())?;
@@ -121,27 +89,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     };
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let settings = RenderSettings::new(args.spp, args.seed, args.sampler);
-    let mut rows = Vec::new();
-    for (name, integrator) in args.strategies.iter().zip(&integrators) {
-        let (film, stats) = render(&scene, integrator, &settings, &|_| {}, &Default::default());
-        let n = film.pixels().len() as f64;
-        let variance = film
-            .pixels()
-            .iter()
-            .map(|p| p.variance().element_sum() / 3.0)
-            .sum::<f64>()
-            / n;
-        let rmse = reference
-            .as_ref()
-            .map(|r| crate::images::film_rmse(&film, r));
-        rows.push(Row {
-            name: name.trim().to_string(),
-            seconds: stats.seconds,
-            variance,
-            rmse,
-            film,
-        });
-    }
+    let rows = compare(&scene, &strategies, &settings, reference.as_deref());
     if let (Some(r), Some(p), Some(best)) = (
         &reference,
         &args.reference,
@@ -154,17 +102,11 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             (true, u32::MAX) => "inf".to_string(),
             (true, d) => d.to_string(),
         };
-        if let Some(w) = crate::images::reference_mismatch(&best.film, r, p, &depth) {
+        if let Some(w) = pathlab_lab::images::reference_mismatch(&best.film, r, p, &depth) {
             eprintln!("warning: {w}");
         }
     }
     write_side_by_side(&rows, &args.output)?;
-    // Undefined when the variance is unknown (one sample per pixel) or the time too short to
-    // measure.
-    let efficiency = |r: &Row| {
-        let cost = r.variance * r.seconds;
-        (args.spp > 1 && cost > 0.0).then(|| 1.0 / cost)
-    };
     if args.json {
         let out = json!({
             "scene": args.scene,
@@ -176,7 +118,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
                 "seconds": r.seconds,
                 "mean_pixel_variance": r.variance,
                 "rmse": r.rmse,
-                "efficiency": efficiency(r),
+                "efficiency": r.efficiency(args.spp),
             })).collect::<Vec<_>>(),
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
@@ -194,7 +136,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     );
     for r in &rows {
         let rmse = r.rmse.map_or("-".to_string(), |e| format!("{e:.5}"));
-        let efficiency = efficiency(r).map_or("-".to_string(), |e| format!("{e:.4e}"));
+        let efficiency = r
+            .efficiency(args.spp)
+            .map_or("-".to_string(), |e| format!("{e:.4e}"));
         println!(
             "  {:<12} {:>9.3} {:>16.6} {:>12} {:>14}",
             r.name, r.seconds, r.variance, rmse, efficiency
@@ -204,38 +148,5 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         "  (variance: per sample, averaged over pixels; efficiency = 1 / (variance x seconds))"
     );
     println!("  side-by-side image written to {}", args.output.display());
-    Ok(())
-}
-
-/// The renders next to each other, each labelled with its strategy.
-fn write_side_by_side(rows: &[Row], path: &std::path::Path) -> Result<()> {
-    let (w, h) = (rows[0].film.width(), rows[0].film.height());
-    let label = 28u32;
-    let (tw, th) = (w * rows.len() as u32, h + label);
-    let mut buf = vec![255u8; (tw * th * 3) as usize];
-    for (k, r) in rows.iter().enumerate() {
-        for (i, c) in r.film.mean_image().iter().enumerate() {
-            let (x, y) = (k as u32 * w + i as u32 % w, label + i as u32 / w);
-            let o = ((y * tw + x) * 3) as usize;
-            for ch in 0..3 {
-                buf[o + ch] = (ToneMap::Srgb.encode(c[ch], 1.0) * 255.0 + 0.5) as u8;
-            }
-        }
-    }
-    pathlab_lab::plot::register_font();
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (tw, th)).into_drawing_area();
-        for (k, r) in rows.iter().enumerate() {
-            root.draw(&Text::new(
-                r.name.clone(),
-                (k as i32 * w as i32 + 6, 6),
-                ("sans-serif", 18).into_font().color(&BLACK),
-            ))
-            .map_err(|e| anyhow::anyhow!("labelling the comparison failed: {e:?}"))?;
-        }
-        root.present()
-            .map_err(|e| anyhow::anyhow!("labelling the comparison failed: {e:?}"))?;
-    }
-    write_rgb8(path, tw, th, &buf)?;
     Ok(())
 }

@@ -1,15 +1,12 @@
-//! `pathlab converge`: how the error against a reference falls with samples and with time, for
-//! independent and Sobol sampling and for uniform and error-driven sample allocation.
+//! `pathlab converge`: the arguments and the report of [`pathlab_lab::converge`] (how the error
+//! against a reference falls with samples and with time, for independent and Sobol sampling and
+//! for uniform and error-driven sample allocation).
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use pathlab_lab::plot::{self, RmseCurve};
-use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::film::Film;
+use pathlab_lab::plot;
 use pathlab_render::image_io::read_exr_rgb;
 use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
-use pathlab_render::progressive::{render_progressive, StopRule};
-use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
 use serde_json::json;
 use std::path::PathBuf;
@@ -70,78 +67,22 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         max_depth: args.max_depth,
         ..Default::default()
     });
-    let levels: Vec<u32> = (0..=16)
-        .map(|k| 1u32 << k)
-        .filter(|&s| s <= args.max_spp)
-        .collect();
-    let top = levels.last().copied().unwrap_or(1);
-    let rmse = |film: &Film| -> f64 { crate::images::film_rmse(film, &reference) };
-    // The first independent render at the most samples checks the reference belongs to it.
-    let mut checked = false;
-    let mut check = |film: &Film, kind: SamplerKind, spp: u32| {
-        if checked || kind != SamplerKind::Independent || spp != top {
-            return;
-        }
-        checked = true;
-        let depth = if args.max_depth == u32::MAX {
-            "inf".to_string()
-        } else {
-            args.max_depth.to_string()
-        };
-        if let Some(w) =
-            crate::images::reference_mismatch(film, &reference, &args.reference, &depth)
-        {
-            eprintln!("warning: {w}");
-        }
+    let study =
+        pathlab_lab::converge::converge(&scene, &integrator, &reference, args.max_spp, args.seed);
+    let depth = if args.max_depth == u32::MAX {
+        "inf".to_string()
+    } else {
+        args.max_depth.to_string()
     };
-    let mut curves = Vec::new();
-    for (name, kind) in [
-        ("independent", SamplerKind::Independent),
-        ("sobol", SamplerKind::Sobol),
-    ] {
-        let points = levels
-            .iter()
-            .map(|&spp| {
-                let (film, stats) = render(
-                    &scene,
-                    &integrator,
-                    &RenderSettings::new(spp, args.seed, kind),
-                    &|_| {},
-                    &Default::default(),
-                );
-                check(&film, kind, spp);
-                (spp as f64, stats.seconds, rmse(&film))
-            })
-            .collect::<Vec<_>>();
-        curves.push(curve(name, points));
+    if let Some(w) = pathlab_lab::images::reference_mismatch(
+        &study.top_independent,
+        &reference,
+        &args.reference,
+        &depth,
+    ) {
+        eprintln!("warning: {w}");
     }
-    // Error-driven allocation (independent samples): the same average sample counts, placed
-    // where the estimated error falls most.
-    let points = levels
-        .iter()
-        .filter(|&&spp| spp >= 32)
-        .map(|&spp| {
-            let stop = StopRule {
-                target_error: None,
-                time_limit: None,
-                max_spp: spp,
-            };
-            let settings = RenderSettings::new(spp, args.seed, SamplerKind::Independent);
-            let (film, stats, _) = render_progressive(
-                &scene,
-                &integrator,
-                &settings,
-                &stop,
-                &|_, _| {},
-                &Default::default(),
-            );
-            let n = film.pixels().len() as f64;
-            (stats.samples as f64 / n, stats.seconds, rmse(&film))
-        })
-        .collect::<Vec<_>>();
-    if !points.is_empty() {
-        curves.push(curve("error-driven", points));
-    }
+    let curves = study.curves;
     let name = |p: &std::path::Path| {
         p.file_name().map_or_else(
             || p.display().to_string(),
@@ -181,21 +122,4 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
     println!("  plot written to {}", args.output.display());
     Ok(())
-}
-
-fn curve(name: &str, points: Vec<(f64, f64, f64)>) -> RmseCurve {
-    let as_conv: Vec<plot::ConvergencePoint> = points
-        .iter()
-        .map(|p| plot::ConvergencePoint {
-            n: p.0,
-            estimate: 0.0,
-            ci_half: 0.0,
-            rmse: p.2,
-        })
-        .collect();
-    RmseCurve {
-        name: name.to_string(),
-        slope: plot::fitted_slope(&as_conv),
-        points,
-    }
 }

@@ -1,10 +1,10 @@
 //! `pathlab convert` and `pathlab diff`: the images pathlab writes, re-encoded and compared.
 
-use crate::images::{relative_mse, rmse};
 use crate::render_cmd::ToneMapName;
 use anyhow::{bail, Result};
 use clap::Args;
 use glam::Vec3;
+use pathlab_lab::images::{relative_mse, rmse};
 use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, write_rgb8, ToneMap};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -148,7 +148,7 @@ pub fn run_diff(args: &DiffArgs) -> Result<()> {
 fn write_difference_heat(path: &Path, w: u32, h: u32, diff: &[Vec3]) -> Result<()> {
     let lum: Vec<f32> = diff
         .iter()
-        .map(|d| (0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z).abs())
+        .map(|d| pathlab_render::light::luminance(*d).abs())
         .collect();
     let mut sorted = lum.clone();
     sorted.sort_by(f32::total_cmp);

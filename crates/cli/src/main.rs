@@ -1,11 +1,9 @@
 //! `pathlab`: the command-line front end of the pathlab renderer and Monte Carlo toolkit.
 
-mod bench_cmd;
 mod compare_cmd;
 mod converge_cmd;
 mod farm;
 mod image_cmd;
-mod images;
 mod info_cmd;
 mod integrate;
 mod render_cmd;
@@ -43,8 +41,6 @@ enum Command {
     Diff(image_cmd::DiffArgs),
     /// Add the films of a render's shards (`render --shard I/N -o PART.plf`) into its image.
     Merge(farm::MergeArgs),
-    /// Measure speed (not a test): BVH build and ray throughput against Embree's ray files.
-    Bench(bench_cmd::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -66,7 +62,6 @@ fn main() -> ExitCode {
         Command::Integrate(args) => integrate::run(args),
         Command::Convert(args) => image_cmd::run_convert(args),
         Command::Diff(args) => image_cmd::run_diff(args),
-        Command::Bench(args) => bench_cmd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -15,7 +15,7 @@ use pathlab_render::integrator::{
 use pathlab_render::progressive::{
     estimated_relative_rmse, render_progressive_from, ProgressiveReport, StopRule,
 };
-use pathlab_render::render::{render, render_from, Adaptive, AdaptiveRule, RenderSettings};
+use pathlab_render::render::{render_from, Adaptive, AdaptiveRule, RenderSettings};
 use pathlab_render::scene::Scene;
 use serde_json::json;
 use std::io::IsTerminal;
@@ -618,13 +618,11 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
     }
     if args.adaptive_rule == Some(RuleName::Neyman) {
         if let Some(a) = settings.adaptive.as_mut() {
-            // A short pilot for the image's mean luminance (its samples are not reused).
-            let pilot = RenderSettings::new(4, args.seed.wrapping_add(1), sampler);
-            let (film, _) = render(&scene, &integrator, &pilot, &|_| {}, cancel);
-            let m = film.image_mean();
-            let image_luminance = 0.2126 * m.x + 0.7152 * m.y + 0.0722 * m.z;
-            if image_luminance > 0.0 {
-                a.rule = AdaptiveRule::Neyman { image_luminance };
+            let seed = args.seed.wrapping_add(1);
+            let (rule, _) =
+                AdaptiveRule::neyman_from_pilot(&scene, &integrator, seed, sampler, cancel);
+            if let Some(rule) = rule {
+                a.rule = rule;
             }
         }
     }

@@ -1,9 +1,18 @@
 //! pathlab's experiments as functions that return data, for the command line, a notebook or a
-//! viewer to present: a distribution's samples against its exact pdf ([`sample`]), Monte Carlo
-//! integration of an expression with its error ([`integrate`], over the expression language of
-//! [`expr`]), and the plots of both ([`plot`]).
+//! viewer to present:
+//! - [`sample`]: a distribution's samples against its exact pdf (moments, chi-square fit);
+//! - [`integrate`]: Monte Carlo integration of an expression ([`expr`]) over a box, with an
+//!   error that holds for every sampler, and the samplers' convergence study;
+//! - [`compare`]: strategies side by side on one scene (variance, RMSE, efficiency);
+//! - [`converge`]: a scene's error against a reference as samples grow, per way of sampling;
+//! - [`images`]: image metrics (RMSE, relative MSE) and the check that a reference belongs to
+//!   a render;
+//! - [`plot`]: the plots of all of them (PNG or SVG).
 
+pub mod compare;
+pub mod converge;
 pub mod expr;
+pub mod images;
 pub mod integrate;
 pub mod plot;
 pub mod sample;

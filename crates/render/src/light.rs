@@ -364,10 +364,21 @@ fn attenuate(attenuation: [f32; 3], dist2: f32) -> f32 {
     }
 }
 
+/// The weights of relative luminance Y for linear sRGB / Rec. 709 primaries.
+pub const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
 /// Relative luminance of linear sRGB / Rec. 709 primaries.
 #[inline]
 pub fn luminance(c: Rgb) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+    let [r, g, b] = LUMINANCE_WEIGHTS;
+    r as f32 * c.x + g as f32 * c.y + b as f32 * c.z
+}
+
+/// [`luminance`] in double precision (of image means and other sums).
+#[inline]
+pub fn luminance_f64(c: glam::DVec3) -> f64 {
+    let [r, g, b] = LUMINANCE_WEIGHTS;
+    r * c.x + g * c.y + b * c.z
 }
 
 impl Light {

@@ -148,6 +148,29 @@ impl Adaptive {
     }
 }
 
+impl AdaptiveRule {
+    /// Samples per pixel of the Neyman rule's pilot render.
+    pub const NEYMAN_PILOT_SPP: u32 = 4;
+
+    /// The Neyman rule for `scene`: a short pilot render (`NEYMAN_PILOT_SPP` samples per
+    /// pixel with `seed`, not reused in the image) gives the image's mean luminance L̄. `None`
+    /// when the pilot saw no light (L̄ = 0: the rule's n ∝ σ/L̄ is undefined). Also what the
+    /// pilot cost.
+    pub fn neyman_from_pilot(
+        scene: &Scene,
+        integrator: &dyn Integrator,
+        seed: u64,
+        sampler: SamplerKind,
+        cancel: &AtomicBool,
+    ) -> (Option<AdaptiveRule>, RenderStats) {
+        let pilot = RenderSettings::new(Self::NEYMAN_PILOT_SPP, seed, sampler);
+        let (film, stats) = render(scene, integrator, &pilot, &|_| {}, cancel);
+        let image_luminance = crate::light::luminance_f64(film.image_mean());
+        let rule = (image_luminance > 0.0).then_some(AdaptiveRule::Neyman { image_luminance });
+        (rule, stats)
+    }
+}
+
 impl RenderSettings {
     /// `spp` samples per pixel of the whole image with the given seed and sampler.
     pub fn new(spp: u32, seed: u64, sampler: SamplerKind) -> Self {

@@ -734,17 +734,21 @@ fn neyman_adaptive_sampling_matches_mitsuba_and_beats_uniform_at_equal_samples()
     let (mut mse_adaptive, mut mse_uniform) = (0.0, 0.0);
     for rep in 0..REPLICATES {
         // A short pilot (4 spp) gives the image's mean luminance; its samples count in the total.
-        let pilot = render_independent(&scene, 1, 4, 90 + 10 * rep);
-        let m = pilot.0.image_mean();
-        let image_luminance = 0.2126 * m.x + 0.7152 * m.y + 0.0722 * m.z;
+        let (rule, pilot) = AdaptiveRule::neyman_from_pilot(
+            &scene,
+            &path(1),
+            90 + 10 * rep,
+            SamplerKind::Independent,
+            &Default::default(),
+        );
         let mut settings = RenderSettings::new(1024, 91 + 10 * rep, SamplerKind::Independent);
         settings.adaptive = Some(Adaptive {
-            rule: AdaptiveRule::Neyman { image_luminance },
+            rule: rule.expect("the box is lit"),
             ..Adaptive::DEFAULT
         });
         let (adaptive, stats) = render(&scene, &path(1), &settings, &|_| {}, &Default::default());
         let n = adaptive.pixels().len() as f64;
-        let total = stats.samples + pilot.1.samples;
+        let total = stats.samples + pilot.samples;
         let spp = (total as f64 / n).round() as u32;
         let uniform = render_independent(&scene, 1, spp, 92 + 10 * rep).0;
         let (ea, eu) = (squared_errors(&adaptive, &r), squared_errors(&uniform, &r));

@@ -15,6 +15,7 @@ use glam::{DVec3, Vec3};
 use pathlab_render::desc::{
     FresnelModel, MaterialDesc, NormalDistribution, Rgb, TextureDesc, TextureFilter, WrapMode,
 };
+use pathlab_render::light::luminance_f64 as luminance;
 
 /// pbrt-v4's named glasses: their index at the sodium d line (587.6 nm).
 const GLASSES: &[(&str, f32)] = &[
@@ -29,11 +30,6 @@ const GLASSES: &[(&str, f32)] = &[
     ("glass-SF10", 1.7283),
     ("glass-SF11", 1.7847),
 ];
-
-/// Relative luminance of linear sRGB.
-fn luminance(c: DVec3) -> f64 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
 
 /// What a spectrum parameter stands for.
 #[derive(Clone, Copy, PartialEq, Eq)]

@@ -328,7 +328,7 @@ impl Builder {
                 };
                 if wl.z > 0.0 {
                     let sin_t = (std::f64::consts::PI * j as f64 / (out_h - 1) as f64).sin();
-                    let lum = 0.2126 * l.x as f64 + 0.7152 * l.y as f64 + 0.0722 * l.z as f64;
+                    let lum = pathlab_render::light::luminance_f64(l.as_dvec3());
                     upper += lum * wl.z * sin_t;
                 }
                 out.push(l);

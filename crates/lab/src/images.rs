@@ -56,10 +56,7 @@ pub fn depth_from_name(path: &Path) -> Option<String> {
     Some(d.saturating_sub(1).to_string())
 }
 
-/// Luminance of a colour (Rec. 709).
-fn luminance(c: glam::DVec3) -> f64 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
+use pathlab_render::light::luminance_f64 as luminance;
 
 /// A warning when `reference` cannot be an image of what `film` renders: the image means,
 /// in luminance, differ by more than five of the render's standard errors (plus 0.1% of the

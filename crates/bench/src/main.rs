@@ -1,10 +1,10 @@
-//! `pathlab bench`: measurements that are not tests. `bench rays MESH RAYS` traces the exact
+//! `pathlab-bench`: measurements that are not tests. `pathlab-bench rays MESH RAYS` traces the exact
 //! rays of a ray file written by the Embree benchmark (`bench/embree/`), checks every hit
 //! distance against Embree's, and reports build time, throughput and memory, so that the two
 //! can be compared as ratios in one script.
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 use pathlab_render::geometry::Ray;
 use pathlab_render::scene::Scene;
@@ -13,9 +13,11 @@ use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Raw command-line arguments of `pathlab bench`.
-#[derive(Args, Debug)]
-pub struct BenchArgs {
+/// pathlab-bench: measurements that are not tests (BVH build and ray throughput against
+/// Embree's ray files).
+#[derive(Parser, Debug)]
+#[command(name = "pathlab-bench", version, about, long_about = None)]
+struct BenchArgs {
     #[command(subcommand)]
     what: BenchWhat,
 }
@@ -169,11 +171,19 @@ fn agreement(rays: &[FileRay], hits: &[f32]) -> usize {
         .count()
 }
 
-/// Runs `pathlab bench`.
-pub fn run(args: &BenchArgs) -> Result<()> {
-    match &args.what {
+fn main() -> std::process::ExitCode {
+    let args = BenchArgs::parse();
+    let result = match &args.what {
         BenchWhat::Rays(a) => rays(a),
         BenchWhat::Obj(a) => export_obj(a),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
+            eprintln!("error: {}", chain.join(": "));
+            std::process::ExitCode::FAILURE
+        }
     }
 }
 
