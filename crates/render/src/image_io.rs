@@ -71,7 +71,12 @@ pub fn write_exr(
     let layer = Layer::new(
         (width as usize, height as usize),
         LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
+        // Blocks in increasing order, so that the same image gives the same bytes however
+        // the blocks' compression was spread over threads.
+        Encoding {
+            line_order: LineOrder::Increasing,
+            ..Encoding::FAST_LOSSLESS
+        },
         AnyChannels::sort(channels.into()),
     );
     Image::from_layer(layer).write().to_file(path).map_err(err)
@@ -302,5 +307,33 @@ mod tests {
         assert_eq!((w, h), (4, 3));
         assert_eq!(back, rgb);
         let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn the_same_image_is_written_as_the_same_bytes() {
+        // Large enough for many 64 x 64 blocks, compressed on several threads.
+        let (w, h) = (300u32, 200u32);
+        let rgb: Vec<Rgb> = (0..w * h)
+            .map(|i| Rgb::new((i % 7) as f32, (i % 13) as f32 * 0.5, (i / w) as f32))
+            .collect();
+        let counts: Vec<f32> = (0..w * h).map(|i| i as f32).collect();
+        let channel = [ExtraChannel {
+            name: "samples.Y".to_string(),
+            values: &counts,
+        }];
+        let dir = std::env::temp_dir().join(format!("pathlab-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bytes: Vec<Vec<u8>> = (0..4)
+            .map(|k| {
+                let path = dir.join(format!("{k}.exr"));
+                write_exr(&path, w, h, &rgb, &channel).unwrap();
+                std::fs::read(&path).unwrap()
+            })
+            .collect();
+        assert!(bytes.windows(2).all(|b| b[0] == b[1]));
+        let (rw, rh, back) = read_exr_rgb(&dir.join("0.exr")).unwrap();
+        assert_eq!((rw, rh), (w, h));
+        assert!(back == rgb);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -46,6 +46,7 @@ pub mod desc;
 pub mod envmap;
 pub mod film;
 pub mod film_file;
+pub mod film_image;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;

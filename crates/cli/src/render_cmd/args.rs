@@ -1,0 +1,402 @@
+//! `pathlab render`'s flags, and their checks before anything is loaded.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::integrator::DirectStrategy;
+use pathlab_render::render::{Adaptive, AdaptiveRule};
+use std::path::PathBuf;
+
+/// Which integrator renders the image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum IntegratorName {
+    /// Path tracing with next-event estimation, MIS and Russian roulette.
+    Path,
+    /// Direct lighting only, by the strategy chosen with --direct.
+    Direct,
+    /// Debug view: shading normals.
+    Normals,
+    /// Debug view: distance to the first surface.
+    Depth,
+    /// Debug view: BVH nodes visited per camera ray.
+    Bvh,
+}
+
+/// Adaptive stopping rules.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum RuleName {
+    /// Unbiased: a pilot batch from its own stream plans each pixel's count (the course's
+    /// precision target), and only the planned samples make the image.
+    TwoStage,
+    /// The course's relative-precision rule, checked after each batch (biased by optional
+    /// stopping).
+    Course,
+    /// Samples in proportion to each pixel's standard deviation.
+    Neyman,
+}
+
+/// PNG tone maps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ToneMapName {
+    /// Exposure, clamp, sRGB transfer function.
+    Srgb,
+    /// The CS184 course's renderer: clamp((√2 c)^(1/2.2)), √2 being half a stop up.
+    Cs184,
+}
+
+/// Extra outputs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Aov {
+    /// Variance of each pixel's mean (squared standard error), per channel.
+    Variance,
+    /// Samples per pixel.
+    Samples,
+}
+
+/// `--lighting` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LightingName {
+    /// Light sampling and BSDF sampling with MIS.
+    Mis,
+    /// BSDF sampling only.
+    Bsdf,
+    /// Light sampling only.
+    Light,
+}
+
+/// `--fresnel` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FresnelName {
+    /// The exact dielectric Fresnel equations.
+    Exact,
+    /// Schlick's approximation.
+    Schlick,
+}
+
+/// Raw command-line arguments of `pathlab render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// The scene: a file (.xml Mitsuba 3, .pbrt pbrt-v4, .dae the course's COLLADA, .obj, .ply,
+    /// .gltf, .glb) or
+    /// a built-in scene's name (cornell-box).
+    #[arg(default_value = "cornell-box")]
+    pub scene: String,
+    /// Samples per pixel (default: the scene file's, else 64).
+    #[arg(short = 's', long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
+    /// Light samples per surface point (direct lighting: directions or light points per pixel
+    /// sample).
+    #[arg(short = 'l', long, default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
+    pub light_samples: u32,
+    /// Largest bounce: 0 = light seen directly, 1 = direct lighting, 2 = one indirect bounce,
+    /// ..., inf (or -1, as Mitsuba writes it) = unbounded (with Russian roulette). Default: the
+    /// scene file's, else inf.
+    #[arg(short = 'm', long, allow_negative_numbers = true)]
+    pub max_depth: Option<String>,
+    /// First bounce at which Russian roulette may end a path (default: the scene file's, else
+    /// 5).
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..))]
+    pub rr_depth: Option<u32>,
+    /// Only the radiance of bounce K (0 = emission seen directly, 1 = direct, ...).
+    #[arg(long, value_name = "K", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..))]
+    pub only_bounce: Option<u32>,
+    /// Worker threads (0: all cores).
+    #[arg(short = 't', long, default_value_t = 0, allow_negative_numbers = true, value_parser = threads_arg)]
+    pub threads: usize,
+    /// Image size in pixels (default: the scene's). The view is scaled to fit, except for the
+    /// course's .dae scenes, whose camera keeps the course viewer's pixel scale: a smaller
+    /// size shows a centred crop, a larger one more around it (use --scale to resize those).
+    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"], allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub resolution: Option<Vec<u32>>,
+    /// The scene's own view at F times its resolution (any format; the .dae scenes' way to
+    /// change their size without cropping).
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
+    pub scale: Option<f32>,
+    /// Field of view in degrees on the image's smaller axis, in place of the scene camera's.
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub fov: Option<f32>,
+    /// Adaptive sampling: each pixel takes the samples that bring the 95% interval of its mean
+    /// luminance within ± TOL relative (at most --spp), in batches of BATCH; by default planned
+    /// from a pilot batch that is not part of the image, so that the image stays unbiased
+    /// (see --adaptive-rule). Defaults 32 0.05. Writes the samples-per-pixel heat map to
+    /// NAME_rate.png.
+    #[arg(short = 'a', long, num_args = 0..=2, value_names = ["BATCH", "TOL"], default_missing_values = ["32", "0.05"])]
+    pub adaptive: Option<Vec<String>>,
+    /// Thin lens: aperture radius (0: pinhole). Overrides the scene's.
+    #[arg(
+        short = 'b',
+        long,
+        value_name = "RADIUS",
+        allow_negative_numbers = true
+    )]
+    pub lens_radius: Option<f32>,
+    /// Thin lens: distance to the plane in focus. Overrides the scene's.
+    #[arg(
+        short = 'd',
+        long,
+        value_name = "DISTANCE",
+        allow_negative_numbers = true
+    )]
+    pub focal_distance: Option<f32>,
+    /// Adaptive rule: two-stage (default; n = (1.96σ/(TOL·μ))² from a pilot batch of its own,
+    /// unbiased), course (stop after a batch once 1.96σ/√n ≤ TOL·μ, the course's rule, biased
+    /// by optional stopping), or neyman (stop once n ≥ (1.96/TOL)² σ/L̄ with L̄ from a 4-spp
+    /// pilot: samples in proportion to σ, which minimises the image's MSE; biased as course).
+    /// Only with -a.
+    #[arg(long, value_enum)]
+    pub adaptive_rule: Option<RuleName>,
+    /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black).
+    #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..))]
+    pub crop: Option<Vec<u32>>,
+    /// Output image: .exr (linear) or .png (sRGB). Repeat for several files from one render
+    /// (-o a.exr -o a.png). Default: SCENE.png.
+    #[arg(short = 'o', long, visible_short_alias = 'f', value_name = "FILE")]
+    pub output: Vec<PathBuf>,
+    /// The integrator (default: the one the scene file names, else path).
+    #[arg(long, value_enum)]
+    pub integrator: Option<IntegratorName>,
+    /// A scene parameter, NAME=VALUE, for the `$NAME` references of a Mitsuba scene (its
+    /// `<default>`s give the others). Repeat for several.
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
+    pub define: Vec<String>,
+    /// How the path tracer finds light at each vertex: mis (light and BSDF sampling combined),
+    /// bsdf (BSDF sampling only) or light (light sampling only). Default: mis. Path tracer
+    /// only.
+    #[arg(long, value_enum)]
+    pub lighting: Option<LightingName>,
+    /// Light the scene with this environment map (equirectangular .exr, .hdr, .png or .jpg, in
+    /// Mitsuba's convention), in place of the scene's own environment.
+    #[arg(short = 'e', long, value_name = "FILE")]
+    pub envmap: Option<PathBuf>,
+    /// Scale of the --envmap radiance.
+    #[arg(long, default_value_t = 1.0, value_name = "SCALE")]
+    pub envmap_scale: f32,
+    /// Fresnel reflectance of smooth glass: exact, or schlick (the course's approximation).
+    #[arg(long, value_enum, default_value_t = FresnelName::Exact)]
+    pub fresnel: FresnelName,
+    /// Direct-lighting strategy for --integrator direct: hemisphere, cosine, light or mis
+    /// (default).
+    #[arg(long)]
+    pub direct: Option<DirectStrategy>,
+    /// Where the uniform numbers come from: sobol (Owen-scrambled, padded per dimension),
+    /// stratified or independent. Per-pixel variances (--aov variance) are exact estimates only
+    /// for independent samples; for the others they overstate the error.
+    /// Default: sobol, or independent with --target-error/--time (whose error estimate is
+    /// exact only for independent samples).
+    #[arg(long)]
+    pub sampler: Option<SamplerKind>,
+    /// Render in passes until the estimated relative RMSE of the image is at most E, spending
+    /// each pass where it lowers the error most (-s then caps the average spp; default 65536).
+    #[arg(long, value_name = "E", allow_negative_numbers = true)]
+    pub target_error: Option<f64>,
+    /// Render in passes for this many seconds, spending each pass where it lowers the error most.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub time: Option<f64>,
+    /// Seed of the random numbers.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Exposure in stops applied before PNG encoding.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// PNG encoding: srgb (exposure, clamp, the sRGB curve), or cs184 (the course's renderer:
+    /// radiance times √2, which is half a stop up, then gamma 2.2 and clamp).
+    #[arg(long, value_enum, default_value_t = ToneMapName::Srgb)]
+    pub tonemap: ToneMapName,
+    /// Extra outputs, comma-separated: variance, samples (EXR channels, or files next to a PNG).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub aov: Vec<Aov>,
+    /// Write the film's exact state to FILE (.plf) after passes, at most every
+    /// --checkpoint-every seconds, and when the render is stopped: `--resume FILE` goes on
+    /// from it to the same image, bit for bit.
+    #[arg(long, value_name = "FILE")]
+    pub checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (default 60).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 60.0,
+        allow_negative_numbers = true
+    )]
+    pub checkpoint_every: f64,
+    /// Go on from a checkpoint of this render (the same scene, flags and seed) to -s (or, with
+    /// --target-error/--time, to the target or for the time; with -a, to each pixel's count).
+    #[arg(long, value_name = "FILE")]
+    pub resume: Option<PathBuf>,
+    /// Render only the I-th (from 0) of N equal ranges of every pixel's samples: a whole-frame
+    /// image of spp/N samples per pixel. Write it as a film (-o PART.plf); `pathlab merge`
+    /// adds the N parts into the image one render would give, bit for bit.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// No progress bar.
+    #[arg(short = 'q', long)]
+    pub quiet: bool,
+    /// Print run statistics as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A `--threads` value: a count of worker threads, 0 for all cores.
+fn threads_arg(text: &str) -> std::result::Result<usize, String> {
+    text.parse::<usize>()
+        .map_err(|_| format!("'{text}' is not a number of threads (0 for all cores, 1, 2, ...)"))
+}
+
+/// [`parse_max_depth`] as a clap value parser.
+pub fn parse_depth_arg(text: &str) -> std::result::Result<u32, String> {
+    parse_max_depth(text).map_err(|e| e.to_string())
+}
+
+/// A `--max-depth` value: a number of bounces or `inf` (also `-1`).
+pub fn parse_max_depth(text: &str) -> Result<u32> {
+    if text.eq_ignore_ascii_case("inf") || text == "-1" {
+        return Ok(u32::MAX);
+    }
+    text.parse::<u32>().with_context(|| {
+        format!("--max-depth {text}: expected a number of bounces (0, 1, 2, ...) or inf")
+    })
+}
+
+fn parse_adaptive(values: &[String], rule: Option<RuleName>) -> Result<Adaptive> {
+    let batch = match values.first() {
+        Some(b) => b.parse::<u32>().ok().filter(|&b| b > 0).with_context(|| {
+            format!("--adaptive {b}: BATCH must be a positive number of samples")
+        })?,
+        None => Adaptive::DEFAULT.batch,
+    };
+    let tolerance = match values.get(1) {
+        Some(t) => t
+            .parse::<f32>()
+            .ok()
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .with_context(|| {
+                format!("--adaptive {batch} {t}: TOL must be a positive number such as 0.05")
+            })?,
+        None => Adaptive::DEFAULT.tolerance,
+    };
+    Ok(Adaptive {
+        batch,
+        tolerance,
+        min_samples: 4 * batch,
+        rule: match rule {
+            Some(RuleName::Course) => AdaptiveRule::Course,
+            // The Neyman rule's image luminance comes from its pilot render, later.
+            Some(RuleName::Neyman) => AdaptiveRule::Course,
+            Some(RuleName::TwoStage) | None => AdaptiveRule::TwoStage,
+        },
+    })
+}
+
+/// Flags that contradict each other or a value no image can show: an error, before anything
+/// is loaded; flags that the chosen integrator does not read: a warning each (returned).
+fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>> {
+    if !args.exposure.is_finite() {
+        bail!(
+            "--exposure {}: must be a finite number of stops",
+            args.exposure
+        );
+    }
+    if let (Some(k), Some(m)) = (args.only_bounce, cli_depth) {
+        if k > m {
+            bail!("--only-bounce {k} is beyond --max-depth {m}: the image would be black");
+        }
+    }
+    let mut warnings = Vec::new();
+    let mut unused = |flag: &str, applies: &str| {
+        warnings.push(format!("{flag} applies to {applies} only; ignored"))
+    };
+    let integrator = args.integrator;
+    let path = matches!(integrator, None | Some(IntegratorName::Path));
+    let debug = matches!(
+        integrator,
+        Some(IntegratorName::Normals | IntegratorName::Depth | IntegratorName::Bvh)
+    );
+    if args.direct.is_some() && integrator != Some(IntegratorName::Direct) {
+        unused("--direct", "--integrator direct");
+    }
+    if args.lighting.is_some() && !path {
+        unused("--lighting", "the path tracer (--integrator path)");
+    }
+    if args.only_bounce.is_some() && !path {
+        unused("--only-bounce", "the path tracer (--integrator path)");
+    }
+    if debug && args.light_samples > 1 {
+        unused("--light-samples", "the path and direct integrators");
+    }
+    if args.adaptive_rule.is_some() && args.adaptive.is_none() {
+        unused("--adaptive-rule", "adaptive sampling (-a)");
+    }
+    Ok(warnings)
+}
+
+/// The flags as checked values: everything that can be checked before the scene is loaded.
+pub(super) struct Checked {
+    /// `-m` as given (the scene's hint, or unbounded, otherwise).
+    pub cli_depth: Option<u32>,
+    /// Warnings about flags the chosen integrator does not read.
+    pub warnings: Vec<String>,
+    /// `-D NAME=VALUE` pairs.
+    pub params: Vec<(String, String)>,
+    /// Whether the render is progressive (`--target-error` or `--time`).
+    pub progressive: bool,
+    /// `-a`, parsed (the Neyman rule's luminance comes from its pilot, after loading).
+    pub adaptive: Option<Adaptive>,
+}
+
+/// Checks every flag that needs no scene: an error names the flag and what was expected.
+pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
+    let cli_depth = args.max_depth.as_deref().map(parse_max_depth).transpose()?;
+    let warnings = check_flags(args, cli_depth)?;
+    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
+        bail!(
+            "--checkpoint-every {}: must be a number of seconds >= 0",
+            args.checkpoint_every
+        );
+    }
+    let params = args
+        .define
+        .iter()
+        .map(|d| match d.split_once('=') {
+            Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.to_string())),
+            _ => bail!("-D {d}: expected NAME=VALUE"),
+        })
+        .collect::<Result<Vec<_>>>()?;
+    if let Some(e) = args.target_error {
+        if !(e.is_finite() && e > 0.0) {
+            bail!("--target-error {e}: must be a positive number such as 0.02");
+        }
+    }
+    if let Some(t) = args.time {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--time {t}: must be a positive number of seconds");
+        }
+    }
+    let progressive = args.target_error.is_some() || args.time.is_some();
+    if progressive && args.adaptive.is_some() {
+        bail!(
+            "--adaptive and --target-error/--time are different ways to place samples; choose one"
+        );
+    }
+    let adaptive = args
+        .adaptive
+        .as_deref()
+        .map(|a| parse_adaptive(a, args.adaptive_rule))
+        .transpose()?;
+    if args.shard.is_some() && (progressive || adaptive.is_some()) {
+        bail!("--shard splits a render of fixed samples per pixel; it cannot be combined with -a, --target-error or --time");
+    }
+    let stopping_rule = adaptive.is_some()
+        && matches!(
+            args.adaptive_rule,
+            Some(RuleName::Course | RuleName::Neyman)
+        );
+    if (args.checkpoint.is_some() || args.resume.is_some()) && stopping_rule {
+        bail!("--checkpoint and --resume: the course and neyman adaptive rules decide on every sample a pixel has drawn, which a film does not keep; use the default two-stage rule");
+    }
+    Ok(Checked {
+        cli_depth,
+        warnings,
+        params,
+        progressive,
+        adaptive,
+    })
+}
