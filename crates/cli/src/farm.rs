@@ -4,7 +4,6 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use pathlab_render::desc::SceneDesc;
-use pathlab_render::film::Film;
 use pathlab_render::film_file::{self, FilmHeader};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -155,76 +154,10 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
     let mut parts = Vec::new();
     for p in &args.parts {
         let (h, film) = film_file::read(p)?;
-        parts.push((p.clone(), h, film));
+        parts.push((p.display().to_string(), h, film));
     }
-    let (first_path, first, _) = &parts[0];
-    for (p, h, _) in &parts[1..] {
-        if h.key != first.key
-            || h.resolution != first.resolution
-            || h.seed != first.seed
-            || h.spp != first.spp
-        {
-            bail!(
-                "{}: not a part of the same render as {} ({} vs {})",
-                p.display(),
-                first_path.display(),
-                h.description,
-                first.description
-            );
-        }
-    }
-    // Every part whole, and the ranges tiling [0, spp) once.
-    for (p, h, film) in &parts {
-        let want = (h.range[1] - h.range[0]) as u64;
-        if let Some(px) = film.pixels().iter().find(|px| px.count() != want) {
-            bail!(
-                "{}: incomplete (a pixel holds {} of its {want} samples); render it again",
-                p.display(),
-                px.count()
-            );
-        }
-    }
-    let mut ranges: Vec<(u32, u32, &PathBuf)> = parts
-        .iter()
-        .map(|(p, h, _)| (h.range[0], h.range[1], p))
-        .collect();
-    ranges.sort();
-    let mut problems = Vec::new();
-    let mut at = 0u32;
-    let mut last: Option<&PathBuf> = None;
-    for &(a, b, p) in &ranges {
-        if a > at {
-            problems.push(format!("samples {at}..{a} are missing"));
-        } else if a < at {
-            problems.push(format!(
-                "{} overlaps {} (samples {a}..{})",
-                p.display(),
-                last.map_or(String::new(), |l| l.display().to_string()),
-                at.min(b)
-            ));
-        }
-        at = at.max(b);
-        last = Some(p);
-    }
-    if at < first.spp {
-        problems.push(format!("samples {at}..{} are missing", first.spp));
-    }
-    if !problems.is_empty() {
-        bail!(
-            "the parts do not cover the render's {} samples once: {}",
-            first.spp,
-            problems.join("; ")
-        );
-    }
-    let [w, h] = first.resolution;
-    let mut film = Film::new(w, h);
-    for (_, _, f) in &parts {
-        for (a, b) in film.pixels_mut().iter_mut().zip(f.pixels()) {
-            a.merge(b);
-        }
-    }
-    let mut header = first.clone();
-    header.range = [0, first.spp];
+    let (header, film) = film_file::merge(&parts).map_err(anyhow::Error::msg)?;
+    let (first, [w, h]) = (&header, header.resolution);
     crate::render_cmd::write_film_image(&film, &args.output, &header, args.exposure)?;
     eprintln!(
         "merged {} parts ({} spp, {}x{}); wrote {}",

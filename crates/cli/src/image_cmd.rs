@@ -4,8 +4,8 @@ use crate::render_cmd::ToneMapName;
 use anyhow::{bail, Result};
 use clap::Args;
 use glam::Vec3;
-use pathlab_lab::images::{relative_mse, rmse};
-use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, write_rgb8, ToneMap};
+use pathlab_lab::images::{relative_mse, rmse, write_difference_heat_map};
+use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, ToneMap};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -114,7 +114,10 @@ pub fn run_diff(args: &DiffArgs) -> Result<()> {
         if ext == "exr" {
             write_exr(out, wa, ha, &diff, &[])?;
         } else {
-            write_difference_heat(out, wa, ha, &diff)?;
+            let top = write_difference_heat_map(out, wa, ha, &diff)?;
+            eprintln!(
+                "difference image: black 0 to white {top:.4} (the 99th percentile of |A - B|, luminance)"
+            );
         }
     }
     if args.json {
@@ -140,34 +143,5 @@ pub fn run_diff(args: &DiffArgs) -> Result<()> {
                 .map_or(String::new(), |o| format!("; wrote {}", o.display()))
         );
     }
-    Ok(())
-}
-
-/// |difference| in luminance as grey levels: black at zero, white at the 99th percentile (the
-/// scale printed), so that a few fireflies do not hide the rest.
-fn write_difference_heat(path: &Path, w: u32, h: u32, diff: &[Vec3]) -> Result<()> {
-    let lum: Vec<f32> = diff
-        .iter()
-        .map(|d| pathlab_render::light::luminance(*d).abs())
-        .collect();
-    let mut sorted = lum.clone();
-    sorted.sort_by(f32::total_cmp);
-    let top = sorted
-        .get((sorted.len() as f64 * 0.99) as usize)
-        .or(sorted.last())
-        .copied()
-        .unwrap_or(0.0)
-        .max(f32::MIN_POSITIVE);
-    let bytes: Vec<u8> = lum
-        .iter()
-        .flat_map(|&v| {
-            let g = ((v / top).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-            [g, g, g]
-        })
-        .collect();
-    write_rgb8(path, w, h, &bytes)?;
-    eprintln!(
-        "difference image: black 0 to white {top:.4} (the 99th percentile of |A - B|, luminance)"
-    );
     Ok(())
 }

@@ -56,7 +56,7 @@ pub fn depth_from_name(path: &Path) -> Option<String> {
     Some(d.saturating_sub(1).to_string())
 }
 
-use pathlab_render::light::luminance_f64 as luminance;
+use pathlab_render::light::{luminance as luminance_f32, luminance_f64 as luminance};
 
 /// A warning when `reference` cannot be an image of what `film` renders: the image means,
 /// in luminance, differ by more than five of the render's standard errors (plus 0.1% of the
@@ -86,6 +86,34 @@ pub fn reference_mismatch(
         reference_path.display(),
         z.abs()
     ))
+}
+
+/// |difference| in luminance as grey levels: black at zero, white at the 99th percentile (the
+/// scale returned), so that a few fireflies do not hide the rest.
+pub fn write_difference_heat_map(
+    path: &Path,
+    w: u32,
+    h: u32,
+    diff: &[Vec3],
+) -> Result<f32, pathlab_render::image_io::ImageError> {
+    let lum: Vec<f32> = diff.iter().map(|d| luminance_f32(*d).abs()).collect();
+    let mut sorted = lum.clone();
+    sorted.sort_by(f32::total_cmp);
+    let top = sorted
+        .get((sorted.len() as f64 * 0.99) as usize)
+        .or(sorted.last())
+        .copied()
+        .unwrap_or(0.0)
+        .max(f32::MIN_POSITIVE);
+    let bytes: Vec<u8> = lum
+        .iter()
+        .flat_map(|&v| {
+            let g = ((v / top).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+            [g, g, g]
+        })
+        .collect();
+    pathlab_render::image_io::write_rgb8(path, w, h, &bytes)?;
+    Ok(top)
 }
 
 #[cfg(test)]

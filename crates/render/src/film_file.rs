@@ -219,6 +219,79 @@ pub fn parse(bytes: &[u8]) -> Result<(FilmHeader, Film), String> {
     Ok((header, film))
 }
 
+/// Adds the films of a render's shards into the film of the whole render, after checking that
+/// they are parts of one render (same key, resolution, seed and samples per pixel), each whole
+/// (every pixel holds its range's samples) and that their sample ranges cover `[0, spp)` once.
+/// `parts` are (name for messages, header, film). The sums are exact, so the result is the
+/// single render's film to the bit; its header is the first part's with the whole range. An
+/// error says which part differs, which is incomplete, and which samples are missing or
+/// covered twice.
+pub fn merge(parts: &[(String, FilmHeader, Film)]) -> Result<(FilmHeader, Film), String> {
+    let Some((first_name, first, _)) = parts.first() else {
+        return Err("no parts to merge".to_string());
+    };
+    for (name, h, _) in &parts[1..] {
+        if h.key != first.key
+            || h.resolution != first.resolution
+            || h.seed != first.seed
+            || h.spp != first.spp
+        {
+            return Err(format!(
+                "{name}: not a part of the same render as {first_name} ({} vs {})",
+                h.description, first.description
+            ));
+        }
+    }
+    for (name, h, film) in parts {
+        let want = (h.range[1] - h.range[0]) as u64;
+        if let Some(px) = film.pixels().iter().find(|px| px.count() != want) {
+            return Err(format!(
+                "{name}: incomplete (a pixel holds {} of its {want} samples); render it again",
+                px.count()
+            ));
+        }
+    }
+    let mut ranges: Vec<(u32, u32, &str)> = parts
+        .iter()
+        .map(|(name, h, _)| (h.range[0], h.range[1], name.as_str()))
+        .collect();
+    ranges.sort();
+    let mut problems = Vec::new();
+    let (mut at, mut last) = (0u32, "");
+    for &(a, b, name) in &ranges {
+        if a > at {
+            problems.push(format!("samples {at}..{a} are missing"));
+        } else if a < at {
+            problems.push(format!(
+                "{name} overlaps {last} (samples {a}..{})",
+                at.min(b)
+            ));
+        }
+        at = at.max(b);
+        last = name;
+    }
+    if at < first.spp {
+        problems.push(format!("samples {at}..{} are missing", first.spp));
+    }
+    if !problems.is_empty() {
+        return Err(format!(
+            "the parts do not cover the render's {} samples once: {}",
+            first.spp,
+            problems.join("; ")
+        ));
+    }
+    let [w, h] = first.resolution;
+    let mut film = Film::new(w, h);
+    for (_, _, f) in parts {
+        for (a, b) in film.pixels_mut().iter_mut().zip(f.pixels()) {
+            a.merge(b);
+        }
+    }
+    let mut header = first.clone();
+    header.range = [0, first.spp];
+    Ok((header, film))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
