@@ -59,6 +59,7 @@ pub mod sdf_grid;
 pub mod shape;
 #[cfg(target_arch = "x86_64")]
 pub mod simd;
+pub mod tev;
 pub mod texture;
 
 pub use pathlab_mc as mc;

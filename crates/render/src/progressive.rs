@@ -26,7 +26,7 @@
 
 use crate::film::Film;
 use crate::integrator::Integrator;
-use crate::render::{Frame, RenderSettings, RenderStats};
+use crate::render::{Frame, RenderSettings, RenderStats, TileDone};
 use crate::scene::Scene;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -102,8 +102,8 @@ pub fn render_progressive(
 
 /// Renders in whole-frame passes (the same pass routine as every render) until `stop` says
 /// so, continuing `film` (a checkpoint's, or an empty one). `settings.spp` is ignored (the
-/// stop rule's `max_spp` caps the average); `settings.adaptive` too. `progress(samples)` as
-/// tiles finish; `after_pass(film, stats, pass, estimated error)` after each finished pass.
+/// stop rule's `max_spp` caps the average); `settings.adaptive` too. `progress` as
+/// tiles finish ([`TileDone`]); `after_pass(film, stats, pass, estimated error)` after each finished pass.
 ///
 /// Each pass's allocation is a function of the film alone, so going on from a film written
 /// after a pass gives, with the same stop rule, the image of the uninterrupted render bit for
@@ -115,7 +115,7 @@ pub fn render_progressive_from(
     settings: &RenderSettings,
     stop: &StopRule,
     mut film: Film,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: &(dyn Fn(&TileDone) + Sync),
     cancel: &AtomicBool,
     after_pass: &mut dyn FnMut(&Film, &RenderStats, u32, f64),
 ) -> (Film, RenderStats, ProgressiveReport) {

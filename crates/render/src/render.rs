@@ -205,6 +205,24 @@ pub struct RenderStats {
     pub cancelled: bool,
 }
 
+/// A tile's work, told to a render's `progress` as it finishes (from worker threads).
+#[derive(Clone, Copy, Debug)]
+pub struct TileDone<'a> {
+    /// Samples traced (finite and not).
+    pub samples: u64,
+    /// The tile's top-left pixel.
+    pub x0: u32,
+    /// Its top-left pixel's row.
+    pub y0: u32,
+    /// Its width in pixels.
+    pub w: u32,
+    /// What this pass adds to each of the tile's pixels (row-major, `w` wide): merged into a
+    /// copy of the film as the pass began, they give the film as it will be when the pass
+    /// ends (a live view's). Empty for work that adds nothing to the film (the two-stage
+    /// adaptive rule's pilot).
+    pub pixels: &'a [PixelStats],
+}
+
 struct TileResult {
     x0: u32,
     y0: u32,
@@ -262,14 +280,14 @@ fn add_sample(px: &mut PixelStats, l: crate::desc::Rgb, ok: &mut u64, bad: &mut 
 ///
 /// Each pixel's samples use the sampler positioned at (pixel, sample index), and the film
 /// sums them exactly, so the image is the same for the same seed whatever the thread count,
-/// tile order or pass schedule. `progress(samples)` is called from worker threads as tiles
-/// finish; when `cancel` becomes true the render stops within a sample per thread and the
+/// tile order or pass schedule. `progress` is told of each tile as it finishes (from worker
+/// threads: its samples, and what it adds to the film, see [`TileDone`]); when `cancel` becomes true the render stops within a sample per thread and the
 /// film holds every sample finished (whole passes, and part of the last).
 pub fn render(
     scene: &Scene,
     integrator: &dyn Integrator,
     settings: &RenderSettings,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: &(dyn Fn(&TileDone) + Sync),
     cancel: &AtomicBool,
 ) -> (Film, RenderStats) {
     let [width, height] = scene.camera().resolution();
@@ -318,7 +336,7 @@ fn render_adaptive(
     adaptive: Adaptive,
     film: &mut Film,
     stats: &mut RenderStats,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: &(dyn Fn(&TileDone) + Sync),
     cancel: &AtomicBool,
     after_round: &mut dyn FnMut(&Film, &RenderStats),
 ) {
@@ -362,7 +380,13 @@ fn render_adaptive(
                     plan[k as usize] =
                         adaptive.planned_samples(&pilot.luminance(), deterministic, settings.spp);
                 }
-                progress(out.pilot);
+                progress(&TileDone {
+                    samples: out.pilot,
+                    x0,
+                    y0,
+                    w,
+                    pixels: &[],
+                });
                 (out, plan)
             })
             .collect();
@@ -409,7 +433,13 @@ fn render_adaptive(
                     out.nonfinite += bad;
                     tile_fixed[k as usize] = out.path.random_vertices == before;
                 }
-                progress(out.samples + out.nonfinite);
+                progress(&TileDone {
+                    samples: out.samples + out.nonfinite,
+                    x0,
+                    y0,
+                    w,
+                    pixels: &out.pixels,
+                });
                 (out, tile_fixed)
             })
             .collect();
@@ -535,7 +565,7 @@ impl<'a> Frame<'a> {
         film: &mut Film,
         stats: &mut RenderStats,
         end: &(dyn Fn(u32, u32, u64) -> u32 + Sync),
-        progress: &(dyn Fn(u64) + Sync),
+        progress: &(dyn Fn(&TileDone) + Sync),
         cancel: &AtomicBool,
     ) {
         let first = self.settings.sample_range.map_or(0, |r| r[0]);
@@ -572,7 +602,13 @@ impl<'a> Frame<'a> {
                 );
                 out.samples += ok;
                 out.nonfinite += bad;
-                progress(ok + bad);
+                progress(&TileDone {
+                    samples: ok + bad,
+                    x0,
+                    y0,
+                    w,
+                    pixels: &out.pixels,
+                });
                 out
             })
             .collect();
@@ -589,7 +625,7 @@ pub fn render_from(
     integrator: &dyn Integrator,
     settings: &RenderSettings,
     mut film: Film,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: &(dyn Fn(&TileDone) + Sync),
     cancel: &AtomicBool,
     after_pass: &mut dyn FnMut(&Film, &RenderStats),
 ) -> (Film, RenderStats) {

@@ -24,8 +24,9 @@ use pathlab_render::integrator::IntegratorKind;
 use pathlab_render::progressive::{
     estimated_relative_rmse, render_progressive_from, ProgressiveReport, StopRule,
 };
-use pathlab_render::render::{render_from, RenderSettings, RenderStats};
+use pathlab_render::render::{render_from, RenderSettings, RenderStats, TileDone};
 use pathlab_render::scene::Scene;
+use pathlab_render::tev::{Layers, TevDisplay};
 use pathlab_scene::SceneDesc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -77,6 +78,18 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         Some(path) => resumed_film(path, &header, args.quiet)?,
         None => Film::new(w, h),
     };
+    let display = args.display.as_deref().and_then(|addr| {
+        let name = std::path::Path::new(&args.scene)
+            .file_name()
+            .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
+        let layers = Layers {
+            variance: args.aov.contains(&args::Aov::Variance),
+            samples: args.aov.contains(&args::Aov::Samples),
+        };
+        TevDisplay::connect(addr, &name, &start_film, layers)
+            .map_err(|w| eprintln!("warning: {w}"))
+            .ok()
+    });
     let pixels = settings.crop.map_or(w as u64 * h as u64, |c| {
         (c[2] - c[0]) as u64 * (c[3] - c[1]) as u64
     });
@@ -96,9 +109,18 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
             max_spp: stop_cap,
         }),
     };
+    let progress = |t: &TileDone| {
+        bar.inc(t.samples);
+        if let Some(d) = &display {
+            d.tile(t);
+        }
+    };
     let (film, stats, estimated_error) =
-        pool.install(|| job.run(args, start_film, &bar, cancel))?;
+        pool.install(|| job.run(args, start_film, &progress, &bar, cancel))?;
     bar.finish_and_clear();
+    if let Some(w) = display.and_then(|d| d.finish(&film)) {
+        eprintln!("warning: {w}");
+    }
     if stats.cancelled {
         let counts = film.sample_counts();
         let (lo, hi) = counts.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &c| {
@@ -245,6 +267,7 @@ impl Job<'_> {
         &self,
         args: &RenderArgs,
         film: Film,
+        progress: &(dyn Fn(&TileDone) + Sync),
         bar: &Arc<indicatif::ProgressBar>,
         cancel: &AtomicBool,
     ) -> Result<(Film, RenderStats, Option<f64>)> {
@@ -272,7 +295,7 @@ impl Job<'_> {
                     self.settings,
                     stop,
                     film,
-                    &|_| {},
+                    progress,
                     cancel,
                     &mut after_pass,
                 );
@@ -291,7 +314,7 @@ impl Job<'_> {
                     self.integrator,
                     self.settings,
                     film,
-                    &|n| bar.inc(n),
+                    progress,
                     cancel,
                     &mut |film, _| checkpoint(film),
                 );
