@@ -56,7 +56,7 @@ pub fn depth_from_name(path: &Path) -> Option<String> {
     Some(d.saturating_sub(1).to_string())
 }
 
-use pathlab_render::light::{luminance as luminance_f32, luminance_f64 as luminance};
+use pathlab_render::color::{luminance as luminance_f32, luminance_f64 as luminance};
 
 /// A warning when `reference` cannot be an image of what `film` renders: the image means,
 /// in luminance, differ by more than five of the render's standard errors (plus 0.1% of the

@@ -6,8 +6,7 @@ use std::sync::Arc;
 pub use crate::bsdf::{FresnelModel, NormalDistribution};
 pub use crate::texture::Texture;
 
-/// Linear RGB.
-pub type Rgb = Vec3;
+pub use crate::color::Rgb;
 
 /// A whole scene, as plain data.
 #[derive(Clone, Debug, Default)]

@@ -25,7 +25,7 @@ impl PixelStats {
     #[inline]
     pub fn add(&mut self, l: Rgb) {
         self.n += 1;
-        let lum = crate::light::luminance(l);
+        let lum = crate::color::luminance(l);
         for (c, v) in [l.x, l.y, l.z, lum].into_iter().enumerate() {
             let v = v as f64;
             self.sums[c] = self.sums[c].saturating_add(to_fixed(v));

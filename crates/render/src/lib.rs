@@ -42,8 +42,8 @@
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
+pub mod color;
 pub mod desc;
-pub mod envmap;
 pub mod film;
 pub mod film_file;
 pub mod film_image;
@@ -52,6 +52,8 @@ pub mod image_io;
 pub mod integrator;
 pub mod lanes;
 pub mod light;
+/// Environment maps (in [`light`]), by their old path.
+pub use light::envmap;
 pub mod progressive;
 pub mod render;
 pub mod scene;

@@ -165,7 +165,7 @@ impl AdaptiveRule {
     ) -> (Option<AdaptiveRule>, RenderStats) {
         let pilot = RenderSettings::new(Self::NEYMAN_PILOT_SPP, seed, sampler);
         let (film, stats) = render(scene, integrator, &pilot, &|_| {}, cancel);
-        let image_luminance = crate::light::luminance_f64(film.image_mean());
+        let image_luminance = crate::color::luminance_f64(film.image_mean());
         let rule = (image_luminance > 0.0).then_some(AdaptiveRule::Neyman { image_luminance });
         (rule, stats)
     }

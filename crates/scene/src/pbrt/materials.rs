@@ -12,10 +12,10 @@ use crate::mitsuba::ior::named_conductor;
 use crate::spectrum::{blackbody_to_rgb, sampled_to_rgb, xyz_to_srgb, SpectrumKind};
 use crate::Error;
 use glam::{DVec3, Vec3};
+use pathlab_render::color::luminance_f64 as luminance;
 use pathlab_render::desc::{
     FresnelModel, MaterialDesc, NormalDistribution, Rgb, TextureDesc, TextureFilter, WrapMode,
 };
-use pathlab_render::light::luminance_f64 as luminance;
 
 /// pbrt-v4's named glasses: their index at the sodium d line (587.6 nm).
 const GLASSES: &[(&str, f32)] = &[

@@ -328,7 +328,7 @@ impl Builder {
                 };
                 if wl.z > 0.0 {
                     let sin_t = (std::f64::consts::PI * j as f64 / (out_h - 1) as f64).sin();
-                    let lum = pathlab_render::light::luminance_f64(l.as_dvec3());
+                    let lum = pathlab_render::color::luminance_f64(l.as_dvec3());
                     upper += lum * wl.z * sin_t;
                 }
                 out.push(l);

@@ -1,4 +1,3 @@
-
 use super::box_test::RayBoxes;
 use super::stack::Stack;
 use super::*;

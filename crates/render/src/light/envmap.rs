@@ -12,8 +12,8 @@
 //! radiance inside it) times ∫ sin θ over its rows, so the density per solid angle,
 //! p(ω) = p(u, v) / (2π² sin θ), follows the radiance and small bright suns are found.
 
+use crate::color::luminance;
 use crate::desc::Rgb;
-use crate::light::luminance;
 use glam::{Mat3, Vec2, Vec3};
 use pathlab_mc::distribution::PiecewiseConstant2D;
 use std::f32::consts::{PI, TAU};

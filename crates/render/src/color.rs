@@ -1,0 +1,23 @@
+//! Colour: linear sRGB / Rec. 709 radiance and reflectance, and its luminance.
+
+use glam::Vec3;
+
+/// Linear sRGB / Rec. 709 radiance or reflectance.
+pub type Rgb = Vec3;
+
+/// The weights of relative luminance Y for linear sRGB / Rec. 709 primaries.
+pub const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+/// Relative luminance of linear sRGB / Rec. 709 primaries.
+#[inline]
+pub fn luminance(c: Rgb) -> f32 {
+    let [r, g, b] = LUMINANCE_WEIGHTS;
+    r as f32 * c.x + g as f32 * c.y + b as f32 * c.z
+}
+
+/// [`luminance`] in double precision (of image means and other sums).
+#[inline]
+pub fn luminance_f64(c: glam::DVec3) -> f64 {
+    let [r, g, b] = LUMINANCE_WEIGHTS;
+    r * c.x + g * c.y + b * c.z
+}
