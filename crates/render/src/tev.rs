@@ -350,7 +350,7 @@ mod tests {
         .concat();
         assert_eq!(u, want);
         let c = close_image_packet("ab");
-        assert_eq!(c, [9, 0, 0, 0, 2, b'a', b'b', 0].to_vec());
+        assert_eq!(c, [8, 0, 0, 0, 2, b'a', b'b', 0].to_vec());
         assert_eq!(
             u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as usize,
             c.len()
