@@ -166,6 +166,9 @@ enum Message {
     Finish(Box<Film>),
 }
 
+/// The port tev listens on unless told otherwise.
+pub const TEV_PORT: u16 = 14158;
+
 /// Seconds between updates sent to tev.
 const UPDATE_INTERVAL: Duration = Duration::from_millis(250);
 /// Edge of the tiles the display tracks and sends (the render's own tile size).
@@ -178,15 +181,21 @@ pub struct TevDisplay {
 }
 
 impl TevDisplay {
-    /// Connects to tev at `addr` (`HOST:PORT`; tev listens on 14158), creates the image
+    /// Connects to tev at `addr` (`HOST:PORT`, or `HOST` for tev's port 14158), creates the image
     /// `name` and shows `film` (the render's starting film) in it. An error is a sentence for
     /// a warning: nothing listening, or a refused connection.
     pub fn connect(addr: &str, name: &str, film: &Film, layers: Layers) -> Result<Self, String> {
-        let target = addr
+        // A host alone means tev's own port.
+        let with_port = if addr.contains(':') {
+            addr.to_string()
+        } else {
+            format!("{addr}:{TEV_PORT}")
+        };
+        let target = with_port
             .to_socket_addrs()
-            .map_err(|e| format!("--display {addr}: {e}"))?
+            .map_err(|e| format!("--display {addr}: {e}; rendering without it"))?
             .next()
-            .ok_or_else(|| format!("--display {addr}: no such address"))?;
+            .ok_or_else(|| format!("--display {addr}: no such address; rendering without it"))?;
         let stream = TcpStream::connect_timeout(&target, Duration::from_secs(1)).map_err(|e| {
             format!("--display {addr}: cannot reach tev ({e}); rendering without it")
         })?;
