@@ -62,10 +62,27 @@ pub struct Bvh {
     prim_indices: Vec<u32>,
 }
 
-struct BuildPrim {
-    bounds: Aabb,
-    centroid: Vec3,
-    index: u32,
+/// A primitive as the builders (this binary tree's and the wide trees') see it.
+#[derive(Clone, Copy)]
+pub(super) struct BuildPrim {
+    pub(super) bounds: Aabb,
+    pub(super) centroid: Vec3,
+    pub(super) index: u32,
+}
+
+/// The primitives a tree is built over: those whose box (`bounds[i]` for primitive `i`) is
+/// neither empty nor non-finite.
+pub(super) fn build_prims(bounds: &[Aabb]) -> Vec<BuildPrim> {
+    bounds
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| !b.is_empty() && b.min.is_finite() && b.max.is_finite())
+        .map(|(i, b)| BuildPrim {
+            bounds: *b,
+            centroid: b.centroid(),
+            index: i as u32,
+        })
+        .collect()
 }
 
 #[derive(Clone, Copy)]
@@ -84,16 +101,7 @@ impl Bvh {
     /// Builds the tree over `bounds` (primitive `i` has box `bounds[i]`). Primitives with an
     /// empty or non-finite box are left out.
     pub fn build(bounds: &[Aabb], params: BvhParams) -> Bvh {
-        let mut prims: Vec<BuildPrim> = bounds
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| !b.is_empty() && b.min.is_finite() && b.max.is_finite())
-            .map(|(i, b)| BuildPrim {
-                bounds: *b,
-                centroid: b.centroid(),
-                index: i as u32,
-            })
-            .collect();
+        let mut prims = build_prims(bounds);
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(2 * prims.len() / params.max_leaf_size.max(1) + 1),
             prim_indices: Vec::with_capacity(prims.len()),

@@ -3,9 +3,8 @@
 
 use super::node::{leaf_word, Node, MAX_LEAF, MAX_PRIMITIVES};
 use super::WideBvh;
-use crate::accel::bvh::{partition, BvhParams};
+use crate::accel::bvh::{build_prims, partition, BuildPrim, BvhParams};
 use crate::geometry::Aabb;
-use glam::Vec3;
 
 /// Number of SAH bins per axis (fixed, so that binning needs no allocation).
 const BINS: usize = 32;
@@ -14,12 +13,6 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// Depth of the binary tree from which splits are at the median: below it, at most 32 more
 /// levels for up to 2^32 primitives.
 const MEDIAN_DEPTH: usize = 32;
-#[derive(Clone, Copy)]
-struct BuildPrim {
-    bounds: Aabb,
-    centroid: Vec3,
-    index: u32,
-}
 
 /// The binary tree the builder makes before collapsing it.
 enum BuildNode {
@@ -58,16 +51,7 @@ impl<const W: usize> WideBvh<W> {
             max_leaf_size: params.max_leaf_size.clamp(1, MAX_LEAF),
             ..params
         };
-        let mut prims: Vec<BuildPrim> = bounds
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| !b.is_empty() && b.min.is_finite() && b.max.is_finite())
-            .map(|(i, b)| BuildPrim {
-                bounds: *b,
-                centroid: b.centroid(),
-                index: i as u32,
-            })
-            .collect();
+        let mut prims = build_prims(bounds);
         if prims.is_empty() {
             return WideBvh::default();
         }
