@@ -181,6 +181,17 @@ impl Film {
         self.pixels.iter().map(|p| p.count() as f32).collect()
     }
 
+    /// The fewest, the most and the mean samples per pixel, over the values
+    /// [`Film::sample_counts`] holds (adaptive and progressive renders vary them per pixel).
+    pub fn sample_count_range(&self) -> SampleCountRange {
+        let counts = self.sample_counts();
+        let (min, max) = counts.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &c| {
+            (lo.min(c), hi.max(c))
+        });
+        let mean = counts.iter().map(|&c| c as f64).sum::<f64>() / counts.len().max(1) as f64;
+        SampleCountRange { min, max, mean }
+    }
+
     /// Mean of all pixel means.
     pub fn image_mean(&self) -> DVec3 {
         let sum: DVec3 = self.pixels.iter().map(|p| p.mean()).sum();
@@ -194,4 +205,15 @@ impl Film {
         let n = self.pixels.len().max(1) as f64;
         (sum / (n * n)).map(f64::sqrt)
     }
+}
+
+/// Samples per pixel over a film ([`Film::sample_count_range`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleCountRange {
+    /// The fewest a pixel holds.
+    pub min: f32,
+    /// The most a pixel holds.
+    pub max: f32,
+    /// Their mean over the pixels.
+    pub mean: f64,
 }

@@ -122,10 +122,8 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         eprintln!("warning: {w}");
     }
     if stats.cancelled {
-        let counts = film.sample_counts();
-        let (lo, hi) = counts.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &c| {
-            (lo.min(c), hi.max(c))
-        });
+        let spp = film.sample_count_range();
+        let (lo, hi) = (spp.min, spp.max);
         eprintln!(
             "interrupted: writing the image of the {} samples finished, {lo:.0} to {hi:.0} per pixel{}",
             stats.samples,
@@ -154,9 +152,8 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         }
     }
     if let (Some(rate), false) = (&written.rate_image, args.quiet) {
-        let counts = film.sample_counts();
-        let pixels = counts.len().max(1) as f64;
-        let mean = counts.iter().map(|&c| c as f64).sum::<f64>() / pixels;
+        let mean = film.sample_count_range().mean;
+        let pixels = film.pixels().len().max(1) as f64;
         let pilot = if stats.pilot_samples > 0 {
             format!(
                 ", plus {:.1} pilot samples per pixel that chose the counts",

@@ -82,11 +82,8 @@ pub(super) fn print_summary(
     let build = scene.stats();
     let mean = film.image_mean();
     // Samples per pixel as taken: adaptive and progressive renders vary them per pixel.
-    let counts = film.sample_counts();
-    let (spp_lo, spp_hi) = counts.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &c| {
-        (lo.min(c), hi.max(c))
-    });
-    let spp_mean = counts.iter().map(|&c| c as f64).sum::<f64>() / counts.len().max(1) as f64;
+    let spp = film.sample_count_range();
+    let (spp_lo, spp_hi, spp_mean) = (spp.min, spp.max, spp.mean);
     let varies = spp_lo != spp_hi || progressive || settings.adaptive.is_some();
     let spp_text = if varies {
         format!("{spp_mean:.1} spp on average ({spp_lo:.0} to {spp_hi:.0})")
