@@ -172,6 +172,20 @@ impl AdaptiveRule {
 }
 
 impl RenderSettings {
+    /// `[x0, y0, x1, y1]` of the pixels rendered in an image of `resolution`: the crop window
+    /// (clamped to the image), or the whole image.
+    pub fn window(&self, [width, height]: [u32; 2]) -> [u32; 4] {
+        self.crop.map_or([0, 0, width, height], |[x0, y0, x1, y1]| {
+            [x0.min(width), y0.min(height), x1.min(width), y1.min(height)]
+        })
+    }
+
+    /// How many pixels of an image of `resolution` are rendered ([`RenderSettings::window`]).
+    pub fn pixel_count(&self, resolution: [u32; 2]) -> u64 {
+        let [x0, y0, x1, y1] = self.window(resolution);
+        x1.saturating_sub(x0) as u64 * y1.saturating_sub(y0) as u64
+    }
+
     /// `spp` samples per pixel of the whole image with the given seed and sampler.
     pub fn new(spp: u32, seed: u64, sampler: SamplerKind) -> Self {
         RenderSettings {
@@ -493,12 +507,7 @@ impl<'a> Frame<'a> {
         integrator: &'a dyn Integrator,
         settings: &'a RenderSettings,
     ) -> Self {
-        let [width, height] = scene.camera().resolution();
-        let window = settings
-            .crop
-            .map_or([0, 0, width, height], |[x0, y0, x1, y1]| {
-                [x0.min(width), y0.min(height), x1.min(width), y1.min(height)]
-            });
+        let window = settings.window(scene.camera().resolution());
         let [cx0, cy0, cx1, cy1] = window;
         let tiles = (cy0..cy1)
             .step_by(TILE_SIZE as usize)
@@ -521,8 +530,7 @@ impl<'a> Frame<'a> {
 
     /// How many pixels are rendered.
     pub(crate) fn pixel_count(&self) -> u64 {
-        let [x0, y0, x1, y1] = self.window;
-        (x1 - x0) as u64 * (y1 - y0) as u64
+        self.settings.pixel_count(self.scene.camera().resolution())
     }
 
     fn new_tile(&self, x0: u32, y0: u32) -> (u32, u32, TileResult) {

@@ -90,9 +90,7 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
             .map_err(|w| eprintln!("warning: {w}"))
             .ok()
     });
-    let pixels = settings.crop.map_or(w as u64 * h as u64, |c| {
-        (c[2] - c[0]) as u64 * (c[3] - c[1]) as u64
-    });
+    let pixels = settings.pixel_count(desc.resolution);
     let bar = Arc::new(report::progress_bar(args, progressive, pixels * spp as u64));
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
