@@ -1,7 +1,7 @@
-//! `pathlab-bench`: measurements that are not tests. `pathlab-bench rays MESH RAYS` traces the exact
-//! rays of a ray file written by the Embree benchmark (`bench/embree/`), checks every hit
-//! distance against Embree's, and reports build time, throughput and memory, so that the two
-//! can be compared as ratios in one script.
+//! `pathlab-bench`: measurements that are not tests. `pathlab-bench rays MESH RAYS` traces
+//! the exact rays of a ray file written by the Embree benchmark (`bench/embree/`), checks
+//! every hit distance against Embree's, and reports build time, throughput and memory, so
+//! that the two can be compared as ratios in one script.
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};

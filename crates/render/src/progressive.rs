@@ -102,8 +102,9 @@ pub fn render_progressive(
 
 /// Renders in whole-frame passes (the same pass routine as every render) until `stop` says
 /// so, continuing `film` (a checkpoint's, or an empty one). `settings.spp` is ignored (the
-/// stop rule's `max_spp` caps the average); `settings.adaptive` too. `progress` as
-/// tiles finish ([`TileDone`]); `after_pass(film, stats, pass, estimated error)` after each finished pass.
+/// stop rule's `max_spp` caps the average); `settings.adaptive` too. `progress` as tiles
+/// finish ([`TileDone`]); `after_pass(film, stats, pass, estimated error)` after each
+/// finished pass.
 ///
 /// Each pass's allocation is a function of the film alone, so going on from a film written
 /// after a pass gives, with the same stop rule, the image of the uninterrupted render bit for

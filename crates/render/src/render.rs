@@ -295,8 +295,9 @@ fn add_sample(px: &mut PixelStats, l: crate::desc::Rgb, ok: &mut u64, bad: &mut 
 /// Each pixel's samples use the sampler positioned at (pixel, sample index), and the film
 /// sums them exactly, so the image is the same for the same seed whatever the thread count,
 /// tile order or pass schedule. `progress` is told of each tile as it finishes (from worker
-/// threads: its samples, and what it adds to the film, see [`TileDone`]); when `cancel` becomes true the render stops within a sample per thread and the
-/// film holds every sample finished (whole passes, and part of the last).
+/// threads: its samples, and what it adds to the film, see [`TileDone`]); when `cancel`
+/// becomes true the render stops within a sample per thread and the film holds every sample
+/// finished (whole passes, and part of the last).
 pub fn render(
     scene: &Scene,
     integrator: &dyn Integrator,

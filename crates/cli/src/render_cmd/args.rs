@@ -228,8 +228,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
     /// Show the render in the tev image viewer as it converges: tev's HOST:PORT (tev listens
-    /// on 127.0.0.1:14158, the port taken when only a HOST is given; start it with `tev`). With --aov, the variance and sample-count
-    /// layers too. If nothing listens: a warning, and the render goes on.
+    /// on 127.0.0.1:14158, the port taken when only a HOST is given; start it with `tev`).
+    /// With --aov, the variance and sample-count layers too. If nothing listens: a warning,
+    /// and the render goes on.
     #[arg(long, value_name = "HOST:PORT")]
     pub display: Option<String>,
     /// No progress bar.
