@@ -286,6 +286,8 @@ fn run(link: &mut Link, shadow: &mut Film, from_render: &Receiver<Message>) -> O
     let mut last = Instant::now();
     loop {
         match from_render.recv_timeout(UPDATE_INTERVAL / 4) {
+            // Once tev is gone nothing more is shown: the tiles are only taken.
+            Ok(Message::Tile { .. }) if failed.is_some() => {}
             Ok(Message::Tile {
                 x0,
                 y0,
