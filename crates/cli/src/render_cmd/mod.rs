@@ -21,9 +21,7 @@ use outputs::OutputFormat;
 use pathlab_render::film::Film;
 use pathlab_render::film_file::FilmHeader;
 use pathlab_render::integrator::IntegratorKind;
-use pathlab_render::progressive::{
-    estimated_relative_rmse, render_progressive_from, ProgressiveReport, StopRule,
-};
+use pathlab_render::progressive::{estimated_relative_rmse, render_progressive_from, StopRule};
 use pathlab_render::render::{render_from, RenderSettings, RenderStats, TileDone};
 use pathlab_render::scene::Scene;
 use pathlab_render::tev::{Layers, TevDisplay};
@@ -294,7 +292,8 @@ impl Job<'_> {
                     cancel,
                     &mut after_pass,
                 );
-                let error = estimate_or_last(&film, &report);
+                // Of the film as written (after a stop mid-pass too).
+                let error = estimated_relative_rmse(&film);
                 if !args.quiet {
                     eprintln!(
                         "progressive: {} passes, stopped by {}; estimated relative RMSE {error:.4}",
@@ -325,14 +324,4 @@ impl Job<'_> {
         }
         Ok((film, stats, estimated_error))
     }
-}
-
-/// The estimated relative RMSE after the last pass, or of the film when no pass finished
-/// (stopped at once, or a resumed film already at its target).
-fn estimate_or_last(film: &Film, report: &ProgressiveReport) -> f64 {
-    report
-        .error_history
-        .last()
-        .copied()
-        .unwrap_or_else(|| estimated_relative_rmse(film))
 }
