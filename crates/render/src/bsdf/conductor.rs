@@ -2,8 +2,9 @@
 //! reflectance of a complex index of refraction.
 
 use super::fresnel::fresnel_conductor;
-use super::microfacet::{reflect, Microfacet};
+use super::microfacet::Microfacet;
 use super::mirror::specular_reflection;
+use super::scattering::reflect;
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};

@@ -2,6 +2,7 @@
 
 use super::fresnel::{fresnel_dielectric, fresnel_schlick};
 use super::mirror::specular_reflection;
+use super::scattering::refract;
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::Vec3;
@@ -62,22 +63,4 @@ impl SmoothDielectric {
             delta: true,
         })
     }
-}
-
-/// Refracts `wo` (local frame, z = normal) through an interface of relative index `eta`
-/// (inside / outside); `None` under total internal reflection. Returns wi and the relative
-/// index η' along the path (η for entering, 1/η for leaving).
-pub fn refract(wo: Vec3, eta: f32) -> Option<(Vec3, f32)> {
-    let (cos_o, etap, sign) = if wo.z > 0.0 {
-        (wo.z, eta, 1.0)
-    } else {
-        (-wo.z, 1.0 / eta, -1.0)
-    };
-    let sin2_t = (1.0 - cos_o * cos_o).max(0.0) / (etap * etap);
-    if sin2_t >= 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let wi = Vec3::new(-wo.x / etap, -wo.y / etap, -sign * cos_t);
-    Some((wi.normalize(), etap))
 }

@@ -8,7 +8,9 @@
 use super::rough_plastic::CoatTable;
 use super::*;
 use crate::desc::{MaterialDesc, NormalDistribution, Rgb};
+use crate::geometry::Frame;
 use crate::texture::{Tex, TexPoint};
+use glam::{Vec2, Vec3};
 
 /// Where a material is evaluated.
 #[derive(Clone, Copy, Debug)]
@@ -88,20 +90,20 @@ pub enum Model {
 /// A principled material's textured parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PrincipledModel {
-    base_color: Tex,
-    roughness: Tex,
-    anisotropic: Option<Tex>,
-    spec_trans: Option<Tex>,
-    metallic: Option<Tex>,
-    clearcoat: Option<Tex>,
-    clearcoat_gloss: Tex,
-    sheen: Option<Tex>,
-    sheen_tint: Option<Tex>,
-    spec_tint: Option<Tex>,
-    flatness: Option<Tex>,
-    diff_trans: Option<Tex>,
-    eta: Tex,
-    thin: bool,
+    pub(super) base_color: Tex,
+    pub(super) roughness: Tex,
+    pub(super) anisotropic: Option<Tex>,
+    pub(super) spec_trans: Option<Tex>,
+    pub(super) metallic: Option<Tex>,
+    pub(super) clearcoat: Option<Tex>,
+    pub(super) clearcoat_gloss: Tex,
+    pub(super) sheen: Option<Tex>,
+    pub(super) sheen_tint: Option<Tex>,
+    pub(super) spec_tint: Option<Tex>,
+    pub(super) flatness: Option<Tex>,
+    pub(super) diff_trans: Option<Tex>,
+    pub(super) eta: Tex,
+    pub(super) thin: bool,
 }
 
 impl PrincipledModel {
@@ -371,239 +373,6 @@ impl Material {
                 }
                 let n_local = tangent_frame(at.n, at.dpdu).to_local(n);
                 inner.collect(p, &at.perturbed(n_local, wo), wo, weight, lobes, null);
-            }
-        }
-    }
-
-    /// The material of a description; `attribute` gives the scene's table index of a named
-    /// mesh attribute its textures read.
-    pub fn from_desc(d: &MaterialDesc, attribute: &mut dyn FnMut(&str) -> u32) -> Self {
-        let mut tex = |t: &crate::desc::TextureDesc| Tex::new(t, attribute);
-        match d {
-            MaterialDesc::Diffuse {
-                reflectance,
-                two_sided,
-            } => Material::new(
-                Bxdf::Diffuse(Diffuse {
-                    reflectance: reflectance.clamp(Vec3::ZERO, Vec3::ONE),
-                }),
-                *two_sided,
-            ),
-            MaterialDesc::TexturedDiffuse {
-                texture,
-                scale,
-                two_sided,
-            } => Material::Leaf(Leaf {
-                model: Model::Diffuse {
-                    texture: tex(texture),
-                    scale: scale.max(Vec3::ZERO),
-                },
-                two_sided: *two_sided,
-            }),
-            MaterialDesc::Mirror { reflectance } => Material::new(
-                Bxdf::Mirror(Mirror {
-                    reflectance: *reflectance,
-                }),
-                true,
-            ),
-            &MaterialDesc::Glass {
-                reflectance,
-                transmittance,
-                roughness,
-                ior,
-                distribution,
-                fresnel,
-            } => {
-                let eta = usable_ior(ior);
-                let bxdf = if roughness > SMOOTH_ALPHA {
-                    Bxdf::RoughDielectric(RoughDielectric {
-                        eta,
-                        distribution: Microfacet::new(distribution, roughness),
-                        reflectance,
-                        transmittance,
-                    })
-                } else {
-                    Bxdf::Dielectric(SmoothDielectric {
-                        eta,
-                        reflectance,
-                        transmittance,
-                        fresnel,
-                    })
-                };
-                // The side matters: inside and outside differ.
-                Material::new(bxdf, false)
-            }
-            &MaterialDesc::ThinGlass {
-                reflectance,
-                transmittance,
-                ior,
-            } => Material::new(
-                Bxdf::ThinDielectric(ThinDielectric {
-                    eta: usable_ior(ior),
-                    reflectance,
-                    transmittance,
-                }),
-                false,
-            ),
-            &MaterialDesc::Conductor {
-                alpha,
-                eta,
-                k,
-                distribution,
-            } => Material::new(
-                Bxdf::Conductor(Conductor {
-                    eta,
-                    k,
-                    specular: Rgb::ONE,
-                    distribution: (alpha > SMOOTH_ALPHA)
-                        .then(|| Microfacet::new(distribution, alpha)),
-                }),
-                true,
-            ),
-            MaterialDesc::RoughConductor {
-                alpha_u,
-                alpha_v,
-                eta,
-                k,
-                specular,
-                distribution,
-            } if alpha_u.as_constant().is_some()
-                && alpha_u.as_constant() == alpha_v.as_constant()
-                && specular.as_constant().is_some() =>
-            {
-                let alpha = alpha_u.as_constant().unwrap_or_default().x;
-                Material::new(
-                    Bxdf::Conductor(Conductor {
-                        eta: *eta,
-                        k: *k,
-                        specular: specular.as_constant().unwrap_or(Rgb::ONE),
-                        distribution: (alpha > SMOOTH_ALPHA)
-                            .then(|| Microfacet::new(*distribution, alpha)),
-                    }),
-                    true,
-                )
-            }
-            MaterialDesc::RoughConductor {
-                alpha_u,
-                alpha_v,
-                eta,
-                k,
-                specular,
-                distribution,
-            } => Material::Leaf(Leaf {
-                model: Model::Conductor {
-                    alpha_u: tex(alpha_u),
-                    alpha_v: tex(alpha_v),
-                    eta: *eta,
-                    k: *k,
-                    specular: tex(specular),
-                    kind: *distribution,
-                },
-                two_sided: true,
-            }),
-            &MaterialDesc::Plastic {
-                diffuse,
-                specular,
-                ior,
-                nonlinear,
-            } => Material::new(
-                Bxdf::Plastic(
-                    Plastic::new(
-                        diffuse.clamp(Vec3::ZERO, Vec3::ONE),
-                        usable_ior(ior),
-                        nonlinear,
-                    )
-                    .with_specular(specular.max(Vec3::ZERO)),
-                ),
-                false,
-            ),
-            MaterialDesc::RoughPlastic {
-                diffuse,
-                specular,
-                alpha,
-                ior,
-                nonlinear,
-                distribution,
-            } => {
-                let eta = usable_ior(*ior);
-                let m = Microfacet::new(*distribution, *alpha);
-                if let Some(d) = diffuse.as_constant() {
-                    return Material::new(
-                        Bxdf::RoughPlastic(RoughPlastic::new(
-                            d.clamp(Vec3::ZERO, Vec3::ONE),
-                            *specular,
-                            eta,
-                            m,
-                            *nonlinear,
-                        )),
-                        false,
-                    );
-                }
-                Material::Leaf(Leaf {
-                    model: Model::RoughPlastic {
-                        diffuse: tex(diffuse),
-                        specular: *specular,
-                        eta,
-                        distribution: m,
-                        nonlinear: *nonlinear,
-                        table: CoatTable::get(m, eta),
-                    },
-                    two_sided: false,
-                })
-            }
-            MaterialDesc::Principled(d) => {
-                let mut opt = |t: &Option<crate::desc::TextureDesc>| t.as_ref().map(&mut tex);
-                let model = PrincipledModel {
-                    anisotropic: opt(&d.anisotropic),
-                    spec_trans: opt(&d.spec_trans),
-                    metallic: opt(&d.metallic),
-                    clearcoat: opt(&d.clearcoat),
-                    sheen: opt(&d.sheen),
-                    sheen_tint: opt(&d.sheen_tint),
-                    spec_tint: opt(&d.spec_tint),
-                    flatness: opt(&d.flatness),
-                    diff_trans: opt(&d.diff_trans),
-                    base_color: tex(&d.base_color),
-                    roughness: tex(&d.roughness),
-                    clearcoat_gloss: tex(&d.clearcoat_gloss),
-                    eta: tex(&d.eta),
-                    thin: d.thin,
-                };
-                Material::Leaf(Leaf {
-                    model: Model::Principled(Box::new(model)),
-                    two_sided: false,
-                })
-            }
-            MaterialDesc::Mask { opacity, inner } => {
-                let o = tex(opacity);
-                Material::Mask(o, Box::new(Material::from_desc(inner, attribute)))
-            }
-            MaterialDesc::Blend {
-                weight,
-                first,
-                second,
-            } => {
-                let w = tex(weight);
-                let a = Material::from_desc(first, attribute);
-                let b = Material::from_desc(second, attribute);
-                Material::Blend(w, Box::new((a, b)))
-            }
-            MaterialDesc::TwoSided { front, back } => {
-                let a = Material::from_desc(front, attribute);
-                let b = Material::from_desc(back, attribute);
-                Material::TwoSided(Box::new((a, b)))
-            }
-            MaterialDesc::NormalMap { normals, inner } => {
-                let n = tex(normals);
-                Material::NormalMap(n, Box::new(Material::from_desc(inner, attribute)))
-            }
-            MaterialDesc::BumpMap {
-                height,
-                scale,
-                inner,
-            } => {
-                let h = tex(height);
-                Material::BumpMap(h, *scale, Box::new(Material::from_desc(inner, attribute)))
             }
         }
     }

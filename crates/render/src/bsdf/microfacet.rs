@@ -237,31 +237,6 @@ impl Microfacet {
     }
 }
 
-/// Mirror reflection of `w` about the unit normal `n`.
-#[inline]
-pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
-    2.0 * w.dot(n) * n - w
-}
-
-/// Refraction of `w` (pointing away from the interface) through a facet with unit normal `n`
-/// and relative index `eta` = n_below / n_above. `None` under total internal reflection;
-/// otherwise the refracted direction and the relative index η' along the path.
-pub fn refract_about(w: Vec3, n: Vec3, eta: f32) -> Option<(Vec3, f32)> {
-    let (mut cos_i, mut n, mut etap) = (w.dot(n), n, eta);
-    if cos_i < 0.0 {
-        etap = 1.0 / eta;
-        cos_i = -cos_i;
-        n = -n;
-    }
-    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (etap * etap);
-    if sin2_t >= 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let wt = -w / etap + (cos_i / etap - cos_t) * n;
-    Some((wt.normalize(), etap))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -318,20 +293,5 @@ mod tests {
                 }
             }
         }
-    }
-
-    #[test]
-    fn refraction_about_a_facet_obeys_snell() {
-        let n = Vec3::new(0.3, 0.1, 1.0).normalize();
-        let w = Vec3::new(-0.2, 0.5, 0.8).normalize();
-        let (t, etap) = refract_about(w, n, 1.5).unwrap();
-        assert_eq!(etap, 1.5);
-        let sin_i = w.cross(n).length();
-        let sin_t = t.cross(n).length();
-        assert!((sin_i - 1.5 * sin_t).abs() < 1e-5);
-        assert!(t.dot(n) < 0.0);
-        let (back, _) = refract_about(t, n, 1.5).unwrap();
-        assert!((back - w).length() < 1e-5);
-        assert!((reflect(w, n).dot(n) - w.dot(n)).abs() < 1e-6);
     }
 }

@@ -6,7 +6,8 @@
 //! both in the local frame. Mitsuba's formulas give f · |cos θi|; these return f.
 
 use super::fresnel::fresnel_dielectric;
-use super::microfacet::{reflect, refract_about, Microfacet, NormalDistribution};
+use super::microfacet::{Microfacet, NormalDistribution};
+use super::scattering::{reflect, refract_about};
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};

@@ -1,7 +1,8 @@
 //! A rough dielectric interface: microfacet reflection and transmission (Walter et al. 2007).
 
 use super::fresnel::fresnel_dielectric;
-use super::microfacet::{reflect, refract_about, Microfacet};
+use super::microfacet::Microfacet;
+use super::scattering::{reflect, refract_about};
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};

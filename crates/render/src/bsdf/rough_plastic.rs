@@ -1,7 +1,8 @@
 //! A diffuse base under a rough dielectric coat (Mitsuba's `roughplastic`).
 
 use super::fresnel::fresnel_dielectric;
-use super::microfacet::{reflect, refract_about, Microfacet, NormalDistribution};
+use super::microfacet::{Microfacet, NormalDistribution};
+use super::scattering::{reflect, refract_about};
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};

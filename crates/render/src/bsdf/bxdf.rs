@@ -1,0 +1,124 @@
+//! The reflectance models a material is made of, dispatched by [`Bxdf`]: each in its own
+//! shading frame (z = shading normal), with `f`, `sample` and `pdf`.
+
+use super::*;
+use crate::desc::Rgb;
+use glam::{Vec2, Vec3};
+
+/// A sampled direction in the local frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalSample {
+    /// f(wo, wi).
+    pub f: Rgb,
+    /// The direction, local frame.
+    pub wi: Vec3,
+    /// Density per solid angle, or the probability of a delta lobe.
+    pub pdf: f32,
+    /// Whether it comes from a delta lobe.
+    pub delta: bool,
+}
+
+impl LocalSample {
+    /// A non-delta sample of direction `wi` with density `pdf`, whose f is evaluated only when
+    /// the density is positive (`None` otherwise: a direction the strategy cannot produce).
+    #[inline]
+    pub(crate) fn evaluated(wi: Vec3, pdf: f32, f: impl FnOnce() -> Rgb) -> Option<LocalSample> {
+        (pdf > 0.0).then(|| LocalSample {
+            f: f(),
+            wi,
+            pdf,
+            delta: false,
+        })
+    }
+}
+
+/// The reflectance model of a material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bxdf {
+    /// Lambertian.
+    Diffuse(Diffuse),
+    /// Perfect specular reflection.
+    Mirror(Mirror),
+    /// Smooth glass.
+    Dielectric(SmoothDielectric),
+    /// A thin sheet of glass.
+    ThinDielectric(ThinDielectric),
+    /// A smooth or rough conductor.
+    Conductor(Conductor),
+    /// Rough glass.
+    RoughDielectric(RoughDielectric),
+    /// Diffuse under a smooth coat.
+    Plastic(Plastic),
+    /// Diffuse under a rough coat.
+    RoughPlastic(RoughPlastic),
+    /// Disney's principled BSDF (Mitsuba's `principled` and `principledthin`).
+    Principled(Principled),
+}
+
+impl Bxdf {
+    /// f(wo, wi) in the local frame (zero for delta lobes).
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        match self {
+            Bxdf::Diffuse(b) => b.f(wo, wi),
+            Bxdf::Conductor(b) => b.f(wo, wi),
+            Bxdf::RoughDielectric(b) => b.f(wo, wi),
+            Bxdf::Plastic(b) => b.f(wo, wi),
+            Bxdf::RoughPlastic(b) => b.f(wo, wi),
+            Bxdf::Principled(b) => b.f(wo, wi),
+            Bxdf::Mirror(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => Rgb::ZERO,
+        }
+    }
+
+    /// Samples wi given wo in the local frame: `uc` chooses a lobe, `u` the direction.
+    pub fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<LocalSample> {
+        match self {
+            Bxdf::Diffuse(b) => b.sample(wo, u),
+            Bxdf::Mirror(b) => b.sample(wo),
+            Bxdf::Dielectric(b) => b.sample(wo, uc),
+            Bxdf::ThinDielectric(b) => b.sample(wo, uc),
+            Bxdf::Conductor(b) => b.sample(wo, u),
+            Bxdf::RoughDielectric(b) => b.sample(wo, uc, u),
+            Bxdf::Plastic(b) => b.sample(wo, uc, u),
+            Bxdf::RoughPlastic(b) => b.sample(wo, uc, u),
+            Bxdf::Principled(b) => b.sample(wo, uc, u),
+        }
+    }
+
+    /// Density of [`Bxdf::sample`] choosing `wi` (its non-delta part).
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            Bxdf::Diffuse(b) => b.pdf(wo, wi),
+            Bxdf::Conductor(b) => b.pdf(wo, wi),
+            Bxdf::RoughDielectric(b) => b.pdf(wo, wi),
+            Bxdf::Plastic(b) => b.pdf(wo, wi),
+            Bxdf::RoughPlastic(b) => b.pdf(wo, wi),
+            Bxdf::Principled(b) => b.pdf(wo, wi),
+            Bxdf::Mirror(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => 0.0,
+        }
+    }
+
+    /// Whether every lobe is a delta distribution (light sampling can never help).
+    pub fn is_delta(&self) -> bool {
+        match self {
+            Bxdf::Mirror(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => true,
+            Bxdf::Conductor(c) => c.distribution.is_none(),
+            Bxdf::Diffuse(_)
+            | Bxdf::RoughDielectric(_)
+            | Bxdf::Plastic(_)
+            | Bxdf::RoughPlastic(_)
+            | Bxdf::Principled(_) => false,
+        }
+    }
+}
+
+/// A description's index of refraction, or glass's 1.5 where it is not a positive number.
+pub(crate) fn usable_ior(ior: f32) -> f32 {
+    if ior > 0.0 && ior.is_finite() {
+        ior
+    } else {
+        1.5
+    }
+}
+
+/// Roughness below which a microfacet model is drawn as its smooth (delta) limit.
+pub(crate) const SMOOTH_ALPHA: f32 = 1e-4;

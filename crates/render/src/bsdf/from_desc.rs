@@ -1,0 +1,247 @@
+//! What a scene's [`MaterialDesc`] becomes: a [`Material`] tree whose leaves are fixed BxDFs
+//! where nothing is textured, and textured models otherwise.
+
+use super::material::PrincipledModel;
+use super::rough_plastic::CoatTable;
+use super::*;
+use crate::desc::{MaterialDesc, PrincipledDesc, Rgb, TextureDesc};
+use crate::texture::Tex;
+use glam::Vec3;
+
+impl Material {
+    /// The material of a description; `attribute` gives the scene's table index of a named
+    /// mesh attribute its textures read.
+    pub fn from_desc(d: &MaterialDesc, attribute: &mut dyn FnMut(&str) -> u32) -> Self {
+        let mut tex = |t: &TextureDesc| Tex::new(t, attribute);
+        match d {
+            MaterialDesc::Diffuse {
+                reflectance,
+                two_sided,
+            } => Material::new(
+                Bxdf::Diffuse(Diffuse {
+                    reflectance: reflectance.clamp(Vec3::ZERO, Vec3::ONE),
+                }),
+                *two_sided,
+            ),
+            MaterialDesc::TexturedDiffuse {
+                texture,
+                scale,
+                two_sided,
+            } => Material::Leaf(Leaf {
+                model: Model::Diffuse {
+                    texture: tex(texture),
+                    scale: scale.max(Vec3::ZERO),
+                },
+                two_sided: *two_sided,
+            }),
+            MaterialDesc::Mirror { reflectance } => Material::new(
+                Bxdf::Mirror(Mirror {
+                    reflectance: *reflectance,
+                }),
+                true,
+            ),
+            MaterialDesc::Glass { .. } | MaterialDesc::ThinGlass { .. } => glass(d),
+            &MaterialDesc::Conductor {
+                alpha,
+                eta,
+                k,
+                distribution,
+            } => conductor(eta, k, Rgb::ONE, distribution, alpha),
+            MaterialDesc::RoughConductor { .. } => rough_conductor(d, &mut tex),
+            &MaterialDesc::Plastic {
+                diffuse,
+                specular,
+                ior,
+                nonlinear,
+            } => Material::new(
+                Bxdf::Plastic(
+                    Plastic::new(
+                        diffuse.clamp(Vec3::ZERO, Vec3::ONE),
+                        usable_ior(ior),
+                        nonlinear,
+                    )
+                    .with_specular(specular.max(Vec3::ZERO)),
+                ),
+                false,
+            ),
+            MaterialDesc::RoughPlastic { .. } => rough_plastic(d, &mut tex),
+            MaterialDesc::Principled(d) => principled(d, &mut tex),
+            MaterialDesc::Mask { opacity, inner } => {
+                let o = tex(opacity);
+                Material::Mask(o, Box::new(Material::from_desc(inner, attribute)))
+            }
+            MaterialDesc::Blend {
+                weight,
+                first,
+                second,
+            } => {
+                let w = tex(weight);
+                let a = Material::from_desc(first, attribute);
+                let b = Material::from_desc(second, attribute);
+                Material::Blend(w, Box::new((a, b)))
+            }
+            MaterialDesc::TwoSided { front, back } => {
+                let a = Material::from_desc(front, attribute);
+                let b = Material::from_desc(back, attribute);
+                Material::TwoSided(Box::new((a, b)))
+            }
+            MaterialDesc::NormalMap { normals, inner } => {
+                let n = tex(normals);
+                Material::NormalMap(n, Box::new(Material::from_desc(inner, attribute)))
+            }
+            MaterialDesc::BumpMap {
+                height,
+                scale,
+                inner,
+            } => {
+                let h = tex(height);
+                Material::BumpMap(h, *scale, Box::new(Material::from_desc(inner, attribute)))
+            }
+        }
+    }
+}
+
+/// Smooth, rough or thin glass. The side matters: inside and outside differ.
+fn glass(d: &MaterialDesc) -> Material {
+    let bxdf = match *d {
+        MaterialDesc::Glass {
+            reflectance,
+            transmittance,
+            roughness,
+            ior,
+            distribution,
+            fresnel: _,
+        } if roughness > SMOOTH_ALPHA => Bxdf::RoughDielectric(RoughDielectric {
+            eta: usable_ior(ior),
+            distribution: Microfacet::new(distribution, roughness),
+            reflectance,
+            transmittance,
+        }),
+        MaterialDesc::Glass {
+            reflectance,
+            transmittance,
+            ior,
+            fresnel,
+            ..
+        } => Bxdf::Dielectric(SmoothDielectric {
+            eta: usable_ior(ior),
+            reflectance,
+            transmittance,
+            fresnel,
+        }),
+        MaterialDesc::ThinGlass {
+            reflectance,
+            transmittance,
+            ior,
+        } => Bxdf::ThinDielectric(ThinDielectric {
+            eta: usable_ior(ior),
+            reflectance,
+            transmittance,
+        }),
+        _ => unreachable!("glass() is called with glass descriptions"),
+    };
+    Material::new(bxdf, false)
+}
+
+/// An isotropic conductor, smooth where `alpha` is below [`SMOOTH_ALPHA`].
+fn conductor(eta: Rgb, k: Rgb, specular: Rgb, kind: NormalDistribution, alpha: f32) -> Material {
+    Material::new(
+        Bxdf::Conductor(Conductor {
+            eta,
+            k,
+            specular,
+            distribution: (alpha > SMOOTH_ALPHA).then(|| Microfacet::new(kind, alpha)),
+        }),
+        true,
+    )
+}
+
+/// A rough conductor: a fixed BxDF when its roughness is one constant and its specular
+/// reflectance constant, else a textured (possibly anisotropic) model.
+fn rough_conductor(d: &MaterialDesc, tex: &mut dyn FnMut(&TextureDesc) -> Tex) -> Material {
+    let MaterialDesc::RoughConductor {
+        alpha_u,
+        alpha_v,
+        eta,
+        k,
+        specular,
+        distribution,
+    } = d
+    else {
+        unreachable!("rough_conductor() is called with rough conductors")
+    };
+    match (alpha_u.as_constant(), specular.as_constant()) {
+        (Some(alpha), Some(specular)) if alpha_v.as_constant() == Some(alpha) => {
+            conductor(*eta, *k, specular, *distribution, alpha.x)
+        }
+        _ => Material::Leaf(Leaf {
+            model: Model::Conductor {
+                alpha_u: tex(alpha_u),
+                alpha_v: tex(alpha_v),
+                eta: *eta,
+                k: *k,
+                specular: tex(specular),
+                kind: *distribution,
+            },
+            two_sided: true,
+        }),
+    }
+}
+
+/// Diffuse under a rough coat: a fixed BxDF when the diffuse reflectance is constant, else a
+/// textured model with its coat's table.
+fn rough_plastic(d: &MaterialDesc, tex: &mut dyn FnMut(&TextureDesc) -> Tex) -> Material {
+    let &MaterialDesc::RoughPlastic {
+        ref diffuse,
+        specular,
+        alpha,
+        ior,
+        nonlinear,
+        distribution,
+    } = d
+    else {
+        unreachable!("rough_plastic() is called with rough plastics")
+    };
+    let eta = usable_ior(ior);
+    let m = Microfacet::new(distribution, alpha);
+    if let Some(d) = diffuse.as_constant() {
+        let bxdf = RoughPlastic::new(d.clamp(Vec3::ZERO, Vec3::ONE), specular, eta, m, nonlinear);
+        return Material::new(Bxdf::RoughPlastic(bxdf), false);
+    }
+    Material::Leaf(Leaf {
+        model: Model::RoughPlastic {
+            diffuse: tex(diffuse),
+            specular,
+            eta,
+            distribution: m,
+            nonlinear,
+            table: CoatTable::get(m, eta),
+        },
+        two_sided: false,
+    })
+}
+
+/// Disney's principled BSDF, its parameters textured.
+fn principled(d: &PrincipledDesc, tex: &mut dyn FnMut(&TextureDesc) -> Tex) -> Material {
+    let mut opt = |t: &Option<TextureDesc>| t.as_ref().map(&mut *tex);
+    let model = PrincipledModel {
+        anisotropic: opt(&d.anisotropic),
+        spec_trans: opt(&d.spec_trans),
+        metallic: opt(&d.metallic),
+        clearcoat: opt(&d.clearcoat),
+        sheen: opt(&d.sheen),
+        sheen_tint: opt(&d.sheen_tint),
+        spec_tint: opt(&d.spec_tint),
+        flatness: opt(&d.flatness),
+        diff_trans: opt(&d.diff_trans),
+        base_color: tex(&d.base_color),
+        roughness: tex(&d.roughness),
+        clearcoat_gloss: tex(&d.clearcoat_gloss),
+        eta: tex(&d.eta),
+        thin: d.thin,
+    };
+    Material::Leaf(Leaf {
+        model: Model::Principled(Box::new(model)),
+        two_sided: false,
+    })
+}

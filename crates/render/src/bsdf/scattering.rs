@@ -1,0 +1,85 @@
+//! Scattered directions: mirror reflection and refraction by Snell's law, about the local
+//! frame's normal (z) or a facet's normal. (Their weights are [`super::fresnel`]'s.)
+
+use glam::Vec3;
+
+/// Mirror reflection of `w` about the unit normal `n`.
+#[inline]
+pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
+    2.0 * w.dot(n) * n - w
+}
+
+/// Refraction of `w` (pointing away from the interface) through a facet with unit normal `n`
+/// and relative index `eta` = n_below / n_above. `None` under total internal reflection;
+/// otherwise the refracted direction and the relative index η' along the path.
+pub fn refract_about(w: Vec3, n: Vec3, eta: f32) -> Option<(Vec3, f32)> {
+    let (mut cos_i, mut n, mut etap) = (w.dot(n), n, eta);
+    if cos_i < 0.0 {
+        etap = 1.0 / eta;
+        cos_i = -cos_i;
+        n = -n;
+    }
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (etap * etap);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let wt = -w / etap + (cos_i / etap - cos_t) * n;
+    Some((wt.normalize(), etap))
+}
+
+/// Refracts `wo` (local frame, z = normal) through an interface of relative index `eta`
+/// (inside / outside); `None` under total internal reflection. Returns wi and the relative
+/// index η' along the path (η for entering, 1/η for leaving).
+pub fn refract(wo: Vec3, eta: f32) -> Option<(Vec3, f32)> {
+    let (cos_o, etap, sign) = if wo.z > 0.0 {
+        (wo.z, eta, 1.0)
+    } else {
+        (-wo.z, 1.0 / eta, -1.0)
+    };
+    let sin2_t = (1.0 - cos_o * cos_o).max(0.0) / (etap * etap);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let wi = Vec3::new(-wo.x / etap, -wo.y / etap, -sign * cos_t);
+    Some((wi.normalize(), etap))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refraction_obeys_snell() {
+        for &(theta, eta) in &[(0.3f32, 1.5f32), (1.2, 1.33), (0.7, 1.0 / 1.5)] {
+            let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
+            match refract(wo, eta) {
+                Some((wi, etap)) => {
+                    assert!(wi.z < 0.0);
+                    let sin_t = (wi.x * wi.x + wi.y * wi.y).sqrt();
+                    assert!((theta.sin() - etap * sin_t).abs() < 1e-5, "{theta} {eta}");
+                    // Back through the interface returns the original direction.
+                    let (back, _) = refract(wi, eta).unwrap();
+                    assert!((back - wo).length() < 1e-4);
+                }
+                None => assert!(theta.sin() / eta > 1.0),
+            }
+        }
+    }
+
+    #[test]
+    fn refraction_about_a_facet_obeys_snell() {
+        let n = Vec3::new(0.3, 0.1, 1.0).normalize();
+        let w = Vec3::new(-0.2, 0.5, 0.8).normalize();
+        let (t, etap) = refract_about(w, n, 1.5).unwrap();
+        assert_eq!(etap, 1.5);
+        let sin_i = w.cross(n).length();
+        let sin_t = t.cross(n).length();
+        assert!((sin_i - 1.5 * sin_t).abs() < 1e-5);
+        assert!(t.dot(n) < 0.0);
+        let (back, _) = refract_about(t, n, 1.5).unwrap();
+        assert!((back - w).length() < 1e-5);
+        assert!((reflect(w, n).dot(n) - w.dot(n)).abs() < 1e-6);
+    }
+}
