@@ -12,9 +12,10 @@
 //!   the alias method for discrete choices;
 //! - [`estimator`]: running mean and variance, standard errors and confidence intervals, and
 //!   the estimator F_N = 1/N Σ f(X_i)/p(X_i);
-//! - [`lanes`]: eight `f32` lanes, and the [`lanes::Real`] and [`lanes::Vector3`] traits
-//!   through which the warps (and the renderer's physics) are written once for one value and
-//!   for eight;
+//! - [`simd`]: the one home of SIMD: eight `f32` lanes ([`simd::lanes`]) and the
+//!   [`simd::lanes::Real`] / [`simd::lanes::Vector3`] traits through which the warps (and the
+//!   renderer's physics) are written once for one value and for eight, the widths' names, and
+//!   the CPU-extension tokens of run-time dispatch;
 //! - [`stats`]: chi-square goodness-of-fit tests of samplers against their pdfs, z-tests and
 //!   F-tests, used by the test suites of every part of pathlab.
 //!
@@ -44,10 +45,10 @@ pub mod distribution;
 pub mod error;
 pub mod estimator;
 pub mod exact;
-pub mod lanes;
 pub mod quadrature;
 pub mod rng;
 pub mod sampler;
+pub mod simd;
 pub mod stats;
 pub mod warp;
 

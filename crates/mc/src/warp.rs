@@ -11,7 +11,7 @@
 //!
 //! The warps a renderer's inner loop draws from (the concentric disk, the cosine-weighted
 //! hemisphere, the triangle, the orthonormal basis) are written once over
-//! [`crate::lanes::Real`]: `sample_x(u)` is their one-value form, and code that samples eight
+//! [`crate::simd::lanes::Real`]: `sample_x(u)` is their one-value form, and code that samples eight
 //! directions at once calls the same function on lanes, to the same bits.
 //!
 //! ```
@@ -23,7 +23,7 @@
 //! assert!((cosine_hemisphere_pdf(w.z) - w.z / std::f32::consts::PI).abs() < 1e-7);
 //! ```
 
-use crate::lanes::{Real, Vector3};
+use crate::simd::lanes::{Real, Vector3};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI, TAU};
 

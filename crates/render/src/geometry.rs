@@ -2,7 +2,7 @@
 //! surface they leave.
 
 use glam::Vec3;
-use pathlab_mc::lanes::{Real, Vector3};
+use pathlab_mc::simd::lanes::{Real, Vector3};
 
 /// A ray `o + t d` for `t` in `(t_min, t_max)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -136,7 +136,7 @@ impl Aabb {
 /// An orthonormal frame: local z is the normal. `V` is glam's `Vec3`, or [`V8`] for the
 /// frames of eight lanes.
 ///
-/// [`V8`]: crate::lanes::V8
+/// [`V8`]: crate::simd::lanes::V8
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame<V = Vec3> {
     /// Local x.

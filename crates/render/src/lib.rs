@@ -50,7 +50,6 @@ pub mod film_image;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;
-pub mod lanes;
 pub mod light;
 /// Environment maps (in [`light`]), by their old path.
 pub use light::envmap;
@@ -59,8 +58,7 @@ pub mod render;
 pub mod scene;
 pub mod sdf_grid;
 pub mod shape;
-#[cfg(target_arch = "x86_64")]
-pub mod simd;
+pub use pathlab_mc::simd;
 pub mod tev;
 pub mod texture;
 

@@ -148,8 +148,7 @@ fn padded_2d(sample_index: u32, seed: u32) -> [f32; 2] {
     [scrambled(n, 0, seed), scrambled(pascal_rev(n), 1, seed)]
 }
 
-/// Paths whose samplers draw together: the width of [`crate::lanes`]' lane types.
-pub const PATH_LANES: usize = crate::lanes::W;
+pub use crate::simd::PATH_LANES;
 
 impl SobolSampler {
     /// Draws for eight samplers at once what each would give for the requests `dims` (1 for
@@ -192,10 +191,10 @@ fn padded_lanes<const N: usize>(
     seed: &[u32; PATH_LANES],
 ) -> [[f32; PATH_LANES]; N] {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: `padded_lanes_avx2` requires AVX2, which this CPU has (just checked). Its
-        // body is safe code.
-        return unsafe { padded_lanes_avx2::<N>(index, seed) };
+    if let Some(avx2) = crate::simd::Avx2::detect() {
+        // SAFETY: `padded_lanes_avx2` requires AVX2, which this CPU has: the token `avx2`
+        // exists. Its body is safe code.
+        return unsafe { padded_lanes_avx2::<N>(avx2, index, seed) };
     }
     padded_lanes_portable::<N>(index, seed)
 }
@@ -204,6 +203,7 @@ fn padded_lanes<const N: usize>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn padded_lanes_avx2<const N: usize>(
+    _: crate::simd::Avx2,
     index: &[u32; PATH_LANES],
     seed: &[u32; PATH_LANES],
 ) -> [[f32; PATH_LANES]; N] {

@@ -12,7 +12,7 @@ pub use bvh::{Bvh, BvhNode, BvhParams};
 #[cfg(target_arch = "x86_64")]
 pub(crate) use tri_block::{AvxNearest, AvxRays};
 pub use tri_block::{BlockHit, Nearest, RayLanes, TriBlock, TRIS_PER_BLOCK};
-pub use wide::{BoxTest, Bvh4, Bvh8, Node, Portable, WideBvh, MAX_PRIMITIVES};
+pub use wide::{BoxTest, Bvh4, Bvh8, Node, Portable, WideBvh, BVH_WIDTH, MAX_PRIMITIVES};
 
 /// Test helpers shared by the BVHs' tests: random boxes as primitives.
 #[cfg(test)]

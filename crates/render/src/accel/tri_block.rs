@@ -7,11 +7,11 @@
 //! block reports the same distances and barycentrics to the bit.
 
 use crate::geometry::Ray;
-use crate::lanes::{F8, V8};
 use crate::shape::Triangle;
+use crate::simd::lanes::{F8, V8};
 
 /// Triangles per leaf block, tested against a ray at once (the BVH's width is `Bvh8`'s 8,
-/// the path tracer's [`pathlab_mc::sampler::PATH_LANES`]).
+/// the path tracer's [`pathlab_mc::simd::PATH_LANES`]).
 pub const TRIS_PER_BLOCK: usize = 4;
 
 /// Up to four triangles. Unused lanes have zero edges, which no ray hits (their determinant

@@ -1,15 +1,15 @@
 //! Lambertian reflection, written once for one direction and for eight lanes (see
-//! [`pathlab_mc::lanes`]): the path tracer's lanes shade with these same functions.
+//! [`pathlab_mc::simd::lanes`]): the path tracer's lanes shade with these same functions.
 
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
-use pathlab_mc::lanes::{Real, Vector3, V8};
+use pathlab_mc::simd::lanes::{Real, Vector3, V8};
 use pathlab_mc::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use std::f32::consts::FRAC_1_PI;
 
 /// Lambertian: f = reflectance / π on the upper hemisphere; sampled cosine-weighted. `V` is the
-/// colour type: [`Rgb`], or [`crate::lanes::V8`] for eight lanes' materials.
+/// colour type: [`Rgb`], or [`crate::simd::lanes::V8`] for eight lanes' materials.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Diffuse<V = Rgb> {
     /// Albedo.

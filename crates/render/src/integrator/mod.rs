@@ -21,8 +21,8 @@ use crate::desc::Rgb;
 use crate::geometry::{offset_ray_origin, spawn_ray_to, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::{Vec2, Vec3};
-use pathlab_mc::lanes::Real;
 use pathlab_mc::sampler::{AnySampler, Sampler};
+use pathlab_mc::simd::lanes::Real;
 
 /// Counters an integrator keeps while it works.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -22,9 +22,9 @@ use crate::accel::RayLanes;
 use crate::bsdf::Diffuse;
 use crate::desc::Rgb;
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
-use crate::lanes::{F8, M8, V8, W};
 use crate::light::{AreaShape, Light, TriangleEmitter};
 use crate::scene::{Scene, SurfaceInteraction};
+use crate::simd::lanes::{F8, M8, V8, W};
 use glam::Vec2;
 use pathlab_mc::sampler::AnySampler;
 

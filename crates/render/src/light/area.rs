@@ -5,7 +5,7 @@ use crate::desc::Rgb;
 use crate::shape::{Sphere, Triangle};
 use crate::texture::Tex;
 use glam::{Mat3, Vec2, Vec3};
-use pathlab_mc::lanes::{Real, Vector3, F8, M8, V8};
+use pathlab_mc::simd::lanes::{Real, Vector3, F8, M8, V8};
 use pathlab_mc::warp::{uniform_triangle, uniform_triangle_pdf};
 use std::f32::consts::PI;
 
@@ -57,7 +57,7 @@ impl AreaTriangle {
 }
 
 /// An emitting triangle of uniform radiance, for light sampling at one point or at eight
-/// lanes' points ([`Vector3`] is `Vec3` or [`crate::lanes::V8`]): the one implementation of a
+/// lanes' points ([`Vector3`] is `Vec3` or [`crate::simd::lanes::V8`]): the one implementation of a
 /// triangle's light sample.
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleEmitter<V: Vector3> {

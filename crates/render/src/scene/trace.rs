@@ -4,11 +4,13 @@
 //! compiled twice, for AVX2 and for the target's baseline, the CPU choosing at run time.
 
 use super::{Prim, Scene};
-use crate::accel::{BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, TRIS_PER_BLOCK};
+use crate::accel::{
+    BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, BVH_WIDTH, TRIS_PER_BLOCK,
+};
 use crate::desc::Visibility;
 use crate::geometry::Ray;
-use crate::lanes::F8;
 use crate::shape::Triangle;
+use crate::simd::lanes::F8;
 #[cfg(target_arch = "x86_64")]
 use crate::simd::Avx2;
 use glam::Vec3;
@@ -150,7 +152,7 @@ impl Scene {
 
     /// [`Scene::closest_hit`] with the box test `boxes`.
     #[inline(always)]
-    fn closest_hit_with(&self, boxes: impl BoxTest<8>, ray: &mut Ray, camera: bool) -> Hit {
+    fn closest_hit_with(&self, boxes: impl BoxTest<BVH_WIDTH>, ray: &mut Ray, camera: bool) -> Hit {
         // The nearest hit's fields as separate scalars (`slot` Hit::NONE: none): the leaf test
         // writes them one by one, and reading them back one by one lets the loads take the
         // stored values directly, where reading a whole `Option<Hit>` with one wide load waits
@@ -274,7 +276,7 @@ impl Scene {
 
     /// [`Scene::any_hit`] with the box test `boxes`.
     #[inline(always)]
-    fn any_hit_with(&self, boxes: impl BoxTest<8>, ray: &Ray, camera: bool) -> bool {
+    fn any_hit_with(&self, boxes: impl BoxTest<BVH_WIDTH>, ray: &Ray, camera: bool) -> bool {
         self.bvh.occluded_leaves_with(boxes, ray, |leaf, r| {
             let (first, count) = Bvh8::leaf_range(leaf);
             (first as usize..(first + count) as usize).any(|b| {

@@ -43,7 +43,11 @@ pub struct WideBvh<const W: usize> {
 /// Four children per node: one SSE register per plane.
 pub type Bvh4 = WideBvh<4>;
 /// Eight children per node: one AVX register per plane.
-pub type Bvh8 = WideBvh<8>;
+pub type Bvh8 = WideBvh<BVH_WIDTH>;
+
+/// Children per node of the BVH the scene traces through ([`Bvh8`]): one AVX register of box
+/// tests.
+pub const BVH_WIDTH: usize = 8;
 
 impl<const W: usize> Default for WideBvh<W> {
     fn default() -> Self {
