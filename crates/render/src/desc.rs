@@ -254,6 +254,38 @@ pub struct Visibility {
     pub indirect: bool,
 }
 
+/// The kinds of ray a shape's [`Visibility`] tells apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    /// A camera ray: the first segment of a path.
+    Camera,
+    /// Every other ray: bounces, shadow rays, light sampling.
+    Indirect,
+}
+
+impl RayKind {
+    /// The kind of the ray that leaves a path's vertex `depth` (0: the camera).
+    #[inline]
+    pub fn at_depth(depth: u32) -> RayKind {
+        if depth == 0 {
+            RayKind::Camera
+        } else {
+            RayKind::Indirect
+        }
+    }
+}
+
+impl Visibility {
+    /// Whether rays of `kind` see the shape.
+    #[inline]
+    pub fn seen_by(self, kind: RayKind) -> bool {
+        match kind {
+            RayKind::Camera => self.camera,
+            RayKind::Indirect => self.indirect,
+        }
+    }
+}
+
 impl Default for Visibility {
     fn default() -> Self {
         Visibility::ALL

@@ -3,7 +3,7 @@
 use crate::accel::{Bvh8, TriBlock};
 use crate::bsdf::{Material, ShadingPoint};
 use crate::camera::Camera;
-use crate::desc::{MaterialDesc, Rgb};
+use crate::desc::{MaterialDesc, RayKind, Rgb};
 use crate::geometry::{Aabb, Ray};
 use crate::light::{sphere_uv, Light, LightSampler};
 use crate::sdf_grid::SdfGrid;
@@ -303,13 +303,13 @@ impl Scene {
     /// The nearest surface along a camera ray, and the number of BVH nodes visited.
     #[inline]
     pub fn intersect_camera(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u32) {
-        self.intersect_as(ray, true)
+        self.intersect_as(ray, RayKind::Camera)
     }
 
     /// The nearest surface along any other ray, and the number of BVH nodes visited.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u32) {
-        self.intersect_as(ray, false)
+        self.intersect_as(ray, RayKind::Indirect)
     }
 
     /// The distance to the nearest surface along a non-camera ray, without making its surface
@@ -317,17 +317,19 @@ impl Scene {
     /// traversal alone.
     pub fn hit_distance(&self, ray: &Ray) -> Option<f32> {
         let mut r = *ray;
-        self.closest_hit(&mut r, false).found().then_some(r.t_max)
+        self.closest_hit(&mut r, RayKind::Indirect)
+            .found()
+            .then_some(r.t_max)
     }
 
     #[inline(always)]
-    fn intersect_as(&self, ray: &Ray, camera: bool) -> (Option<SurfaceInteraction>, u32) {
+    fn intersect_as(&self, ray: &Ray, kind: RayKind) -> (Option<SurfaceInteraction>, u32) {
         let mut si = None;
-        let visited = self.intersect_into(ray, camera, &mut si);
+        let visited = self.intersect_into(ray, kind, &mut si);
         (si, visited)
     }
 
-    /// The nearest surface along a camera ray (`camera`) or another ray, written to `si`
+    /// The nearest surface along a ray of `kind`, written to `si`
     /// (`None` where the ray escapes); returns the number of BVH nodes visited. Made in place,
     /// for callers that keep it in an array: moving a fresh interaction there would copy it
     /// with wide loads of its narrow stores, which wait for them.
@@ -335,11 +337,11 @@ impl Scene {
     pub fn intersect_into(
         &self,
         ray: &Ray,
-        camera: bool,
+        kind: RayKind,
         si: &mut Option<SurfaceInteraction>,
     ) -> u32 {
         let mut r = *ray;
-        let hit = self.closest_hit(&mut r, camera);
+        let hit = self.closest_hit(&mut r, kind);
         if !hit.found() {
             *si = None;
             return hit.visited();
@@ -448,7 +450,7 @@ impl Scene {
 
     /// Whether anything seen by non-camera rays blocks `ray` within its extent.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.any_hit(ray, false)
+        self.any_hit(ray, RayKind::Indirect)
     }
 }
 

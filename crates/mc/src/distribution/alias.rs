@@ -1,3 +1,5 @@
+//! Walker's alias method ([`AliasTable`]): a discrete choice among n outcomes in constant time.
+
 use super::check_weights;
 use crate::error::{Error, Result};
 

@@ -1,3 +1,6 @@
+//! The exponential distribution ([`Exponential`]), sampled by inversion:
+//! x = -ln(1 - U) / λ.
+
 use crate::error::{Error, Result};
 
 /// The exponential distribution with rate λ: pdf λ e^(-λx) on x ≥ 0, CDF 1 - e^(-λx).

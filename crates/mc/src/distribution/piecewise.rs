@@ -1,3 +1,7 @@
+//! Piecewise-constant distributions in 1D ([`PiecewiseConstant1D`]) and 2D
+//! ([`PiecewiseConstant2D`]), sampled by inverting their tabulated CDFs, continuous or
+//! discrete.
+
 use super::check_weights;
 use crate::error::{Error, Result};
 use glam::Vec2;

@@ -1,3 +1,6 @@
+//! The independent sampler ([`IndependentSampler`]): uniform numbers from a PCG32 stream per
+//! pixel, each sample and dimension at its own position in it, independent of one another.
+
 use super::Sampler;
 use crate::rng::Pcg32;
 use glam::Vec2;

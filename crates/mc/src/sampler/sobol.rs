@@ -1,3 +1,6 @@
+//! The Sobol' sampler ([`SobolSampler`]): the first dimensions of Sobol's sequence in pairs,
+//! each pair shuffled and Owen-scrambled by hashing, and its eight-lane draws.
+
 use super::Sampler;
 use crate::rng::{hash_pixel, hash_words, mix_bits};
 use glam::Vec2;

@@ -1,3 +1,6 @@
+//! The stratified sampler ([`StratifiedSampler`]): jittered strata in every dimension, their
+//! order permuted per pixel and dimension, so that a pixel's samples cover every stratum once.
+
 use super::Sampler;
 use crate::rng::{hash_words, Pcg32};
 use glam::Vec2;

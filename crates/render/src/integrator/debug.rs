@@ -1,5 +1,8 @@
+//! Debug views of the first surface a camera ray meets ([`DebugView`]): normals, depth,
+//! and the BVH's cost (nodes visited).
+
 use super::{trace, Integrator, PathStats};
-use crate::desc::Rgb;
+use crate::desc::{RayKind, Rgb};
 use crate::geometry::Ray;
 use crate::scene::Scene;
 use pathlab_mc::sampler::AnySampler;
@@ -20,7 +23,7 @@ pub enum DebugView {
 impl Integrator for DebugView {
     fn li(&self, scene: &Scene, ray: Ray, _sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
         let before = stats.nodes_visited;
-        let hit = trace(scene, &ray, true, stats);
+        let hit = trace(scene, &ray, RayKind::Camera, stats);
         match self {
             DebugView::Normals => hit.map_or(Rgb::ZERO, |si| 0.5 * (si.ns + Rgb::ONE)),
             DebugView::Depth => hit.map_or(Rgb::ZERO, |si| {

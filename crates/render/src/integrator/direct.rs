@@ -1,5 +1,9 @@
+//! Direct lighting only ([`DirectIntegrator`]): one bounce, its directions drawn by uniform
+//! hemisphere, cosine, BSDF or light sampling, or both combined by MIS ([`DirectStrategy`]),
+//! the course's first estimators.
+
 use super::{emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats};
-use crate::desc::Rgb;
+use crate::desc::{RayKind, Rgb};
 use crate::geometry::{spawn_ray, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::Vec3;
@@ -97,7 +101,7 @@ impl DirectIntegrator {
             return (Rgb::ZERO, None);
         }
         let ray = spawn_ray(si.p, si.ng, wi);
-        let found = match trace(scene, &ray, false, stats) {
+        let found = match trace(scene, &ray, RayKind::Indirect, stats) {
             Some(hit) => emitted(scene, si.p, &ray, &hit),
             None => escaped(scene, &ray),
         };
@@ -114,7 +118,7 @@ impl Integrator for DirectIntegrator {
             Some((le, _)) if !self.hide_emitters => le,
             _ => Rgb::ZERO,
         };
-        let Some(si) = trace(scene, &ray, true, stats) else {
+        let Some(si) = trace(scene, &ray, RayKind::Camera, stats) else {
             return seen(escaped(scene, &ray));
         };
         let wo = -ray.d;

@@ -17,7 +17,7 @@ pub use direct::{DirectIntegrator, DirectStrategy};
 pub use path::{PathIntegrator, PathLighting};
 
 use crate::bsdf::Bsdf;
-use crate::desc::Rgb;
+use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, spawn_ray_to, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::{Vec2, Vec3};
@@ -172,18 +172,17 @@ impl Integrator for IntegratorKind {
     }
 }
 
-/// Closest hit of a camera ray (`camera`) or another ray, counting the ray.
+/// Closest hit of a ray of `kind`, counting the ray.
 #[inline]
 pub(crate) fn trace(
     scene: &Scene,
     ray: &Ray,
-    camera: bool,
+    kind: RayKind,
     stats: &mut PathStats,
 ) -> Option<SurfaceInteraction> {
-    let (hit, visited) = if camera {
-        scene.intersect_camera(ray)
-    } else {
-        scene.intersect(ray)
+    let (hit, visited) = match kind {
+        RayKind::Camera => scene.intersect_camera(ray),
+        RayKind::Indirect => scene.intersect(ray),
     };
     stats.rays += 1;
     stats.nodes_visited += visited as u64;
@@ -198,8 +197,10 @@ pub fn power_heuristic(nf: u32, f_pdf: f32, ng: u32, g_pdf: f32) -> f32 {
 }
 
 /// The power heuristic's weight f² / (f² + g²) of a strategy with (sample count times)
-/// density `f` against one with `g`: one for an infinite `f` (a delta), zero where both
-/// vanish. For one value or for lanes.
+/// density `f` against one with `g`: one where `f` overflowed to infinity (light sampling's
+/// density at a grazing angle), zero where both vanish. For one value or for lanes. (Delta
+/// lobes and delta lights are flagged, not given infinite densities: their callers give
+/// them weight one without asking.)
 #[inline(always)]
 pub fn power_heuristic_weight<T: Real>(f: T, g: T) -> T {
     let (zero, one) = (T::splat(0.0), T::splat(1.0));
@@ -273,7 +274,8 @@ pub(crate) fn emitted(
     if le.max_element() <= 0.0 {
         return None;
     }
-    let pdf = scene.light_sampler().pmf(index as usize) * light.pdf_li(p_prev, ray.d, si.p, si.ng);
+    let pdf =
+        scene.light_sampler().pmf(index as usize) * light.pdf_li_at(p_prev, ray.d, si.p, si.ng);
     Some((le, pdf))
 }
 
@@ -283,6 +285,6 @@ pub(crate) fn emitted(
 pub(crate) fn escaped(scene: &Scene, ray: &Ray) -> Option<(Rgb, f32)> {
     let index = scene.environment()?;
     let light = &scene.lights()[index as usize];
-    let pdf = scene.light_sampler().pmf(index as usize) * light.pdf_li(ray.o, ray.d, ray.o, ray.d);
+    let pdf = scene.light_sampler().pmf(index as usize) * light.pdf_li_towards(ray.d);
     Some((scene.environment_le(ray.d), pdf))
 }

@@ -20,7 +20,7 @@ use super::path::{PathIntegrator, PathState};
 use super::{camera_ray, power_heuristic_weight, sample_light, PathStats, SampleRef};
 use crate::accel::RayLanes;
 use crate::bsdf::Diffuse;
-use crate::desc::Rgb;
+use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
 use crate::light::{AreaShape, Light, TriangleEmitter};
 use crate::scene::{Scene, SurfaceInteraction};
@@ -216,7 +216,8 @@ impl PathIntegrator {
                     },
                     None => {
                         stats.nodes_visited +=
-                            scene.intersect_into(&st.ray, st.depth == 0, &mut hits[i]) as u64
+                            scene.intersect_into(&st.ray, RayKind::at_depth(st.depth), &mut hits[i])
+                                as u64
                     }
                 }
                 if !self.arrive(scene, st, hits[i].as_ref()) {
@@ -310,7 +311,7 @@ impl PathIntegrator {
             st.beta *= b.weight.get(i);
             st.beta.max_element() > 0.0
                 && st.beta.is_finite()
-                && self.survive(st, si, b.wi.get(i), b.pdf.0[i], u_rr)
+                && self.survive(st, si, b.wi.get(i), b.pdf.0[i], false, u_rr)
         }
     }
 }

@@ -1,8 +1,12 @@
+//! The path tracer ([`PathIntegrator`]): at each vertex, emission where no other strategy
+//! could have found it, light sampling and BSDF sampling combined by multiple importance
+//! sampling ([`PathLighting`]), then Russian roulette.
+
 use super::{
     emitted, escaped, li_one_at_a_time, power_heuristic, sample_light, trace, Integrator,
     PathStats, SampleRef,
 };
-use crate::desc::Rgb;
+use crate::desc::{RayKind, Rgb};
 use crate::geometry::{spawn_ray, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::Vec3;
@@ -76,11 +80,22 @@ pub(crate) struct PathState {
     pub(crate) beta: Rgb,
     /// The ray the path follows next.
     pub(crate) ray: Ray,
-    /// The previous vertex and the BSDF density of the direction that left it (infinite for a
-    /// delta lobe, which gives emission found through it MIS weight one); none for the camera.
-    pub(crate) prev: Option<(Vec3, f32)>,
+    /// The vertex the path left last, and how it left it; none for the camera.
+    pub(crate) prev: Option<PrevVertex>,
     /// Bounces so far (0: the camera ray).
     pub(crate) depth: u32,
+}
+
+/// The vertex a path left, with what MIS needs of the BSDF sample that left it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrevVertex {
+    /// Its position.
+    pub(crate) p: Vec3,
+    /// The density per solid angle of the direction the path left along.
+    pub(crate) pdf: f32,
+    /// Whether that direction came from a delta lobe: no other strategy could have found what
+    /// it reaches, so MIS gives that weight one.
+    pub(crate) delta: bool,
 }
 
 impl PathState {
@@ -107,19 +122,16 @@ impl PathIntegrator {
         self.only_bounce.is_none_or(|k| k == bounce)
     }
 
-    /// MIS weight of emission found by a BSDF-sampled direction of density `pdf_bsdf`
-    /// (infinite after a delta bounce) that light sampling would find with `pdf_light`.
-    fn bsdf_weight(&self, pdf_bsdf: f32, pdf_light: f32) -> f32 {
+    /// MIS weight of emission found by the BSDF sample that left `prev`, which light
+    /// sampling would find with density `pdf_light`.
+    fn bsdf_weight(&self, prev: &PrevVertex, pdf_light: f32) -> f32 {
+        if prev.delta {
+            return 1.0;
+        }
         match self.lighting {
-            PathLighting::Mis => power_heuristic(1, pdf_bsdf, self.n_light(), pdf_light),
+            PathLighting::Mis => power_heuristic(1, prev.pdf, self.n_light(), pdf_light),
             PathLighting::Bsdf => 1.0,
-            PathLighting::Light => {
-                if pdf_bsdf.is_infinite() {
-                    1.0
-                } else {
-                    0.0
-                }
-            }
+            PathLighting::Light => 0.0,
         }
     }
 
@@ -139,7 +151,7 @@ impl PathIntegrator {
             }
             return false;
         };
-        let p_prev = st.prev.map_or(st.ray.o, |(p, _)| p);
+        let p_prev = st.prev.map_or(st.ray.o, |v| v.p);
         if let Some(found) = emitted(scene, p_prev, &st.ray, si) {
             self.add_found_light(st, found);
         }
@@ -155,7 +167,7 @@ impl PathIntegrator {
         }
         let w = st
             .prev
-            .map_or(1.0, |(_, pdf_bsdf)| self.bsdf_weight(pdf_bsdf, pdf_light));
+            .map_or(1.0, |prev| self.bsdf_weight(&prev, pdf_light));
         if self.wants(st.depth) {
             st.l += st.beta * w * le;
         }
@@ -208,11 +220,10 @@ impl PathIntegrator {
         if st.beta.max_element() <= 0.0 || !st.beta.is_finite() {
             return false;
         }
-        let pdf = if bs.delta { f32::INFINITY } else { bs.pdf };
-        self.survive(st, si, bs.wi, pdf, sampler.next_1d())
+        self.survive(st, si, bs.wi, bs.pdf, bs.delta, sampler.next_1d())
     }
 
-    /// The end of a bounce whose BSDF sample `wi` (density `pdf`, infinite for a delta lobe)
+    /// The end of a bounce whose BSDF sample `wi` (of density `pdf`, or from a delta lobe)
     /// left a finite, positive throughput: Russian roulette with `u_rr`, then the ray along
     /// `wi`. Returns whether the path goes on.
     #[inline]
@@ -222,9 +233,14 @@ impl PathIntegrator {
         si: &SurfaceInteraction,
         wi: Vec3,
         pdf: f32,
+        delta: bool,
         u_rr: f32,
     ) -> bool {
-        st.prev = Some((si.p, pdf));
+        st.prev = Some(PrevVertex {
+            p: si.p,
+            pdf,
+            delta,
+        });
         st.depth += 1;
         if st.depth >= self.rr_depth {
             let q = st.beta.max_element().min(0.95);
@@ -245,7 +261,7 @@ impl Integrator for PathIntegrator {
     fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
         let mut st = PathState::new(ray);
         loop {
-            let hit = trace(scene, &st.ray, st.depth == 0, stats);
+            let hit = trace(scene, &st.ray, RayKind::at_depth(st.depth), stats);
             if !self.arrive(scene, &mut st, hit.as_ref()) {
                 break;
             }

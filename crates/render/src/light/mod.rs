@@ -338,28 +338,32 @@ impl Light {
     }
 
     /// Density per unit solid angle with which [`Light::sample_li`] from `p` produces the point
-    /// `p_light` (normal `n_light`) on an area light, or the direction `wi` for the environment.
-    pub fn pdf_li(&self, p: Vec3, wi: Vec3, p_light: Vec3, n_light: Vec3) -> f32 {
+    /// `p_light` (normal `n_light`) of an area light, in direction `wi`; zero for every other
+    /// light (those at infinity: [`Light::pdf_li_towards`]).
+    pub fn pdf_li_at(&self, p: Vec3, wi: Vec3, p_light: Vec3, n_light: Vec3) -> f32 {
+        let Light::Area { shape, .. } = *self else {
+            return 0.0;
+        };
+        let area = match shape {
+            AreaShape::Triangle(t) => t.area,
+            AreaShape::Sphere(s) => s.area(),
+        };
+        let dist2 = (p_light - p).length_squared();
+        let cos_l = n_light.dot(-wi).abs();
+        if cos_l == 0.0 {
+            0.0
+        } else {
+            dist2 / (cos_l * area)
+        }
+    }
+
+    /// Density per unit solid angle with which [`Light::sample_li`] produces direction `wi` of
+    /// the environment (from any point); zero for every other light.
+    pub fn pdf_li_towards(&self, wi: Vec3) -> f32 {
         match *self {
-            Light::Area { shape, .. } => {
-                let area = match shape {
-                    AreaShape::Triangle(t) => t.area,
-                    AreaShape::Sphere(s) => s.area(),
-                };
-                let dist2 = (p_light - p).length_squared();
-                let cos_l = n_light.dot(-wi).abs();
-                if cos_l == 0.0 {
-                    0.0
-                } else {
-                    dist2 / (cos_l * area)
-                }
-            }
             Light::Environment { .. } => uniform_sphere_pdf(),
             Light::EnvironmentMap { ref map, .. } => map.pdf(wi),
-            Light::Point { .. }
-            | Light::Spot { .. }
-            | Light::Directional { .. }
-            | Light::Projector(_) => 0.0,
+            _ => 0.0,
         }
     }
 
@@ -442,7 +446,7 @@ mod tests {
             assert!((s.p_light - expected).length() < 1e-5);
             assert!((s.b.iter().sum::<f32>() - 1.0).abs() < 1e-6);
             assert!(s.b.iter().all(|&x| x >= 0.0));
-            let pdf = light.pdf_li(p, s.wi, s.p_light, area.normal);
+            let pdf = light.pdf_li_at(p, s.wi, s.p_light, area.normal);
             assert!((s.pdf - pdf).abs() <= 1e-4 * pdf, "{} vs {pdf}", s.pdf);
             let ls = light.sample_li(p, u).unwrap();
             assert_eq!((ls.pdf, ls.wi, ls.p_light), (s.pdf, s.wi, s.p_light));

@@ -7,7 +7,7 @@ use super::{Prim, Scene};
 use crate::accel::{
     BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, BVH_WIDTH, TRIS_PER_BLOCK,
 };
-use crate::desc::Visibility;
+use crate::desc::{RayKind, Visibility};
 use crate::geometry::Ray;
 use crate::shape::Triangle;
 use crate::simd::lanes::F8;
@@ -83,16 +83,19 @@ pub(super) struct BlockInfo {
 }
 
 impl Scene {
-    /// The lanes of block `b` that a camera ray (`camera`) or another ray tests as triangles,
+    /// The lanes of block `b` that a ray of `kind` tests as triangles,
     /// and the lanes it tests as other shapes.
     #[inline(always)]
-    fn block_lanes(&self, b: usize, camera: bool) -> (u32, u32) {
+    fn block_lanes(&self, b: usize, kind: RayKind) -> (u32, u32) {
         if self.all_visible && self.only_triangles {
             // Unused lanes never hit, so all four can be tested.
             return (0b1111, 0);
         }
         let info = &self.block_info[b];
-        let seen = u32::from(if camera { info.camera } else { info.indirect });
+        let seen = u32::from(match kind {
+            RayKind::Camera => info.camera,
+            RayKind::Indirect => info.indirect,
+        });
         let shapes = u32::from(info.shapes);
         (seen & !shapes, seen & shapes)
     }
@@ -114,45 +117,50 @@ impl Scene {
     /// BVH nodes visited. Compiled twice: for CPUs with AVX2 and FMA, chosen at run time, and
     /// for the target's baseline.
     #[inline]
-    pub(super) fn closest_hit(&self, ray: &mut Ray, camera: bool) -> Hit {
+    pub(super) fn closest_hit(&self, ray: &mut Ray, kind: RayKind) -> Hit {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = Avx2::detect() {
             // SAFETY: `closest_hit_avx2` requires AVX2 and FMA, which `avx2` proves this CPU
             // has. Its body is safe code.
-            return unsafe { self.closest_hit_avx2(avx2, ray, camera) };
+            return unsafe { self.closest_hit_avx2(avx2, ray, kind) };
         }
-        self.closest_hit_with(Portable, ray, camera)
+        self.closest_hit_with(Portable, ray, kind)
     }
 
     /// [`Scene::closest_hit`] compiled for AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    fn closest_hit_avx2(&self, avx2: Avx2, ray: &mut Ray, camera: bool) -> Hit {
-        self.closest_hit_with(avx2, ray, camera)
+    fn closest_hit_avx2(&self, avx2: Avx2, ray: &mut Ray, kind: RayKind) -> Hit {
+        self.closest_hit_with(avx2, ray, kind)
     }
 
     /// [`Scene::any_hit`] compiled for AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    fn any_hit_avx2(&self, avx2: Avx2, ray: &Ray, camera: bool) -> bool {
-        self.any_hit_with(avx2, ray, camera)
+    fn any_hit_avx2(&self, avx2: Avx2, ray: &Ray, kind: RayKind) -> bool {
+        self.any_hit_with(avx2, ray, kind)
     }
 
-    /// Whether anything a camera ray (`camera`) or another ray sees blocks `ray`; compiled
+    /// Whether anything a ray of `kind` sees blocks `ray`; compiled
     /// twice, as [`Scene::closest_hit`] is.
     #[inline]
-    pub(super) fn any_hit(&self, ray: &Ray, camera: bool) -> bool {
+    pub(super) fn any_hit(&self, ray: &Ray, kind: RayKind) -> bool {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = Avx2::detect() {
             // SAFETY: as in `closest_hit`: `avx2` proves the features `any_hit_avx2` requires.
-            return unsafe { self.any_hit_avx2(avx2, ray, camera) };
+            return unsafe { self.any_hit_avx2(avx2, ray, kind) };
         }
-        self.any_hit_with(Portable, ray, camera)
+        self.any_hit_with(Portable, ray, kind)
     }
 
     /// [`Scene::closest_hit`] with the box test `boxes`.
     #[inline(always)]
-    fn closest_hit_with(&self, boxes: impl BoxTest<BVH_WIDTH>, ray: &mut Ray, camera: bool) -> Hit {
+    fn closest_hit_with(
+        &self,
+        boxes: impl BoxTest<BVH_WIDTH>,
+        ray: &mut Ray,
+        kind: RayKind,
+    ) -> Hit {
         // The nearest hit's fields as separate scalars (`slot` Hit::NONE: none): the leaf test
         // writes them one by one, and reading them back one by one lets the loads take the
         // stored values directly, where reading a whole `Option<Hit>` with one wide load waits
@@ -162,7 +170,7 @@ impl Scene {
             let (first, count) = Bvh8::leaf_range(leaf);
             let mut any = false;
             for b in first as usize..(first + count) as usize {
-                let (triangles, shapes) = self.block_lanes(b, camera);
+                let (triangles, shapes) = self.block_lanes(b, kind);
                 if let Some(h) = self.blocks[b].intersect(r, triangles) {
                     r.t_max = h.t;
                     (slot, b1, b2) = (self.block_info[b].slots[h.lane], h.b1, h.b2);
@@ -276,11 +284,11 @@ impl Scene {
 
     /// [`Scene::any_hit`] with the box test `boxes`.
     #[inline(always)]
-    fn any_hit_with(&self, boxes: impl BoxTest<BVH_WIDTH>, ray: &Ray, camera: bool) -> bool {
+    fn any_hit_with(&self, boxes: impl BoxTest<BVH_WIDTH>, ray: &Ray, kind: RayKind) -> bool {
         self.bvh.occluded_leaves_with(boxes, ray, |leaf, r| {
             let (first, count) = Bvh8::leaf_range(leaf);
             (first as usize..(first + count) as usize).any(|b| {
-                let (triangles, shapes) = self.block_lanes(b, camera);
+                let (triangles, shapes) = self.block_lanes(b, kind);
                 self.blocks[b].hits(r, triangles) != 0
                     || (shapes != 0 && self.hits_shape(b, shapes, r))
             })
@@ -339,15 +347,11 @@ mod tests {
     use crate::shape::Sphere;
 
     /// Nearest distance along `ray` by testing every shape the ray kind sees.
-    fn brute_force(desc: &SceneDesc, ray: &Ray, camera: bool) -> Option<f32> {
+    fn brute_force(desc: &SceneDesc, ray: &Ray, kind: RayKind) -> Option<f32> {
         let mut best: Option<f32> = None;
         let mut r = *ray;
         for m in &desc.meshes {
-            if !(if camera {
-                m.visibility.camera
-            } else {
-                m.visibility.indirect
-            }) {
+            if !m.visibility.seen_by(kind) {
                 continue;
             }
             for f in m.indices.chunks(3) {
@@ -461,21 +465,24 @@ mod tests {
         for k in 0..3000 {
             let o = point() * 14.0 - 2.0;
             let ray = Ray::new(o, point() * 10.0 - o);
-            let camera = k % 2 == 0;
-            let expected = brute_force(&desc, &ray, camera);
-            let mut r = ray;
-            let portable = scene.closest_hit_with(Portable, &mut r, camera);
-            assert_eq!(portable.found().then_some(r.t_max), expected);
-            let found = if camera {
-                scene.intersect_camera(&ray).0
+            let kind = if k % 2 == 0 {
+                RayKind::Camera
             } else {
-                scene.intersect(&ray).0
+                RayKind::Indirect
+            };
+            let expected = brute_force(&desc, &ray, kind);
+            let mut r = ray;
+            let portable = scene.closest_hit_with(Portable, &mut r, kind);
+            assert_eq!(portable.found().then_some(r.t_max), expected);
+            let found = match kind {
+                RayKind::Camera => scene.intersect_camera(&ray).0,
+                RayKind::Indirect => scene.intersect(&ray).0,
             };
             assert_eq!(found.map(|si| si.t), expected);
-            if !camera {
+            if kind == RayKind::Indirect {
                 assert_eq!(scene.occluded(&ray), expected.is_some());
                 assert_eq!(
-                    scene.any_hit_with(Portable, &ray, false),
+                    scene.any_hit_with(Portable, &ray, RayKind::Indirect),
                     expected.is_some()
                 );
             }
@@ -559,7 +566,7 @@ mod tests {
             ];
             for (i, ray) in each.iter().enumerate() {
                 let mut r = *ray;
-                let bvh = scene.closest_hit(&mut r, false);
+                let bvh = scene.closest_hit(&mut r, RayKind::Indirect);
                 for nearest in &all {
                     let lane = nearest.lane(i);
                     assert_eq!(lane.map(|(_, t, _, _)| t), bvh.found().then_some(r.t_max));

@@ -1,3 +1,6 @@
+//! Tests of the wide BVHs: nearest and any hits against brute force, for both widths and both
+//! box tests (portable and AVX2), with degenerate, axis-parallel and non-finite rays.
+
 use super::box_test::RayBoxes;
 use super::stack::Stack;
 use super::*;
