@@ -128,25 +128,7 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
                 },
             }
         }
-        "twosided" => {
-            let inner = nested(ctx, b)?;
-            match inner.as_slice() {
-                [one] => two_sided(ctx.material_desc(*one)?),
-                [front, back] => MaterialDesc::TwoSided {
-                    front: Box::new(ctx.material_desc(*front)?),
-                    back: Box::new(ctx.material_desc(*back)?),
-                },
-                _ => {
-                    return Err(ctx.error(
-                        b.loc,
-                        format!(
-                            "<bsdf type=\"twosided\"> needs one or two nested <bsdf>s, found {}",
-                            inner.len()
-                        ),
-                    ))
-                }
-            }
-        }
+        "twosided" => two_sided_bsdf(ctx, b)?,
         "mask" => {
             let inner = one_nested(ctx, b)?;
             MaterialDesc::Mask {
@@ -186,113 +168,10 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
                 inner: Box::new(ctx.material_desc(inner)?),
             }
         }
-        "bumpmap" => {
-            let inner = one_nested(ctx, b)?;
-            // The height texture is the nested texture, whatever its name.
-            let textures = ctx.children(b, "texture")?;
-            let [(_, t)] = textures.as_slice() else {
-                return Err(ctx.error(
-                    b.loc,
-                    format!(
-                        "<bsdf type=\"bumpmap\"> needs one nested <texture>, found {}",
-                        textures.len()
-                    ),
-                ));
-            };
-            let height = super::textures::texture(ctx, *t, SpectrumKind::Unbounded)?;
-            MaterialDesc::BumpMap {
-                height,
-                scale: ctx.float(b, "scale", 1.0)? as f32,
-                inner: Box::new(ctx.material_desc(inner)?),
-            }
-        }
-        "conductor" | "roughconductor" => {
-            let (mut eta, mut k) = (Vec3::ZERO, Vec3::ONE);
-            if let Some(name) = ctx.string(b, "material")? {
-                let (e, kk) = named_conductor(&name).ok_or_else(|| {
-                    ctx.error(
-                        ctx.loc_of(b, "material"),
-                        format!(
-                            "{}: unknown conductor material '{name}' (known: {}; or give eta and k)",
-                            ctx.what(b),
-                            conductor_names()
-                        ),
-                    )
-                })?;
-                (eta, k) = (Vec3::from_array(e), Vec3::from_array(kk));
-            }
-            let eta = ctx.color(b, "eta", eta, SpectrumKind::Unbounded)?;
-            let k = ctx.color(b, "k", k, SpectrumKind::Unbounded)?;
-            let specular = ctx.texture(
-                b,
-                "specular_reflectance",
-                Vec3::ONE,
-                SpectrumKind::Reflectance,
-            )?;
-            if b.plugin == "conductor" {
-                MaterialDesc::RoughConductor {
-                    alpha_u: TextureDesc::value(0.0),
-                    alpha_v: TextureDesc::value(0.0),
-                    eta,
-                    k,
-                    specular,
-                    distribution: NormalDistribution::Beckmann,
-                }
-            } else {
-                let distribution = distribution(ctx, b)?;
-                let (alpha_u, alpha_v) = if ctx.has(b, "alpha_u") || ctx.has(b, "alpha_v") {
-                    if ctx.has(b, "alpha") {
-                        return Err(ctx.error(
-                            b.loc,
-                            format!("{}: give either alpha or alpha_u and alpha_v", ctx.what(b)),
-                        ));
-                    }
-                    (
-                        ctx.texture(b, "alpha_u", Vec3::splat(0.1), SpectrumKind::Unbounded)?,
-                        ctx.texture(b, "alpha_v", Vec3::splat(0.1), SpectrumKind::Unbounded)?,
-                    )
-                } else {
-                    let a = ctx.texture(b, "alpha", Vec3::splat(0.1), SpectrumKind::Unbounded)?;
-                    (a.clone(), a)
-                };
-                MaterialDesc::RoughConductor {
-                    alpha_u,
-                    alpha_v,
-                    eta,
-                    k,
-                    specular,
-                    distribution,
-                }
-            }
-        }
+        "bumpmap" => bump_map(ctx, b)?,
+        "conductor" | "roughconductor" => conductor(ctx, b)?,
         "principled" | "principledthin" => principled(ctx, b)?,
-        "roughplastic" => {
-            let alpha = ctx.texture(b, "alpha", Vec3::splat(0.1), SpectrumKind::Unbounded)?;
-            let Some(alpha) = alpha.as_constant() else {
-                return Err(ctx.error(
-                    ctx.loc_of(b, "alpha"),
-                    "<bsdf type=\"roughplastic\">: alpha must be a number (Mitsuba's roughplastic takes no roughness texture)",
-                ));
-            };
-            MaterialDesc::RoughPlastic {
-                diffuse: ctx.texture(
-                    b,
-                    "diffuse_reflectance",
-                    Vec3::splat(0.5),
-                    SpectrumKind::Reflectance,
-                )?,
-                specular: ctx.color(
-                    b,
-                    "specular_reflectance",
-                    Vec3::ONE,
-                    SpectrumKind::Reflectance,
-                )?,
-                alpha: alpha.x,
-                ior: relative_ior(ctx, b, 1.49)?,
-                nonlinear: ctx.boolean(b, "nonlinear", false)?,
-                distribution: distribution(ctx, b)?,
-            }
-        }
+        "roughplastic" => rough_plastic(ctx, b)?,
         "thindielectric" => {
             let (reflectance, transmittance) = specular_scales(ctx, b)?;
             MaterialDesc::ThinGlass {
@@ -345,6 +224,139 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
         }
     };
     Ok(m)
+}
+
+/// Mitsuba's `twosided`: one nested BSDF on both sides, or a front and a back one.
+fn two_sided_bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
+    let inner = nested(ctx, b)?;
+    Ok(match inner.as_slice() {
+        [one] => two_sided(ctx.material_desc(*one)?),
+        [front, back] => MaterialDesc::TwoSided {
+            front: Box::new(ctx.material_desc(*front)?),
+            back: Box::new(ctx.material_desc(*back)?),
+        },
+        _ => {
+            return Err(ctx.error(
+                b.loc,
+                format!(
+                    "<bsdf type=\"twosided\"> needs one or two nested <bsdf>s, found {}",
+                    inner.len()
+                ),
+            ))
+        }
+    })
+}
+
+/// Mitsuba's `bumpmap`: the nested BSDF under the normal that the nested height texture perturbs.
+fn bump_map(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
+    let inner = one_nested(ctx, b)?;
+    // The height texture is the nested texture, whatever its name.
+    let textures = ctx.children(b, "texture")?;
+    let [(_, t)] = textures.as_slice() else {
+        return Err(ctx.error(
+            b.loc,
+            format!(
+                "<bsdf type=\"bumpmap\"> needs one nested <texture>, found {}",
+                textures.len()
+            ),
+        ));
+    };
+    let height = super::textures::texture(ctx, *t, SpectrumKind::Unbounded)?;
+    Ok(MaterialDesc::BumpMap {
+        height,
+        scale: ctx.float(b, "scale", 1.0)? as f32,
+        inner: Box::new(ctx.material_desc(inner)?),
+    })
+}
+
+/// Mitsuba's `conductor` and `roughconductor`: a named metal or `eta` and `k`, and the roughness of the rough one (isotropic or `alpha_u`/`alpha_v`).
+fn conductor(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
+    let (mut eta, mut k) = (Vec3::ZERO, Vec3::ONE);
+    if let Some(name) = ctx.string(b, "material")? {
+        let (e, kk) = named_conductor(&name).ok_or_else(|| {
+            ctx.error(
+                ctx.loc_of(b, "material"),
+                format!(
+                    "{}: unknown conductor material '{name}' (known: {}; or give eta and k)",
+                    ctx.what(b),
+                    conductor_names()
+                ),
+            )
+        })?;
+        (eta, k) = (Vec3::from_array(e), Vec3::from_array(kk));
+    }
+    let eta = ctx.color(b, "eta", eta, SpectrumKind::Unbounded)?;
+    let k = ctx.color(b, "k", k, SpectrumKind::Unbounded)?;
+    let specular = ctx.texture(
+        b,
+        "specular_reflectance",
+        Vec3::ONE,
+        SpectrumKind::Reflectance,
+    )?;
+    Ok(if b.plugin == "conductor" {
+        MaterialDesc::RoughConductor {
+            alpha_u: TextureDesc::value(0.0),
+            alpha_v: TextureDesc::value(0.0),
+            eta,
+            k,
+            specular,
+            distribution: NormalDistribution::Beckmann,
+        }
+    } else {
+        let distribution = distribution(ctx, b)?;
+        let (alpha_u, alpha_v) = if ctx.has(b, "alpha_u") || ctx.has(b, "alpha_v") {
+            if ctx.has(b, "alpha") {
+                return Err(ctx.error(
+                    b.loc,
+                    format!("{}: give either alpha or alpha_u and alpha_v", ctx.what(b)),
+                ));
+            }
+            (
+                ctx.texture(b, "alpha_u", Vec3::splat(0.1), SpectrumKind::Unbounded)?,
+                ctx.texture(b, "alpha_v", Vec3::splat(0.1), SpectrumKind::Unbounded)?,
+            )
+        } else {
+            let a = ctx.texture(b, "alpha", Vec3::splat(0.1), SpectrumKind::Unbounded)?;
+            (a.clone(), a)
+        };
+        MaterialDesc::RoughConductor {
+            alpha_u,
+            alpha_v,
+            eta,
+            k,
+            specular,
+            distribution,
+        }
+    })
+}
+
+/// Mitsuba's `roughplastic` (its roughness a number: Mitsuba takes no texture there).
+fn rough_plastic(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
+    let alpha = ctx.texture(b, "alpha", Vec3::splat(0.1), SpectrumKind::Unbounded)?;
+    let Some(alpha) = alpha.as_constant() else {
+        return Err(ctx.error(
+        ctx.loc_of(b, "alpha"),
+        "<bsdf type=\"roughplastic\">: alpha must be a number (Mitsuba's roughplastic takes no roughness texture)",
+    ));
+    };
+    Ok(MaterialDesc::RoughPlastic {
+        diffuse: ctx.texture(
+            b,
+            "diffuse_reflectance",
+            Vec3::splat(0.5),
+            SpectrumKind::Reflectance,
+        )?,
+        specular: ctx.color(
+            b,
+            "specular_reflectance",
+            Vec3::ONE,
+            SpectrumKind::Reflectance,
+        )?,
+        alpha: alpha.x,
+        ior: relative_ior(ctx, b, 1.49)?,
+        nonlinear: ctx.boolean(b, "nonlinear", false)?,
+        distribution: distribution(ctx, b)?,
+    })
 }
 
 /// Mitsuba's `principled` and `principledthin`: optional parameters switch their lobes on

@@ -307,6 +307,20 @@ impl Builder {
     }
 
     fn directive(&mut self, word: &str, lx: &mut Lexer, depth: usize) -> Result<(), Error> {
+        let known = self.transform_directive(word, lx)?
+            || self.attribute_directive(word, lx)?
+            || self.structure_directive(word, lx, depth)?
+            || self.appearance_directive(word, lx)?
+            || self.shapes_directive(word, lx)?;
+        if known {
+            Ok(())
+        } else {
+            Err(self.error(format!("unknown directive '{word}'")))
+        }
+    }
+
+    /// The transform directives: each changes the current transformation matrix. Returns whether `word` is one of them.
+    fn transform_directive(&mut self, word: &str, lx: &mut Lexer) -> Result<bool, Error> {
         match word {
             "Translate" => {
                 let v = self.numbers(lx, word, 3)?;
@@ -377,6 +391,14 @@ impl Builder {
                 self.numbers(lx, word, 2)?;
                 self.warn("TransformTimes: motion blur is not supported; ignored");
             }
+            _ => return Ok(false),
+        }
+        Ok(true)
+    }
+
+    /// The graphics-state directives: blocks that save and restore it, and the attributes set in it. Returns whether `word` is one of them.
+    fn attribute_directive(&mut self, word: &str, lx: &mut Lexer) -> Result<bool, Error> {
+        match word {
             "ReverseOrientation" => self.gs.reverse_orientation = !self.gs.reverse_orientation,
             "AttributeBegin" | "TransformBegin" => {
                 if word == "TransformBegin" {
@@ -420,6 +442,19 @@ impl Builder {
                     entry.params.push(p);
                 }
             }
+            _ => return Ok(false),
+        }
+        Ok(true)
+    }
+
+    /// The file's structure and options: rendering options before `WorldBegin`, includes, colour space. Returns whether `word` is one of them.
+    fn structure_directive(
+        &mut self,
+        word: &str,
+        lx: &mut Lexer,
+        depth: usize,
+    ) -> Result<bool, Error> {
+        match word {
             "Option" => {
                 let params = ParamList::parse(lx)?;
                 let names: Vec<String> = params.params.iter().map(|p| p.name.clone()).collect();
@@ -473,6 +508,14 @@ impl Builder {
                 self.parse_file(&path, depth + 1)?;
                 self.line = line;
             }
+            _ => return Ok(false),
+        }
+        Ok(true)
+    }
+
+    /// Materials, textures and media. Returns whether `word` is one of them.
+    fn appearance_directive(&mut self, word: &str, lx: &mut Lexer) -> Result<bool, Error> {
+        match word {
             "MakeNamedMaterial" => {
                 let name = self.string_arg(lx, word)?;
                 let params = ParamList::parse(lx)?;
@@ -534,6 +577,14 @@ impl Builder {
                     self.warn("MediumInterface: participating media are not supported; ignored");
                 }
             }
+            _ => return Ok(false),
+        }
+        Ok(true)
+    }
+
+    /// Lights, shapes and object instancing. Returns whether `word` is one of them.
+    fn shapes_directive(&mut self, word: &str, lx: &mut Lexer) -> Result<bool, Error> {
+        match word {
             "LightSource" => {
                 let kind = self.string_arg(lx, word)?;
                 let params = ParamList::parse(lx)?;
@@ -607,11 +658,9 @@ impl Builder {
                 self.file = file;
                 self.line = line;
             }
-            other => {
-                return Err(self.error(format!("unknown directive '{other}'")));
-            }
+            _ => return Ok(false),
         }
-        Ok(())
+        Ok(true)
     }
 
     /// Directives that belong after `WorldBegin`.
