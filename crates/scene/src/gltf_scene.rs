@@ -58,12 +58,7 @@ fn check_position_accessors(bytes: &[u8]) -> Result<(), String> {
 
 /// Loads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<SceneDesc, Error> {
-    let err = |message: String| Error::Parse {
-        path: path.display().to_string(),
-        line: 0,
-        column: 0,
-        message,
-    };
+    let err = |message: String| parse_error(path, message);
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     check_position_accessors(&bytes).map_err(err)?;
     let (doc, buffers, images) = gltf::import(path).map_err(|e| match e {
@@ -81,6 +76,11 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
         .ok_or_else(|| err("the file has no scene".into()))?;
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     let mut visited = 0usize;
+    let file = File {
+        path,
+        buffers: &buffers,
+        images: &images,
+    };
     while let Some((node, parent)) = stack.pop() {
         visited += 1;
         if visited > 1_000_000 {
@@ -95,163 +95,14 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
         }
         if let Some(mesh) = node.mesh() {
             for (k, prim) in mesh.primitives().enumerate() {
-                if prim.mode() != gltf::mesh::Mode::Triangles {
-                    desc.warnings.push(format!(
-                        "mesh {}: primitive {k} is not triangles; skipped",
-                        mesh.index()
-                    ));
-                    continue;
-                }
-                let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-                let positions: Vec<Vec3> = reader
-                    .read_positions()
-                    .ok_or_else(|| {
-                        err(format!(
-                            "mesh {}: primitive {k} has no positions",
-                            mesh.index()
-                        ))
-                    })?
-                    .map(|p| world.transform_point3(Vec3::from_array(p)))
-                    .collect();
-                if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
-                    return Err(err(format!(
-                        "mesh {}: a position is not finite: {p}",
-                        mesh.index()
-                    )));
-                }
-                let indices: Vec<u32> = match reader.read_indices() {
-                    Some(i) => i.into_u32().collect(),
-                    None => (0..positions.len() as u32).collect(),
-                };
-                if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-                    return Err(err(format!(
-                        "mesh {}: index {bad} out of range ({} vertices)",
-                        mesh.index(),
-                        positions.len()
-                    )));
-                }
-                let normal_matrix = world.inverse().transpose();
-                let normals = reader
-                    .read_normals()
-                    .map(|n| {
-                        n.map(|n| {
-                            normal_matrix
-                                .transform_vector3(Vec3::from_array(n))
-                                .normalize_or_zero()
-                        })
-                        .collect()
-                    })
-                    .unwrap_or_default();
-                let uvs = reader
-                    .read_tex_coords(0)
-                    // glTF's v grows downwards; pathlab's upwards.
-                    .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect())
-                    .unwrap_or_default();
-                let m = prim.material();
-                let pbr = m.pbr_metallic_roughness();
-                let base = Vec3::from_slice(&pbr.base_color_factor()[..3]);
-                let texture = pbr.base_color_texture().and_then(|info| {
-                    let index = info.texture().source().index();
-                    let texture = images.get(index).and_then(|img| {
-                        base_color_texture(img, format!("{} image {index}", path.display()))
-                    });
-                    if texture.is_none() {
-                        desc.warnings.push(format!(
-                            "material {}: base-colour image {index} has an unsupported pixel format; using the base colour factor",
-                            m.index().map_or("default".into(), |i| i.to_string())
-                        ));
-                    }
-                    texture
-                });
-                let material = if pbr.metallic_factor() > 0.5 {
-                    // A conductor whose normal-incidence reflectance is the base colour.
-                    let s = base.clamp(Vec3::ZERO, Vec3::splat(0.999)).map(f32::sqrt);
-                    MaterialDesc::Conductor {
-                        alpha: pbr.roughness_factor() * pbr.roughness_factor(),
-                        eta: (Vec3::ONE + s) / (Vec3::ONE - s),
-                        k: Vec3::ZERO,
-                        distribution: NormalDistribution::Ggx,
-                    }
-                } else if let Some(texture) = texture {
-                    MaterialDesc::TexturedDiffuse {
-                        texture: TextureDesc::image(texture),
-                        scale: base.clamp(Vec3::ZERO, Vec3::ONE),
-                        two_sided: m.double_sided(),
-                    }
-                } else {
-                    MaterialDesc::Diffuse {
-                        reflectance: base.clamp(Vec3::ZERO, Vec3::ONE),
-                        two_sided: m.double_sided(),
-                    }
-                };
-                let emission =
-                    Vec3::from_array(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
-                desc.materials.push(material);
-                desc.meshes.push(MeshDesc {
-                    name: mesh.name().unwrap_or("mesh").to_string(),
-                    positions,
-                    indices,
-                    material: desc.materials.len() - 1,
-                    emission: (emission.max_element() > 0.0).then_some(Emission {
-                        radiance: emission,
-                        two_sided: false,
-                    }),
-                    normals,
-                    uvs,
-                    visibility: Visibility::ALL,
-                    ..Default::default()
-                });
+                file.add_primitive(&mut desc, &mesh, k, &prim, world)?;
             }
         }
-        if let (Some(cam), None) = (node.camera(), &camera) {
-            if let gltf::camera::Projection::Perspective(p) = cam.projection() {
-                let origin = world.transform_point3(Vec3::ZERO);
-                let forward = world
-                    .transform_vector3(Vec3::NEG_Z)
-                    .normalize_or(Vec3::NEG_Z);
-                camera = Some((
-                    CameraDesc {
-                        origin,
-                        target: origin + forward,
-                        up: world.transform_vector3(Vec3::Y).normalize_or(Vec3::Y),
-                        fov_degrees: p.yfov().to_degrees(),
-                        fov_axis: FovAxis::Y,
-                        lens_radius: 0.0,
-                        focal_distance: 1.0,
-                        focal_pixels: None,
-                        ..Default::default()
-                    },
-                    p.aspect_ratio(),
-                ));
-            }
+        if camera.is_none() {
+            camera = node.camera().and_then(|c| perspective_camera(&c, world));
         }
         if let Some(light) = node.light() {
-            let color = Vec3::from_array(light.color()) * light.intensity();
-            let position = world.transform_point3(Vec3::ZERO);
-            let direction = world
-                .transform_vector3(Vec3::NEG_Z)
-                .normalize_or(Vec3::NEG_Z);
-            match light.kind() {
-                Kind::Point => desc.point_lights.push(PointLightDesc {
-                    position,
-                    intensity: color,
-                    attenuation: INVERSE_SQUARE,
-                }),
-                Kind::Directional => desc.directional_lights.push(DirectionalLightDesc {
-                    direction,
-                    irradiance: color,
-                }),
-                Kind::Spot {
-                    outer_cone_angle, ..
-                } => desc.spot_lights.push(SpotLightDesc {
-                    position,
-                    direction,
-                    intensity: color,
-                    cutoff_degrees: outer_cone_angle.to_degrees(),
-                    exponent: 0.0,
-                    attenuation: INVERSE_SQUARE,
-                }),
-            }
+            add_light(&mut desc, &light, world);
         }
         stack.extend(node.children().map(|c| (c, world)));
     }
@@ -277,6 +128,205 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
             .push("the scene has no lights: lit by a default sky and key light".into());
     }
     Ok(desc)
+}
+
+/// An error in the glTF file at `path` (which has no lines to point at).
+fn parse_error(path: &Path, message: String) -> Error {
+    Error::Parse {
+        path: path.display().to_string(),
+        line: 0,
+        column: 0,
+        message,
+    }
+}
+
+/// What a glTF file's meshes read from: its path (for messages), buffers and images.
+struct File<'a> {
+    path: &'a Path,
+    buffers: &'a [gltf::buffer::Data],
+    images: &'a [gltf::image::Data],
+}
+
+impl File<'_> {
+    /// Adds primitive `k` of `mesh`, placed by `world`, as a mesh and its material (a warning
+    /// for primitives other than triangles, which are skipped).
+    fn add_primitive(
+        &self,
+        desc: &mut SceneDesc,
+        mesh: &gltf::Mesh,
+        k: usize,
+        prim: &gltf::Primitive,
+        world: Mat4,
+    ) -> Result<(), Error> {
+        let err = |message: String| parse_error(self.path, message);
+        if prim.mode() != gltf::mesh::Mode::Triangles {
+            desc.warnings.push(format!(
+                "mesh {}: primitive {k} is not triangles; skipped",
+                mesh.index()
+            ));
+            return Ok(());
+        }
+        let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| {
+                err(format!(
+                    "mesh {}: primitive {k} has no positions",
+                    mesh.index()
+                ))
+            })?
+            .map(|p| world.transform_point3(Vec3::from_array(p)))
+            .collect();
+        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+            return Err(err(format!(
+                "mesh {}: a position is not finite: {p}",
+                mesh.index()
+            )));
+        }
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(err(format!(
+                "mesh {}: index {bad} out of range ({} vertices)",
+                mesh.index(),
+                positions.len()
+            )));
+        }
+        let normal_matrix = world.inverse().transpose();
+        let normals = reader
+            .read_normals()
+            .map(|n| {
+                n.map(|n| {
+                    normal_matrix
+                        .transform_vector3(Vec3::from_array(n))
+                        .normalize_or_zero()
+                })
+                .collect()
+            })
+            .unwrap_or_default();
+        let uvs = reader
+            .read_tex_coords(0)
+            // glTF's v grows downwards; pathlab's upwards.
+            .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect())
+            .unwrap_or_default();
+        let m = prim.material();
+        let material = self.material(&m, &mut desc.warnings);
+        let emission = Vec3::from_array(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+        desc.materials.push(material);
+        desc.meshes.push(MeshDesc {
+            name: mesh.name().unwrap_or("mesh").to_string(),
+            positions,
+            indices,
+            material: desc.materials.len() - 1,
+            emission: (emission.max_element() > 0.0).then_some(Emission {
+                radiance: emission,
+                two_sided: false,
+            }),
+            normals,
+            uvs,
+            visibility: Visibility::ALL,
+            ..Default::default()
+        });
+        Ok(())
+    }
+
+    /// The closest BSDF to a metallic-roughness material: a conductor whose normal-incidence
+    /// reflectance is the base colour where it is metallic, else diffuse (textured by its
+    /// base-colour image where it has one).
+    fn material(&self, m: &gltf::Material, warnings: &mut Vec<String>) -> MaterialDesc {
+        let pbr = m.pbr_metallic_roughness();
+        let base = Vec3::from_slice(&pbr.base_color_factor()[..3]);
+        let texture = pbr.base_color_texture().and_then(|info| {
+            let index = info.texture().source().index();
+            let texture = self.images.get(index).and_then(|img| {
+                base_color_texture(img, format!("{} image {index}", self.path.display()))
+            });
+            if texture.is_none() {
+                warnings.push(format!(
+                    "material {}: base-colour image {index} has an unsupported pixel format; using the base colour factor",
+                    m.index().map_or("default".into(), |i| i.to_string())
+                ));
+            }
+            texture
+        });
+        if pbr.metallic_factor() > 0.5 {
+            let s = base.clamp(Vec3::ZERO, Vec3::splat(0.999)).map(f32::sqrt);
+            MaterialDesc::Conductor {
+                alpha: pbr.roughness_factor() * pbr.roughness_factor(),
+                eta: (Vec3::ONE + s) / (Vec3::ONE - s),
+                k: Vec3::ZERO,
+                distribution: NormalDistribution::Ggx,
+            }
+        } else if let Some(texture) = texture {
+            MaterialDesc::TexturedDiffuse {
+                texture: TextureDesc::image(texture),
+                scale: base.clamp(Vec3::ZERO, Vec3::ONE),
+                two_sided: m.double_sided(),
+            }
+        } else {
+            MaterialDesc::Diffuse {
+                reflectance: base.clamp(Vec3::ZERO, Vec3::ONE),
+                two_sided: m.double_sided(),
+            }
+        }
+    }
+}
+
+/// A perspective camera placed by `world`, and its aspect ratio if the file gives one.
+fn perspective_camera(cam: &gltf::Camera, world: Mat4) -> Option<(CameraDesc, Option<f32>)> {
+    let gltf::camera::Projection::Perspective(p) = cam.projection() else {
+        return None;
+    };
+    let origin = world.transform_point3(Vec3::ZERO);
+    let forward = world
+        .transform_vector3(Vec3::NEG_Z)
+        .normalize_or(Vec3::NEG_Z);
+    Some((
+        CameraDesc {
+            origin,
+            target: origin + forward,
+            up: world.transform_vector3(Vec3::Y).normalize_or(Vec3::Y),
+            fov_degrees: p.yfov().to_degrees(),
+            fov_axis: FovAxis::Y,
+            lens_radius: 0.0,
+            focal_distance: 1.0,
+            focal_pixels: None,
+            ..Default::default()
+        },
+        p.aspect_ratio(),
+    ))
+}
+
+/// Adds a `KHR_lights_punctual` light placed by `world`.
+fn add_light(desc: &mut SceneDesc, light: &gltf::khr_lights_punctual::Light, world: Mat4) {
+    let color = Vec3::from_array(light.color()) * light.intensity();
+    let position = world.transform_point3(Vec3::ZERO);
+    let direction = world
+        .transform_vector3(Vec3::NEG_Z)
+        .normalize_or(Vec3::NEG_Z);
+    match light.kind() {
+        Kind::Point => desc.point_lights.push(PointLightDesc {
+            position,
+            intensity: color,
+            attenuation: INVERSE_SQUARE,
+        }),
+        Kind::Directional => desc.directional_lights.push(DirectionalLightDesc {
+            direction,
+            irradiance: color,
+        }),
+        Kind::Spot {
+            outer_cone_angle, ..
+        } => desc.spot_lights.push(SpotLightDesc {
+            position,
+            direction,
+            intensity: color,
+            cutoff_degrees: outer_cone_angle.to_degrees(),
+            exponent: 0.0,
+            attenuation: INVERSE_SQUARE,
+        }),
+    }
 }
 
 /// A glTF base-colour image as a linear texture (8-bit channels are sRGB-encoded).
