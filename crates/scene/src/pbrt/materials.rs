@@ -13,9 +13,7 @@ use crate::spectrum::{blackbody_to_rgb, sampled_to_rgb, xyz_to_srgb, SpectrumKin
 use crate::Error;
 use glam::{DVec3, Vec3};
 use pathlab_render::color::luminance_f64 as luminance;
-use pathlab_render::desc::{
-    FresnelModel, MaterialDesc, NormalDistribution, Rgb, TextureDesc, TextureFilter, WrapMode,
-};
+use pathlab_render::desc::{FresnelModel, MaterialDesc, NormalDistribution, Rgb, TextureDesc};
 
 /// pbrt-v4's named glasses: their index at the sodium d line (587.6 nm).
 const GLASSES: &[(&str, f32)] = &[
@@ -245,7 +243,7 @@ impl Builder {
     }
 
     /// A colour that may be a texture: `"texture NAME"` or a spectrum.
-    fn color_texture(
+    pub(super) fn color_texture(
         &mut self,
         params: &ParamList,
         name: &str,
@@ -349,53 +347,9 @@ impl Builder {
     fn material_desc(&mut self, kind: &str, params: &ParamList) -> Result<MaterialDesc, Error> {
         // `type` was read by MakeNamedMaterial.
         params.get("type");
-        let two_sided = |m: MaterialDesc| MaterialDesc::TwoSided {
-            front: Box::new(m.clone()),
-            back: Box::new(m),
-        };
         Ok(match kind {
             "diffuse" => self.diffuse(params, "reflectance", 0.5)?,
-            "conductor" => {
-                let (au, av) = self.roughness(params)?;
-                let (eta, k) = match self.spectrum(params, "reflectance", Use::Albedo)? {
-                    // pbrt-v4: a conductor given by its reflectance r has η = 1 and
-                    // k = 2 √r / √(1 - r).
-                    Some(r) => {
-                        let r = r.clamp(Vec3::ZERO, Vec3::splat(0.9999));
-                        (
-                            Vec3::ONE,
-                            2.0 * r.map(f32::sqrt) / (Vec3::ONE - r).map(f32::sqrt),
-                        )
-                    }
-                    None => {
-                        let eta = self.spectrum(params, "eta", Use::Unbounded)?;
-                        let k = self.spectrum(params, "k", Use::Unbounded)?;
-                        let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
-                        (
-                            eta.unwrap_or(Vec3::from(cu_eta)),
-                            k.unwrap_or(Vec3::from(cu_k)),
-                        )
-                    }
-                };
-                let m = if au == av {
-                    MaterialDesc::Conductor {
-                        alpha: au,
-                        eta,
-                        k,
-                        distribution: NormalDistribution::Ggx,
-                    }
-                } else {
-                    MaterialDesc::RoughConductor {
-                        alpha_u: TextureDesc::value(au),
-                        alpha_v: TextureDesc::value(av),
-                        eta,
-                        k,
-                        specular: TextureDesc::value(1.0),
-                        distribution: NormalDistribution::Ggx,
-                    }
-                };
-                two_sided(m)
-            }
+            "conductor" => self.conductor(params)?,
             "dielectric" => {
                 let (au, av) = self.roughness(params)?;
                 if au != av {
@@ -417,88 +371,14 @@ impl Builder {
                 transmittance: Rgb::ONE,
                 ior: self.eta(params)?,
             },
-            "coateddiffuse" => {
-                let (au, av) = self.roughness(params)?;
-                let ior = self.eta(params)?;
-                let diffuse = self.color_texture(params, "reflectance", Rgb::splat(0.5))?;
-                for p in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
-                    params.get(p);
-                }
-                self.warn("coateddiffuse: approximated by a diffuse base under a dielectric coat with no scattering inside the layer (Mitsuba's plastic), not pbrt-v4's stochastic layers");
-                let m = if au == 0.0 && av == 0.0 {
-                    MaterialDesc::Plastic {
-                        diffuse: diffuse.mean(),
-                        specular: Rgb::ONE,
-                        ior,
-                        nonlinear: false,
-                    }
-                } else {
-                    MaterialDesc::RoughPlastic {
-                        diffuse,
-                        specular: Rgb::ONE,
-                        alpha: 0.5 * (au + av),
-                        ior,
-                        nonlinear: false,
-                        distribution: NormalDistribution::Ggx,
-                    }
-                };
-                two_sided(m)
-            }
-            "coatedconductor" => {
-                self.warn("coatedconductor: approximated by its conductor without the coat");
-                let r = self.float_value(params, "conductor.roughness", 0.0)?;
-                let remap = self.bool(params, "remaproughness", true)?;
-                let a = if remap { r.sqrt() } else { r } as f32;
-                let eta = self.spectrum(params, "conductor.eta", Use::Unbounded)?;
-                let k = self.spectrum(params, "conductor.k", Use::Unbounded)?;
-                let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
-                for p in [
-                    "interface.eta",
-                    "interface.roughness",
-                    "thickness",
-                    "albedo",
-                    "g",
-                    "maxdepth",
-                    "nsamples",
-                ] {
-                    params.get(p);
-                }
-                two_sided(MaterialDesc::Conductor {
-                    alpha: if a < 1e-3 { 0.0 } else { a },
-                    eta: eta.unwrap_or(Vec3::from(cu_eta)),
-                    k: k.unwrap_or(Vec3::from(cu_k)),
-                    distribution: NormalDistribution::Ggx,
-                })
-            }
+            "coateddiffuse" => self.coated_diffuse(params)?,
+            "coatedconductor" => self.coated_conductor(params)?,
             "diffusetransmission" => {
                 params.get("transmittance");
                 self.warn("diffusetransmission: its transmission is not supported; rendered as its diffuse reflection");
                 self.diffuse(params, "reflectance", 0.25)?
             }
-            "mix" => {
-                let names = params
-                    .get("materials")
-                    .and_then(|p| p.strings().map(<[String]>::to_vec))
-                    .unwrap_or_default();
-                if names.len() != 2 {
-                    return Err(self.error("mix: \"string materials\" must name two materials"));
-                }
-                let pick = |n: &str| -> Result<MaterialDesc, Error> {
-                    self.named_materials
-                        .get(n)
-                        .map(|&i| self.desc.materials[i].clone())
-                        .ok_or_else(|| self.error(format!("mix: no material named \"{n}\"")))
-                };
-                let (first, second) = (pick(&names[0])?, pick(&names[1])?);
-                // pbrt-v4 picks the second with probability `amount`: the same expectation
-                // as a blend.
-                let amount = self.float_value(params, "amount", 0.5)?;
-                MaterialDesc::Blend {
-                    weight: TextureDesc::value(amount.clamp(0.0, 1.0) as f32),
-                    first: Box::new(first),
-                    second: Box::new(second),
-                }
-            }
+            "mix" => self.mix(params)?,
             "interface" | "" | "none" => MaterialDesc::Mask {
                 opacity: TextureDesc::value(0.0),
                 inner: Box::new(MaterialDesc::Diffuse {
@@ -518,6 +398,132 @@ impl Builder {
                     two_sided: true,
                 }
             }
+        })
+    }
+
+    /// pbrt-v4's `conductor`: by its `reflectance`, or `eta` and `k` (copper by default), smooth or rough (anisotropic where `uroughness` and `vroughness` differ).
+    fn conductor(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
+        let (au, av) = self.roughness(params)?;
+        let (eta, k) = match self.spectrum(params, "reflectance", Use::Albedo)? {
+            // pbrt-v4: a conductor given by its reflectance r has η = 1 and
+            // k = 2 √r / √(1 - r).
+            Some(r) => {
+                let r = r.clamp(Vec3::ZERO, Vec3::splat(0.9999));
+                (
+                    Vec3::ONE,
+                    2.0 * r.map(f32::sqrt) / (Vec3::ONE - r).map(f32::sqrt),
+                )
+            }
+            None => {
+                let eta = self.spectrum(params, "eta", Use::Unbounded)?;
+                let k = self.spectrum(params, "k", Use::Unbounded)?;
+                let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
+                (
+                    eta.unwrap_or(Vec3::from(cu_eta)),
+                    k.unwrap_or(Vec3::from(cu_k)),
+                )
+            }
+        };
+        let m = if au == av {
+            MaterialDesc::Conductor {
+                alpha: au,
+                eta,
+                k,
+                distribution: NormalDistribution::Ggx,
+            }
+        } else {
+            MaterialDesc::RoughConductor {
+                alpha_u: TextureDesc::value(au),
+                alpha_v: TextureDesc::value(av),
+                eta,
+                k,
+                specular: TextureDesc::value(1.0),
+                distribution: NormalDistribution::Ggx,
+            }
+        };
+        Ok(two_sided(m))
+    }
+
+    /// pbrt-v4's `coateddiffuse`, approximated (with a warning) by Mitsuba's plastic: a diffuse base under a dielectric coat, with no scattering inside the layer.
+    fn coated_diffuse(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
+        let (au, av) = self.roughness(params)?;
+        let ior = self.eta(params)?;
+        let diffuse = self.color_texture(params, "reflectance", Rgb::splat(0.5))?;
+        for p in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
+            params.get(p);
+        }
+        self.warn("coateddiffuse: approximated by a diffuse base under a dielectric coat with no scattering inside the layer (Mitsuba's plastic), not pbrt-v4's stochastic layers");
+        let m = if au == 0.0 && av == 0.0 {
+            MaterialDesc::Plastic {
+                diffuse: diffuse.mean(),
+                specular: Rgb::ONE,
+                ior,
+                nonlinear: false,
+            }
+        } else {
+            MaterialDesc::RoughPlastic {
+                diffuse,
+                specular: Rgb::ONE,
+                alpha: 0.5 * (au + av),
+                ior,
+                nonlinear: false,
+                distribution: NormalDistribution::Ggx,
+            }
+        };
+        Ok(two_sided(m))
+    }
+
+    /// pbrt-v4's `coatedconductor`, approximated (with a warning) by its conductor without the coat.
+    fn coated_conductor(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
+        self.warn("coatedconductor: approximated by its conductor without the coat");
+        let r = self.float_value(params, "conductor.roughness", 0.0)?;
+        let remap = self.bool(params, "remaproughness", true)?;
+        let a = if remap { r.sqrt() } else { r } as f32;
+        let eta = self.spectrum(params, "conductor.eta", Use::Unbounded)?;
+        let k = self.spectrum(params, "conductor.k", Use::Unbounded)?;
+        let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
+        for p in [
+            "interface.eta",
+            "interface.roughness",
+            "thickness",
+            "albedo",
+            "g",
+            "maxdepth",
+            "nsamples",
+        ] {
+            params.get(p);
+        }
+        Ok(two_sided(MaterialDesc::Conductor {
+            alpha: if a < 1e-3 { 0.0 } else { a },
+            eta: eta.unwrap_or(Vec3::from(cu_eta)),
+            k: k.unwrap_or(Vec3::from(cu_k)),
+            distribution: NormalDistribution::Ggx,
+        }))
+    }
+
+    /// pbrt-v4's `mix` of two named materials.
+    fn mix(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
+        let names = params
+            .get("materials")
+            .and_then(|p| p.strings().map(<[String]>::to_vec))
+            .unwrap_or_default();
+        if names.len() != 2 {
+            return Err(self.error("mix: \"string materials\" must name two materials"));
+        }
+        let pick = |n: &str| -> Result<MaterialDesc, Error> {
+            self.named_materials
+                .get(n)
+                .map(|&i| self.desc.materials[i].clone())
+                .ok_or_else(|| self.error(format!("mix: no material named \"{n}\"")))
+        };
+        let (first, second) = (pick(&names[0])?, pick(&names[1])?);
+        // pbrt-v4 picks the second with probability `amount`: the same expectation
+        // as a blend.
+        let amount = self.float_value(params, "amount", 0.5)?;
+        Ok(MaterialDesc::Blend {
+            weight: TextureDesc::value(amount.clamp(0.0, 1.0) as f32),
+            first: Box::new(first),
+            second: Box::new(second),
         })
     }
 
@@ -541,157 +547,12 @@ impl Builder {
             },
         })
     }
+}
 
-    /// `Texture "name" "spectrum"|"float" "class" ...`.
-    pub(crate) fn texture(
-        &mut self,
-        name: String,
-        ty: &str,
-        class: &str,
-        params: ParamList,
-    ) -> Result<(), Error> {
-        if ty != "spectrum" && ty != "float" && ty != "color" {
-            return Err(self.error(format!(
-                "Texture \"{name}\": type \"{ty}\" (expected spectrum or float)"
-            )));
-        }
-        let tex = match class {
-            "constant" => TextureDesc::Constant(if ty == "float" {
-                Rgb::splat(self.float(&params, "value", 1.0)? as f32)
-            } else {
-                self.spectrum(&params, "value", Use::Albedo)?
-                    .unwrap_or(Rgb::ONE)
-            }),
-            "imagemap" => {
-                let file = self.string(&params, "filename")?.ok_or_else(|| {
-                    self.error(format!(
-                        "Texture \"{name}\": imagemap needs \"string filename\""
-                    ))
-                })?;
-                let path = self.resolve(&file);
-                let encoding = self
-                    .string(&params, "encoding")?
-                    .unwrap_or_else(|| "sRGB".into());
-                let raw = encoding == "linear" || ty == "float" && encoding != "sRGB";
-                if encoding.starts_with("gamma") {
-                    self.warn(format!(
-                        "Texture \"{name}\": encoding \"{encoding}\" read as sRGB"
-                    ));
-                }
-                let scale = self.float(&params, "scale", 1.0)? as f32;
-                let invert = self.bool(&params, "invert", false)?;
-                let filter = match self.string(&params, "filter")?.as_deref() {
-                    Some("point") => TextureFilter::Nearest,
-                    _ => TextureFilter::Bilinear,
-                };
-                let wrap = match self.string(&params, "wrap")?.as_deref() {
-                    Some("clamp") => WrapMode::Clamp,
-                    Some("black") => {
-                        self.warn(format!("Texture \"{name}\": wrap \"black\" read as clamp"));
-                        WrapMode::Clamp
-                    }
-                    _ => WrapMode::Repeat,
-                };
-                let su = self.float(&params, "uscale", 1.0)? as f32;
-                let sv = self.float(&params, "vscale", 1.0)? as f32;
-                let du = self.float(&params, "udelta", 0.0)? as f32;
-                let dv = self.float(&params, "vdelta", 0.0)? as f32;
-                if let Some(m) = self.string(&params, "mapping")? {
-                    if m != "uv" {
-                        self.warn(format!(
-                            "Texture \"{name}\": mapping \"{m}\" is not supported; uv is used"
-                        ));
-                    }
-                }
-                match crate::texture::load(&path, raw) {
-                    Ok(image) => {
-                        if invert || scale != 1.0 {
-                            self.warn(format!("Texture \"{name}\": scale and invert of image textures are not supported; ignored"));
-                        }
-                        TextureDesc::Image {
-                            image,
-                            filter,
-                            wrap,
-                            to_uv: glam::Affine2::from_scale_angle_translation(
-                                glam::Vec2::new(su, sv),
-                                0.0,
-                                glam::Vec2::new(du, dv),
-                            ),
-                        }
-                    }
-                    Err(e) => {
-                        self.warn(format!("Texture \"{name}\": {e}; a constant 0.5 is used"));
-                        TextureDesc::value(0.5)
-                    }
-                }
-            }
-            "scale" => {
-                let tex = self.texture_or_value(&params, "tex", ty)?;
-                let scale = self.texture_or_value(&params, "scale", ty)?;
-                match (tex.as_constant(), scale.as_constant()) {
-                    (Some(a), Some(b)) => TextureDesc::Constant(a * b),
-                    (None, Some(b)) if b == Rgb::ONE => tex,
-                    (Some(a), None) if a == Rgb::ONE => scale,
-                    _ => {
-                        self.warn(format!("Texture \"{name}\": a scaled image is not supported; the image alone is used"));
-                        if tex.as_constant().is_none() {
-                            tex
-                        } else {
-                            scale
-                        }
-                    }
-                }
-            }
-            "mix" => {
-                let a = self.texture_or_value(&params, "tex1", ty)?;
-                let b = self.texture_or_value(&params, "tex2", ty)?;
-                let amount = self.float(&params, "amount", 0.5)? as f32;
-                if a.as_constant().is_none()
-                    || b.as_constant().is_none()
-                    || params.has("amount")
-                        && params
-                            .params
-                            .iter()
-                            .any(|p| p.name == "amount" && p.ty == "texture")
-                {
-                    self.warn(format!("Texture \"{name}\": a mix of textures is not supported; their mean is used"));
-                }
-                TextureDesc::Constant(a.mean() * (1.0 - amount) + b.mean() * amount)
-            }
-            other => {
-                self.warn(format!(
-                    "Texture \"{name}\": \"{other}\" textures are not supported; a constant 0.5 is used"
-                ));
-                for p in &params.params {
-                    p.used.set(true);
-                }
-                TextureDesc::value(0.5)
-            }
-        };
-        self.warn_unused(&format!("Texture \"{name}\""), &params);
-        self.textures.insert(name, tex);
-        Ok(())
-    }
-
-    /// A texture parameter or a value of the texture's type (default 1).
-    fn texture_or_value(
-        &mut self,
-        params: &ParamList,
-        name: &str,
-        ty: &str,
-    ) -> Result<TextureDesc, Error> {
-        if params
-            .params
-            .iter()
-            .any(|p| p.name == name && p.ty == "texture")
-        {
-            return self.color_texture(params, name, Rgb::ONE);
-        }
-        Ok(TextureDesc::Constant(if ty == "float" {
-            Rgb::splat(self.float(params, name, 1.0)? as f32)
-        } else {
-            self.spectrum(params, name, Use::Albedo)?
-                .unwrap_or(Rgb::ONE)
-        }))
+/// A material with the same BSDF on both sides (pbrt-v4's materials are two-sided).
+fn two_sided(m: MaterialDesc) -> MaterialDesc {
+    MaterialDesc::TwoSided {
+        front: Box::new(m.clone()),
+        back: Box::new(m),
     }
 }

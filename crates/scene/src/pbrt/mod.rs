@@ -16,6 +16,7 @@ mod lexer;
 mod materials;
 mod params;
 mod shapes;
+mod textures;
 mod world;
 
 use crate::Error;

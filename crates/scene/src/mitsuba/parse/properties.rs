@@ -6,7 +6,12 @@ use super::*;
 
 impl Parser {
     /// The value of property element `node` named `name` (`<float>`, `<rgb>`, `<transform>`...).
-    pub(super) fn property(&mut self, src: &Source, node: XmlNode, name: &str) -> Result<Value, Error> {
+    pub(super) fn property(
+        &mut self,
+        src: &Source,
+        node: XmlNode,
+        name: &str,
+    ) -> Result<Value, Error> {
         let loc = src.loc(node);
         Ok(match node.tag_name().name() {
             "float" => {
@@ -99,7 +104,12 @@ impl Parser {
     }
 
     /// x, y, z attributes (missing ones `default`) or a `value` of 1 or 3 numbers.
-    pub(super) fn xyz(&mut self, src: &Source, node: XmlNode, default: f64) -> Result<DVec3, Error> {
+    pub(super) fn xyz(
+        &mut self,
+        src: &Source,
+        node: XmlNode,
+        default: f64,
+    ) -> Result<DVec3, Error> {
         let loc = src.loc(node);
         let tag = node.tag_name().name().to_string();
         if let Some(v) = self.attr(src, node, "value")? {
@@ -134,7 +144,12 @@ impl Parser {
         ))
     }
 
-    pub(super) fn spectrum(&mut self, src: &Source, node: XmlNode, name: &str) -> Result<Spectrum, Error> {
+    pub(super) fn spectrum(
+        &mut self,
+        src: &Source,
+        node: XmlNode,
+        name: &str,
+    ) -> Result<Spectrum, Error> {
         let loc = src.loc(node);
         let value = self.attr(src, node, "value")?;
         let filename = self.attr(src, node, "filename")?;
