@@ -15,15 +15,20 @@
 //!   bounding-box diagonal around the box centre, in the direction of the camera node's
 //!   transform of (0, 0, -1), looking at the centre, with the image-plane distance fixed for an
 //!   800 x 600 image (other resolutions show more or less at the same scale).
+//!
+//! Geometry (sources, primitives) is read in `geometry`, materials (effects, textures) in
+//! `materials`.
 
 use crate::xml::{child, children, parse_document, path as xpath, read_text, XmlFile};
 use crate::Error;
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec3};
 use pathlab_render::desc::*;
 use roxmltree::Node;
 use std::collections::HashMap;
 use std::path::Path;
-use std::sync::Arc;
+
+mod geometry;
+mod materials;
 
 /// Default image size of the course's renderer.
 pub const DEFAULT_RESOLUTION: [u32; 2] = [800, 600];
@@ -254,150 +259,6 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             })
     }
 
-    fn effect(&mut self, material: Node<'a, 'input>) -> Result<Effect, Error> {
-        let inst = child(material, "instance_effect")
-            .ok_or_else(|| self.file.error(material, "expected an <instance_effect>"))?;
-        let effect = self.lookup(inst, inst.attribute("url").unwrap_or(""))?;
-        let mut diffuse = Vec3::splat(0.5);
-        let mut texture = None;
-        if let Some(shading) = xpath(effect, &["profile_COMMON", "technique"]).and_then(|t| {
-            ["phong", "lambert", "blinn", "constant"]
-                .iter()
-                .find_map(|name| child(t, name))
-        }) {
-            if let Some(d) = child(shading, "diffuse") {
-                if let Some(c) = child(d, "color") {
-                    diffuse = Vec3::from_slice(&self.file.floats_n(c, 3)?);
-                } else if let Some(t) = child(d, "texture") {
-                    texture = self.texture(effect, t);
-                    diffuse = Vec3::ONE;
-                }
-            }
-        }
-        let cgl = effect.descendants().find(|n| {
-            n.is_element()
-                && n.tag_name().name() == "technique"
-                && n.attribute("profile") == Some("CGL")
-        });
-        let mut out = Effect {
-            material: match texture {
-                Some(texture) => MaterialDesc::TexturedDiffuse {
-                    texture: TextureDesc::image(texture),
-                    scale: Vec3::ONE,
-                    two_sided: true,
-                },
-                None => MaterialDesc::Diffuse {
-                    reflectance: diffuse.clamp(Vec3::ZERO, Vec3::ONE),
-                    two_sided: true,
-                },
-            },
-            emission: None,
-        };
-        let Some(cgl) = cgl else {
-            return Ok(out);
-        };
-        let rgb = |n: Node, name: &str, default: Vec3| -> Result<Vec3, Error> {
-            match child(n, name) {
-                Some(c) => Ok(Vec3::from_slice(&self.file.floats_n(c, 3)?)),
-                None => Ok(default),
-            }
-        };
-        let scalar = |n: Node, name: &str, default: f32| -> Result<f32, Error> {
-            match child(n, name) {
-                Some(c) => Ok(self.file.floats_n(c, 1)?[0]),
-                None => Ok(default),
-            }
-        };
-        for m in cgl.children().filter(|c| c.is_element()) {
-            match m.tag_name().name() {
-                "emission" => {
-                    out.emission = Some(rgb(m, "radiance", Vec3::ONE)?);
-                    // An emitter reflects nothing.
-                    out.material = MaterialDesc::Diffuse {
-                        reflectance: Vec3::ZERO,
-                        two_sided: true,
-                    };
-                }
-                "mirror" => {
-                    out.material = MaterialDesc::Mirror {
-                        reflectance: rgb(m, "reflectance", Vec3::ONE)?,
-                    }
-                }
-                "glass" | "refraction" => {
-                    out.material = MaterialDesc::Glass {
-                        reflectance: rgb(m, "reflectance", Vec3::ONE)?,
-                        transmittance: rgb(m, "transmittance", Vec3::ONE)?,
-                        roughness: scalar(m, "roughness", 0.0)?,
-                        ior: scalar(m, "ior", 1.5)?,
-                        distribution: NormalDistribution::Beckmann,
-                        fresnel: FresnelModel::Exact,
-                    }
-                }
-                "microfacet" => {
-                    out.material = MaterialDesc::Conductor {
-                        alpha: scalar(m, "alpha", 0.5)?,
-                        eta: rgb(m, "eta", Vec3::ONE)?,
-                        k: rgb(m, "k", Vec3::ZERO)?,
-                        // The course's microfacet model.
-                        distribution: NormalDistribution::Beckmann,
-                    }
-                }
-                _ => {}
-            }
-        }
-        Ok(out)
-    }
-
-    /// The image a `<texture texture="...">` names, loaded; `None` (with a warning) when it
-    /// cannot be found or read. The name is a sampler's sid in the effect, whose surface names
-    /// the `<image>`; a direct image id works too.
-    fn texture(&mut self, effect: Node, texture: Node) -> Option<Arc<Texture>> {
-        let name = texture.attribute("texture").unwrap_or("?");
-        let param = |sid: &str| {
-            effect
-                .descendants()
-                .find(|n| n.tag_name().name() == "newparam" && n.attribute("sid") == Some(sid))
-        };
-        let text_of = |n: Option<Node>, path: &[&str]| {
-            n.and_then(|n| xpath(n, path))
-                .and_then(|n| n.text())
-                .map(|t| t.trim().to_string())
-        };
-        let surface = text_of(param(name), &["sampler2D", "source"]);
-        let image_id = text_of(
-            surface.as_deref().and_then(param),
-            &["surface", "init_from"],
-        )
-        .unwrap_or_else(|| name.to_string());
-        let image = self
-            .ids
-            .get(image_id.as_str())
-            .copied()
-            .filter(|n| n.tag_name().name() == "image");
-        let Some(file) = text_of(image, &["init_from"]) else {
-            self.desc.warnings.push(format!(
-                "texture '{name}' names no <image>; using a white diffuse surface"
-            ));
-            return None;
-        };
-        let file = file.strip_prefix("file://").unwrap_or(&file).to_string();
-        let full = self
-            .file
-            .path
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join(&file);
-        match crate::texture::load(&full, false) {
-            Ok(t) => Some(t),
-            Err(e) => {
-                self.desc.warnings.push(format!(
-                    "texture '{file}': {e}; using a white diffuse surface"
-                ));
-                None
-            }
-        }
-    }
-
     fn instance_geometry(&mut self, inst: Node<'a, 'input>, world: Mat4) -> Result<(), Error> {
         let geom = self.lookup(inst, inst.attribute("url").unwrap_or(""))?;
         if let Some(sphere) = geom
@@ -481,195 +342,6 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             });
         }
         Ok(())
-    }
-
-    /// Reads a `<source>`'s values (float_array via its accessor) as `stride`-tuples.
-    fn source(&self, source: Node<'a, 'input>, want: usize) -> Result<Vec<f32>, Error> {
-        let array = child(source, "float_array")
-            .ok_or_else(|| self.file.error(source, "expected a <float_array>"))?;
-        let values = self.file.floats(array)?;
-        if let Some(count) = array.attribute("count") {
-            let count: usize = count.parse().map_err(|_| {
-                self.file
-                    .error(array, format!("count '{count}' is not a number"))
-            })?;
-            if count != values.len() {
-                return Err(self.file.error(
-                    array,
-                    format!("count says {count} values but {} are given", values.len()),
-                ));
-            }
-        }
-        let accessor = xpath(source, &["technique_common", "accessor"]);
-        let stride = match accessor.and_then(|a| a.attribute("stride")) {
-            Some(s) => s
-                .parse::<usize>()
-                .ok()
-                .filter(|&s| s >= want)
-                .ok_or_else(|| {
-                    self.file.error(
-                        source,
-                        format!("accessor stride '{s}' must be at least {want}"),
-                    )
-                })?,
-            None => want,
-        };
-        Ok(values
-            .chunks_exact(stride)
-            .flat_map(|c| c[..want].to_vec())
-            .collect())
-    }
-
-    fn primitive(&self, prim: Node<'a, 'input>) -> Result<Triangles, Error> {
-        // Inputs: semantic, source, offset.
-        let mut stride = 0usize;
-        let mut pos: Option<(Vec<Vec3>, usize)> = None;
-        let mut nor: Option<(Vec<Vec3>, usize)> = None;
-        let mut tex: Option<(Vec<Vec2>, usize)> = None;
-        for input in children(prim, "input") {
-            let offset: usize = input
-                .attribute("offset")
-                .unwrap_or("0")
-                .parse()
-                .map_err(|_| self.file.error(input, "offset is not a number"))?;
-            if offset > 64 {
-                return Err(self
-                    .file
-                    .error(input, format!("offset {offset} is implausibly large")));
-            }
-            stride = stride.max(offset + 1);
-            let semantic = input.attribute("semantic").unwrap_or("");
-            let src = self.lookup(input, input.attribute("source").unwrap_or(""))?;
-            let vec3s = |v: Vec<f32>| v.chunks_exact(3).map(Vec3::from_slice).collect::<Vec<_>>();
-            match semantic {
-                "VERTEX" => {
-                    let p = children(src, "input")
-                        .find(|i| i.attribute("semantic") == Some("POSITION"))
-                        .ok_or_else(|| self.file.error(src, "expected a POSITION input"))?;
-                    let psrc = self.lookup(p, p.attribute("source").unwrap_or(""))?;
-                    pos = Some((vec3s(self.source(psrc, 3)?), offset));
-                    if let Some(n) =
-                        children(src, "input").find(|i| i.attribute("semantic") == Some("NORMAL"))
-                    {
-                        let nsrc = self.lookup(n, n.attribute("source").unwrap_or(""))?;
-                        nor = Some((vec3s(self.source(nsrc, 3)?), offset));
-                    }
-                }
-                "POSITION" => pos = Some((vec3s(self.source(src, 3)?), offset)),
-                "NORMAL" => nor = Some((vec3s(self.source(src, 3)?), offset)),
-                "TEXCOORD" if tex.is_none() => {
-                    let v = self.source(src, 2)?;
-                    tex = Some((v.chunks_exact(2).map(Vec2::from_slice).collect(), offset));
-                }
-                _ => {}
-            }
-        }
-        let (positions, pos_offset) =
-            pos.ok_or_else(|| self.file.error(prim, "expected a VERTEX input"))?;
-        let stride = stride.max(1);
-        // Polygons: vertex counts and index lists.
-        let polygons: Vec<Vec<u32>> = match prim.tag_name().name() {
-            "polygons" => children(prim, "p")
-                .map(|p| self.file.indices(p))
-                .collect::<Result<_, _>>()?,
-            kind => {
-                let p = child(prim, "p")
-                    .map(|p| self.file.indices(p))
-                    .transpose()?
-                    .unwrap_or_default();
-                let counts: Vec<u32> = if kind == "polylist" {
-                    child(prim, "vcount")
-                        .map(|v| self.file.indices(v))
-                        .transpose()?
-                        .unwrap_or_default()
-                } else {
-                    vec![3; p.len() / (3 * stride)]
-                };
-                let mut out = Vec::with_capacity(counts.len().min(p.len()));
-                let mut at = 0usize;
-                for &c in &counts {
-                    let len = c as usize * stride;
-                    let Some(slice) = p.get(at..at + len) else {
-                        return Err(self.file.error(
-                            prim,
-                            format!(
-                                "<p> has {} indices but the polygon counts need more",
-                                p.len()
-                            ),
-                        ));
-                    };
-                    out.push(slice.to_vec());
-                    at += len;
-                }
-                out
-            }
-        };
-        if let Some(count) = prim
-            .attribute("count")
-            .and_then(|c| c.parse::<usize>().ok())
-        {
-            if count != polygons.len() {
-                return Err(self.file.error(
-                    prim,
-                    format!(
-                        "count says {count} polygons but {} are given",
-                        polygons.len()
-                    ),
-                ));
-            }
-        }
-        let mut out = Triangles::default();
-        let fetch =
-            |list: &[u32], corner: usize, offset: usize| list[corner * stride + offset] as usize;
-        for poly in &polygons {
-            if poly.len() % stride != 0 {
-                return Err(self.file.error(
-                    prim,
-                    "a polygon's index count is not a multiple of the input count",
-                ));
-            }
-            let corners = poly.len() / stride;
-            for k in 1..corners.saturating_sub(1) {
-                for corner in [0, k, k + 1] {
-                    let pi = fetch(poly, corner, pos_offset);
-                    let p = *positions.get(pi).ok_or_else(|| {
-                        self.file.error(
-                            prim,
-                            format!(
-                                "position index {pi} out of range ({} positions)",
-                                positions.len()
-                            ),
-                        )
-                    })?;
-                    out.positions.push(p);
-                    if let Some((normals, off)) = &nor {
-                        let ni = fetch(poly, corner, *off);
-                        out.normals.push(*normals.get(ni).ok_or_else(|| {
-                            self.file.error(
-                                prim,
-                                format!(
-                                    "normal index {ni} out of range ({} normals)",
-                                    normals.len()
-                                ),
-                            )
-                        })?);
-                    }
-                    if let Some((uvs, off)) = &tex {
-                        let ti = fetch(poly, corner, *off);
-                        out.uvs.push(*uvs.get(ti).ok_or_else(|| {
-                            self.file.error(
-                                prim,
-                                format!(
-                                    "texture coordinate index {ti} out of range ({})",
-                                    uvs.len()
-                                ),
-                            )
-                        })?);
-                    }
-                }
-            }
-        }
-        Ok(out)
     }
 
     fn light(&mut self, light: Node<'a, 'input>, world: Mat4) -> Result<(), Error> {
@@ -898,12 +570,4 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
             ..Default::default()
         })
     }
-}
-
-/// Triangles expanded per corner.
-#[derive(Default)]
-struct Triangles {
-    positions: Vec<Vec3>,
-    normals: Vec<Vec3>,
-    uvs: Vec<Vec2>,
 }
