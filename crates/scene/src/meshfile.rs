@@ -414,31 +414,75 @@ pub fn ply_mesh_from(reader: &mut impl std::io::BufRead, path: &Path) -> Result<
         .payload
         .get("vertex")
         .ok_or_else(|| err("no 'vertex' element".into()))?;
-    let scalar = |e: &DefaultElement, key: &str| -> Option<f32> {
-        match e.get(key)? {
-            Property::Float(v) => Some(*v),
-            Property::Double(v) => Some(*v as f32),
-            Property::Char(v) => Some(*v as f32),
-            Property::UChar(v) => Some(*v as f32),
-            Property::Short(v) => Some(*v as f32),
-            Property::UShort(v) => Some(*v as f32),
-            Property::Int(v) => Some(*v as f32),
-            Property::UInt(v) => Some(*v as f32),
-            _ => None,
-        }
+    let PlyVertices {
+        positions,
+        normals,
+        uvs,
+    } = ply_vertices(vertices).map_err(err)?;
+    let keys = |element: &str| -> Vec<String> {
+        ply.header
+            .elements
+            .get(element)
+            .map(|e| e.properties.keys().cloned().collect())
+            .unwrap_or_default()
     };
+    let mut attributes = ply_attributes(&keys("vertex"), vertices, "vertex_", &ply_scalar);
+    let mut indices = Vec::new();
+    if let Some(faces) = ply.payload.get("face") {
+        let face_attributes = ply_attributes(&keys("face"), faces, "face_", &ply_scalar);
+        let face_attributes =
+            ply_faces(faces, positions.len(), face_attributes, &mut indices).map_err(err)?;
+        attributes.extend(face_attributes);
+    }
+    Ok(MeshDesc {
+        name,
+        positions,
+        indices,
+        normals,
+        uvs,
+        attributes,
+        ..Default::default()
+    })
+}
+
+/// A numeric property of a PLY element as `f32`.
+fn ply_scalar(e: &DefaultElement, key: &str) -> Option<f32> {
+    match e.get(key)? {
+        Property::Float(v) => Some(*v),
+        Property::Double(v) => Some(*v as f32),
+        Property::Char(v) => Some(*v as f32),
+        Property::UChar(v) => Some(*v as f32),
+        Property::Short(v) => Some(*v as f32),
+        Property::UShort(v) => Some(*v as f32),
+        Property::Int(v) => Some(*v as f32),
+        Property::UInt(v) => Some(*v as f32),
+        _ => None,
+    }
+}
+
+/// A PLY file's vertex data.
+struct PlyVertices {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+}
+
+/// The positions of a PLY file's vertices, and their normals and texture coordinates where
+/// every vertex has them (else empty).
+fn ply_vertices(vertices: &[DefaultElement]) -> Result<PlyVertices, String> {
     let mut positions = Vec::with_capacity(vertices.len());
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
+    let scalar = ply_scalar;
     for (i, v) in vertices.iter().enumerate() {
         let p = match (scalar(v, "x"), scalar(v, "y"), scalar(v, "z")) {
             (Some(x), Some(y), Some(z)) => Vec3::new(x, y, z),
-            _ => return Err(err(format!("vertex {i} lacks a numeric x, y or z"))),
+            _ => return Err(format!("vertex {i} lacks a numeric x, y or z")),
         };
         if !p.is_finite() {
-            return Err(err(format!(
+            return Err(format!(
                 "vertex {i} has a coordinate that is not a finite number: {p}"
-            )));
+            ));
         }
         positions.push(p);
         if let (Some(x), Some(y), Some(z)) = (scalar(v, "nx"), scalar(v, "ny"), scalar(v, "nz")) {
@@ -457,66 +501,51 @@ pub fn ply_mesh_from(reader: &mut impl std::io::BufRead, path: &Path) -> Result<
     if uvs.len() != positions.len() {
         uvs.clear();
     }
-    let keys = |element: &str| -> Vec<String> {
-        ply.header
-            .elements
-            .get(element)
-            .map(|e| e.properties.keys().cloned().collect())
-            .unwrap_or_default()
-    };
-    let mut attributes = ply_attributes(&keys("vertex"), vertices, "vertex_", &scalar);
-    let mut indices = Vec::new();
-    if let Some(faces) = ply.payload.get("face") {
-        let mut face_attributes = ply_attributes(&keys("face"), faces, "face_", &scalar);
-        let mut triangle_values: Vec<Vec<Vec3>> = vec![Vec::new(); face_attributes.len()];
-        for (f, face) in faces.iter().enumerate() {
-            let list: Vec<i64> = match face
-                .get("vertex_indices")
-                .or_else(|| face.get("vertex_index"))
-            {
-                Some(Property::ListInt(v)) => v.iter().map(|&x| x as i64).collect(),
-                Some(Property::ListUInt(v)) => v.iter().map(|&x| x as i64).collect(),
-                Some(Property::ListShort(v)) => v.iter().map(|&x| x as i64).collect(),
-                Some(Property::ListUShort(v)) => v.iter().map(|&x| x as i64).collect(),
-                Some(Property::ListChar(v)) => v.iter().map(|&x| x as i64).collect(),
-                Some(Property::ListUChar(v)) => v.iter().map(|&x| x as i64).collect(),
-                _ => return Err(err(format!("face {f} has no integer vertex_indices list"))),
-            };
-            if let Some(&bad) = list
-                .iter()
-                .find(|&&i| i < 0 || i as usize >= positions.len())
-            {
-                return Err(err(format!(
-                    "face {f}: vertex index {bad} out of range ({} vertices)",
-                    positions.len()
-                )));
-            }
-            for k in 1..list.len().saturating_sub(1) {
-                indices.extend([list[0] as u32, list[k] as u32, list[k + 1] as u32]);
-                for (a, values) in face_attributes.iter().zip(&mut triangle_values) {
-                    values.push(a.values[f]);
-                }
-            }
-        }
-        for (a, values) in face_attributes.iter_mut().zip(triangle_values) {
-            a.values = values;
-        }
-        attributes.extend(face_attributes);
-    }
-    let name = path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("ply")
-        .to_string();
-    Ok(MeshDesc {
-        name,
+    Ok(PlyVertices {
         positions,
-        indices,
         normals,
         uvs,
-        attributes,
-        ..Default::default()
     })
+}
+
+/// Fans a PLY file's faces (polygons over `vertex_count` vertices) into triangles, appended to
+/// `indices`; returns the face attributes with one value per triangle.
+fn ply_faces(
+    faces: &[DefaultElement],
+    vertex_count: usize,
+    mut face_attributes: Vec<MeshAttribute>,
+    indices: &mut Vec<u32>,
+) -> Result<Vec<MeshAttribute>, String> {
+    let mut triangle_values: Vec<Vec<Vec3>> = vec![Vec::new(); face_attributes.len()];
+    for (f, face) in faces.iter().enumerate() {
+        let list: Vec<i64> = match face
+            .get("vertex_indices")
+            .or_else(|| face.get("vertex_index"))
+        {
+            Some(Property::ListInt(v)) => v.iter().map(|&x| x as i64).collect(),
+            Some(Property::ListUInt(v)) => v.iter().map(|&x| x as i64).collect(),
+            Some(Property::ListShort(v)) => v.iter().map(|&x| x as i64).collect(),
+            Some(Property::ListUShort(v)) => v.iter().map(|&x| x as i64).collect(),
+            Some(Property::ListChar(v)) => v.iter().map(|&x| x as i64).collect(),
+            Some(Property::ListUChar(v)) => v.iter().map(|&x| x as i64).collect(),
+            _ => return Err(format!("face {f} has no integer vertex_indices list")),
+        };
+        if let Some(&bad) = list.iter().find(|&&i| i < 0 || i as usize >= vertex_count) {
+            return Err(format!(
+                "face {f}: vertex index {bad} out of range ({vertex_count} vertices)"
+            ));
+        }
+        for k in 1..list.len().saturating_sub(1) {
+            indices.extend([list[0] as u32, list[k] as u32, list[k + 1] as u32]);
+            for (a, values) in face_attributes.iter().zip(&mut triangle_values) {
+                values.push(a.values[f]);
+            }
+        }
+    }
+    for (a, values) in face_attributes.iter_mut().zip(triangle_values) {
+        a.values = values;
+    }
+    Ok(face_attributes)
 }
 
 /// Adds the default camera, resolution and (when nothing emits) lights of a standalone mesh.
