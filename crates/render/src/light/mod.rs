@@ -170,6 +170,72 @@ impl Light {
         }
     }
 
+    /// [`Light::sample_li`] of an area light: a point on its triangle or sphere, its radiance
+    /// read from the texture where there is one.
+    fn sample_area_li(
+        &self,
+        shape: AreaShape,
+        texture: Option<&AreaTexture>,
+        radiance: Rgb,
+        two_sided: bool,
+        p: Vec3,
+        u: Vec2,
+    ) -> Option<LightLiSample> {
+        let (s, b) = match shape {
+            AreaShape::Triangle(t) => {
+                let s = t.emitter(radiance, two_sided).sample_li(p, u.x, u.y);
+                if s.dist2 == 0.0 || s.abs_cos_light == 0.0 {
+                    return None;
+                }
+                let li = match texture {
+                    None => s.li,
+                    Some(tex) if s.emits => {
+                        radiance * tex.tex.eval(&TexPoint::uv(tex.uv(&shape, s.p_light, s.b)))
+                    }
+                    Some(_) => Rgb::ZERO,
+                };
+                return Some(LightLiSample {
+                    li,
+                    wi: s.wi,
+                    pdf: s.pdf,
+                    p_light: s.p_light,
+                    n_light: Some(t.normal),
+                    is_delta: false,
+                });
+            }
+            AreaShape::Sphere(sph) => (sph.sample(u), [0.0; 3]),
+        };
+        let to_light = s.p - p;
+        let dist2 = to_light.length_squared();
+        if dist2 == 0.0 {
+            return None;
+        }
+        let wi = to_light / dist2.sqrt();
+        let cos_l = s.n.dot(-wi).abs();
+        if cos_l == 0.0 {
+            return None;
+        }
+        let li = match texture {
+            None => self.le(s.n, -wi, Vec2::ZERO),
+            Some(t) => {
+                let c = s.n.dot(-wi);
+                if c > 0.0 || (two_sided && c < 0.0) {
+                    radiance * t.tex.eval(&TexPoint::uv(t.uv(&shape, s.p, b)))
+                } else {
+                    Rgb::ZERO
+                }
+            }
+        };
+        Some(LightLiSample {
+            li,
+            wi,
+            pdf: s.pdf_area * dist2 / cos_l,
+            p_light: s.p,
+            n_light: Some(s.n),
+            is_delta: false,
+        })
+    }
+
     /// Samples incident radiance at `p`.
     pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightLiSample> {
         match *self {
@@ -178,62 +244,7 @@ impl Light {
                 ref texture,
                 radiance,
                 two_sided,
-            } => {
-                let (s, b) = match shape {
-                    AreaShape::Triangle(t) => {
-                        let s = t.emitter(radiance, two_sided).sample_li(p, u.x, u.y);
-                        if s.dist2 == 0.0 || s.abs_cos_light == 0.0 {
-                            return None;
-                        }
-                        let li = match texture {
-                            None => s.li,
-                            Some(tex) if s.emits => {
-                                radiance
-                                    * tex.tex.eval(&TexPoint::uv(tex.uv(&shape, s.p_light, s.b)))
-                            }
-                            Some(_) => Rgb::ZERO,
-                        };
-                        return Some(LightLiSample {
-                            li,
-                            wi: s.wi,
-                            pdf: s.pdf,
-                            p_light: s.p_light,
-                            n_light: Some(t.normal),
-                            is_delta: false,
-                        });
-                    }
-                    AreaShape::Sphere(sph) => (sph.sample(u), [0.0; 3]),
-                };
-                let to_light = s.p - p;
-                let dist2 = to_light.length_squared();
-                if dist2 == 0.0 {
-                    return None;
-                }
-                let wi = to_light / dist2.sqrt();
-                let cos_l = s.n.dot(-wi).abs();
-                if cos_l == 0.0 {
-                    return None;
-                }
-                let li = match texture {
-                    None => self.le(s.n, -wi, Vec2::ZERO),
-                    Some(t) => {
-                        let c = s.n.dot(-wi);
-                        if c > 0.0 || (two_sided && c < 0.0) {
-                            radiance * t.tex.eval(&TexPoint::uv(t.uv(&shape, s.p, b)))
-                        } else {
-                            Rgb::ZERO
-                        }
-                    }
-                };
-                Some(LightLiSample {
-                    li,
-                    wi,
-                    pdf: s.pdf_area * dist2 / cos_l,
-                    p_light: s.p,
-                    n_light: Some(s.n),
-                    is_delta: false,
-                })
-            }
+            } => self.sample_area_li(shape, texture.as_deref(), radiance, two_sided, p, u),
             Light::Point {
                 position,
                 intensity,
