@@ -1,57 +1,12 @@
-//! Renders that survive and scale: what identifies a render (for checkpoints and shards),
-//! stopping on signals, and `pathlab merge`.
+//! Renders that survive and scale: shards of a render, stopping on signals, and
+//! `pathlab merge` (a render's identity and checkpoints are [`pathlab_lab::job`]'s).
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use pathlab_render::desc::SceneDesc;
-use pathlab_render::film_file::{self, FilmHeader};
-use std::fmt::Write as _;
+use pathlab_render::film_file;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
-
-/// A streaming FNV-1a hash of formatted text.
-struct Hasher(u64);
-
-impl std::fmt::Write for Hasher {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        for &b in s.as_bytes() {
-            self.0 ^= b as u64;
-            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
-        }
-        Ok(())
-    }
-}
-
-/// A key for the scene, every setting that changes the image (`settings`) and the program's
-/// version: checkpoints and shards are accepted only by a render with the same key.
-pub fn render_key(desc: &SceneDesc, settings: &str) -> String {
-    let mut h = Hasher(0xcbf2_9ce4_8422_2325);
-    // The scene as the renderer gets it (after every command-line change), then the
-    // settings, and the program's version (another version may sample differently).
-    let _ = write!(h, "{desc:?}|{settings}|{}", env!("CARGO_PKG_VERSION"));
-    format!("{:016x}", h.0)
-}
-
-/// The header of a film file for this render.
-pub fn header(
-    desc: &SceneDesc,
-    key: &str,
-    description: &str,
-    seed: u64,
-    spp: u32,
-    range: [u32; 2],
-) -> FilmHeader {
-    FilmHeader {
-        resolution: desc.resolution,
-        key: key.to_string(),
-        description: description.to_string(),
-        seed,
-        spp,
-        range,
-        writer: format!("pathlab {}", env!("CARGO_PKG_VERSION")),
-    }
-}
 
 /// `--shard I/N` as the sample range of shard I (from 0) of N over `spp` samples.
 pub fn shard_range(text: &str, spp: u32) -> Result<[u32; 2]> {
@@ -67,46 +22,6 @@ pub fn shard_range(text: &str, spp: u32) -> Result<[u32; 2]> {
     }
     let at = |k: u64| (k * spp as u64 / n) as u32;
     Ok([at(i), at(i + 1)])
-}
-
-/// Checks that the film file `path` (header `h`) belongs to this render.
-pub fn check_matches(path: &std::path::Path, h: &FilmHeader, ours: &FilmHeader) -> Result<()> {
-    let p = path.display();
-    if h.resolution != ours.resolution {
-        bail!(
-            "{p}: the film is {}x{}, this render {}x{}",
-            h.resolution[0],
-            h.resolution[1],
-            ours.resolution[0],
-            ours.resolution[1]
-        );
-    }
-    if h.key != ours.key {
-        bail!(
-            "{p}: it belongs to another scene or settings ({}), not this render's ({})",
-            h.description,
-            ours.description
-        );
-    }
-    if h.seed != ours.seed || h.spp != ours.spp {
-        bail!(
-            "{p}: seed {} and {} spp, this render seed {} and {} spp",
-            h.seed,
-            h.spp,
-            ours.seed,
-            ours.spp
-        );
-    }
-    if h.range != ours.range {
-        bail!(
-            "{p}: samples {}..{}, this render {}..{}",
-            h.range[0],
-            h.range[1],
-            ours.range[0],
-            ours.range[1]
-        );
-    }
-    Ok(())
 }
 
 /// The signals that stop a render: SIGINT and SIGTERM set `cancel`; SIGTERM also sets
@@ -158,7 +73,7 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
     }
     let (header, film) = film_file::merge(&parts).map_err(anyhow::Error::msg)?;
     let (first, [w, h]) = (&header, header.resolution);
-    crate::render_cmd::write_film_image(&film, &args.output, &header, args.exposure)?;
+    pathlab_lab::outputs::write_film_image(&film, &args.output, &header, args.exposure)?;
     eprintln!(
         "merged {} parts ({} spp, {}x{}); wrote {}",
         parts.len(),

@@ -7,12 +7,16 @@
 //! - [`converge`]: a scene's error against a reference as samples grow, per way of sampling;
 //! - [`images`]: image metrics (RMSE, relative MSE) and the check that a reference belongs to
 //!   a render;
-//! - [`plot`]: the plots of all of them (PNG or SVG).
+//! - [`plot`]: the plots of all of them (PNG or SVG);
+//! - [`job`]: a render as a job: its film files' identity, checkpoints, progressive stops;
+//! - [`outputs`]: a render's images written (EXR with AOV layers, PNG, film files, heat maps).
 
 pub mod compare;
 pub mod converge;
 pub mod expr;
 pub mod images;
 pub mod integrate;
+pub mod job;
+pub mod outputs;
 pub mod plot;
 pub mod sample;

@@ -12,20 +12,18 @@ mod report;
 mod setup;
 
 pub use args::{parse_depth_arg, RenderArgs, ToneMapName};
-pub use outputs::write_film_image;
 pub use setup::apply_resolution;
 
 use anyhow::{Context, Result};
-use args::IntegratorName;
-use outputs::OutputFormat;
+use args::{Aov, IntegratorName};
+use pathlab_lab::job::{film_header, resumed_film, Checkpoint, JobOutcome, RenderJob};
+use pathlab_lab::outputs::{write_all, ImageOptions, OutputFormat, Written};
 use pathlab_render::film::Film;
-use pathlab_render::film_file::FilmHeader;
-use pathlab_render::integrator::IntegratorKind;
-use pathlab_render::progressive::{estimated_relative_rmse, render_progressive_from, StopRule};
-use pathlab_render::render::{render_from, RenderSettings, RenderStats, TileDone};
+use pathlab_render::image_io::ToneMap;
+use pathlab_render::progressive::StopRule;
+use pathlab_render::render::TileDone;
 use pathlab_render::scene::Scene;
 use pathlab_render::tev::{Layers, TevDisplay};
-use pathlab_scene::SceneDesc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
@@ -67,34 +65,34 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
         &desc,
         &settings,
         &integrator,
-        integrator_name,
+        &format!("{integrator_name:?}"),
         progressive.then_some(stop_cap),
         film_files,
     );
     let [w, h] = desc.resolution;
     let start_film = match &args.resume {
-        Some(path) => resumed_film(path, &header, args.quiet)?,
+        Some(path) => {
+            let film = resumed_film(path, &header)?;
+            if !args.quiet {
+                let n = film.pixels().iter().map(|p| p.count()).min().unwrap_or(0);
+                eprintln!(
+                    "resuming {}: every pixel holds at least {n} of {} samples",
+                    path.display(),
+                    header.range[1] - header.range[0]
+                );
+            }
+            film
+        }
         None => Film::new(w, h),
     };
-    let display = args.display.as_deref().and_then(|addr| {
-        let name = std::path::Path::new(&args.scene)
-            .file_name()
-            .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
-        let layers = Layers {
-            variance: args.aov.contains(&args::Aov::Variance),
-            samples: args.aov.contains(&args::Aov::Samples),
-        };
-        TevDisplay::connect(addr, &name, &start_film, layers)
-            .map_err(|w| eprintln!("warning: {w}"))
-            .ok()
-    });
+    let display = connect_display(args, &start_film);
     let pixels = settings.pixel_count(desc.resolution);
     let bar = Arc::new(report::progress_bar(args, progressive, pixels * spp as u64));
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()
         .context("cannot start the worker threads")?;
-    let job = Job {
+    let job = RenderJob {
         scene: &scene,
         integrator: &integrator,
         settings: &settings,
@@ -104,6 +102,10 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
             time_limit: args.time,
             max_spp: stop_cap,
         }),
+        checkpoint: args.checkpoint.clone().map(|path| Checkpoint {
+            path,
+            every_seconds: args.checkpoint_every,
+        }),
     };
     let progress = |t: &TileDone| {
         bar.inc(t.samples);
@@ -111,11 +113,23 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
             d.tile(t);
         }
     };
-    let (film, stats, estimated_error) =
-        pool.install(|| job.run(args, start_film, &progress, &bar, cancel))?;
+    let mut after_pass = |pass: u32, error: f64| {
+        bar.set_message(format!("pass {pass}: estimated relative RMSE {error:.4}"));
+    };
+    let JobOutcome {
+        film,
+        stats,
+        progressive: passes,
+    } = pool.install(|| job.run(start_film, &progress, &mut after_pass, cancel))?;
     bar.finish_and_clear();
     if let Some(w) = display.and_then(|d| d.finish(&film)) {
         eprintln!("warning: {w}");
+    }
+    if let (Some((report, error)), false) = (&passes, args.quiet) {
+        eprintln!(
+            "progressive: {} passes, stopped by {}; estimated relative RMSE {error:.4}",
+            report.passes, report.stopped_by
+        );
     }
     if stats.cancelled {
         let spp = film.sample_count_range();
@@ -126,17 +140,74 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
             if args.checkpoint.is_some() { " (and the checkpoint)" } else { "" }
         );
     }
+    let options = ImageOptions {
+        variance: args.aov.contains(&Aov::Variance),
+        samples: args.aov.contains(&Aov::Samples),
+        tonemap: match args.tonemap {
+            ToneMapName::Srgb => ToneMap::Srgb,
+            ToneMapName::Cs184 => ToneMap::Cs184,
+        },
+        exposure: args.exposure,
+    };
     let bvh_view = integrator_name == IntegratorName::Bvh;
     let adaptive_cap = settings.adaptive.is_some().then_some(spp);
-    let written = outputs::write_all(
+    let written = write_all(
         &film,
         &outputs,
         &formats,
         &header,
-        args,
+        options,
         bvh_view,
         adaptive_cap,
     )?;
+    report_written(args, &film, &stats, &written, &formats, spp);
+    let summary = report::Summary {
+        outputs: &outputs,
+        settings: &settings,
+        integrator_name,
+        max_depth,
+        progressive,
+        stop_cap,
+        threads: pool.current_num_threads(),
+        estimated_error: passes.map(|(_, error)| error),
+        heat_range: written.heat_range,
+    };
+    report::print_summary(args, &scene, &film, &stats, &summary)?;
+    // Stopped by a signal: the shell's convention, 128 + the signal's number.
+    Ok(if !stats.cancelled {
+        0
+    } else if signals.terminated.load(Ordering::Relaxed) {
+        143
+    } else {
+        130
+    })
+}
+
+/// The tev viewer `--display` names, sent the film to start from; `None` (after one warning)
+/// when nothing listens there.
+fn connect_display(args: &RenderArgs, film: &Film) -> Option<TevDisplay> {
+    let addr = args.display.as_deref()?;
+    let name = std::path::Path::new(&args.scene)
+        .file_name()
+        .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
+    let layers = Layers {
+        variance: args.aov.contains(&Aov::Variance),
+        samples: args.aov.contains(&Aov::Samples),
+    };
+    TevDisplay::connect(addr, &name, film, layers)
+        .map_err(|w| eprintln!("warning: {w}"))
+        .ok()
+}
+
+/// Tells what was written besides the outputs: the BVH view's range, the adaptive rate image.
+fn report_written(
+    args: &RenderArgs,
+    film: &Film,
+    stats: &pathlab_render::render::RenderStats,
+    written: &Written,
+    formats: &[OutputFormat],
+    spp: u32,
+) {
     if !(args.quiet || args.json) {
         if let Some((lo, hi)) = written.heat_range {
             let how = if formats.contains(&OutputFormat::Png) {
@@ -162,166 +233,5 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
             "adaptive: {mean:.1} samples per pixel on average (at most {spp}){pilot}; rate image {}",
             rate.display()
         );
-    }
-    let summary = report::Summary {
-        outputs: &outputs,
-        settings: &settings,
-        integrator_name,
-        max_depth,
-        progressive,
-        stop_cap,
-        threads: pool.current_num_threads(),
-        estimated_error,
-        heat_range: written.heat_range,
-    };
-    report::print_summary(args, &scene, &film, &stats, &summary)?;
-    // Stopped by a signal: the shell's convention, 128 + the signal's number.
-    Ok(if !stats.cancelled {
-        0
-    } else if signals.terminated.load(Ordering::Relaxed) {
-        143
-    } else {
-        130
-    })
-}
-
-/// The header of this render's film files: what identifies it (the scene as the renderer gets
-/// it and every setting that changes the image, hashed only when `film_files` are read or
-/// written, since hashing a large scene takes time), its seed and sample range. A progressive
-/// render (`progressive_cap`) holds up to its cap and resumes only under the same cap.
-fn film_header(
-    desc: &SceneDesc,
-    settings: &RenderSettings,
-    integrator: &IntegratorKind,
-    integrator_name: IntegratorName,
-    progressive_cap: Option<u32>,
-    film_files: bool,
-) -> FilmHeader {
-    let sampler = settings.sampler;
-    let description = format!(
-        "{integrator_name:?} integrator, {} sampler, seed {}, crop {:?}",
-        sampler.name(),
-        settings.seed,
-        settings.crop
-    )
-    .to_lowercase();
-    let key = if film_files {
-        crate::farm::render_key(
-            desc,
-            &format!(
-                "{integrator:?}|{sampler:?}|{:?}|{:?}|progressive {}",
-                settings.crop,
-                settings.adaptive,
-                progressive_cap.is_some()
-            ),
-        )
-    } else {
-        String::new()
-    };
-    let (spp, range) = match progressive_cap {
-        Some(cap) => (cap, [0, cap]),
-        None => (
-            settings.spp,
-            settings.sample_range.unwrap_or([0, settings.spp]),
-        ),
-    };
-    crate::farm::header(desc, &key, &description, settings.seed, spp, range)
-}
-
-/// The film of a checkpoint, checked against this render's header.
-fn resumed_film(path: &std::path::Path, header: &FilmHeader, quiet: bool) -> Result<Film> {
-    let (h, film) = pathlab_render::film_file::read(path)?;
-    crate::farm::check_matches(path, &h, header)?;
-    if !quiet {
-        let n = film.pixels().iter().map(|p| p.count()).min().unwrap_or(0);
-        eprintln!(
-            "resuming {}: every pixel holds at least {n} of {} samples",
-            path.display(),
-            header.range[1] - header.range[0]
-        );
-    }
-    Ok(film)
-}
-
-/// A render to run: fixed samples per pixel (or adaptive), or progressive to `stop`.
-struct Job<'a> {
-    scene: &'a Scene,
-    integrator: &'a IntegratorKind,
-    settings: &'a RenderSettings,
-    header: &'a FilmHeader,
-    stop: Option<StopRule>,
-}
-
-impl Job<'_> {
-    /// Renders from `film`, writing checkpoints after finished passes (at most every
-    /// `--checkpoint-every` seconds) and when done or stopped; the film, the statistics and,
-    /// for progressive renders, the estimated relative RMSE.
-    fn run(
-        &self,
-        args: &RenderArgs,
-        film: Film,
-        progress: &(dyn Fn(&TileDone) + Sync),
-        bar: &Arc<indicatif::ProgressBar>,
-        cancel: &AtomicBool,
-    ) -> Result<(Film, RenderStats, Option<f64>)> {
-        let mut last_checkpoint = std::time::Instant::now();
-        let mut checkpoint_error = None;
-        let mut checkpoint = |film: &Film| {
-            if let Some(path) = &args.checkpoint {
-                if last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every {
-                    if let Err(e) = pathlab_render::film_file::write(path, self.header, film) {
-                        checkpoint_error.get_or_insert(e);
-                    }
-                    last_checkpoint = std::time::Instant::now();
-                }
-            }
-        };
-        let (film, stats, estimated_error) = match &self.stop {
-            Some(stop) => {
-                let mut after_pass = |film: &Film, _: &RenderStats, pass: u32, error: f64| {
-                    bar.set_message(format!("pass {pass}: estimated relative RMSE {error:.4}"));
-                    checkpoint(film);
-                };
-                let (film, stats, report) = render_progressive_from(
-                    self.scene,
-                    self.integrator,
-                    self.settings,
-                    stop,
-                    film,
-                    progress,
-                    cancel,
-                    &mut after_pass,
-                );
-                // Of the film as written (after a stop mid-pass too).
-                let error = estimated_relative_rmse(&film);
-                if !args.quiet {
-                    eprintln!(
-                        "progressive: {} passes, stopped by {}; estimated relative RMSE {error:.4}",
-                        report.passes, report.stopped_by
-                    );
-                }
-                (film, stats, Some(error))
-            }
-            None => {
-                let (film, stats) = render_from(
-                    self.scene,
-                    self.integrator,
-                    self.settings,
-                    film,
-                    progress,
-                    cancel,
-                    &mut |film, _| checkpoint(film),
-                );
-                (film, stats, None)
-            }
-        };
-        if let Some(e) = checkpoint_error {
-            return Err(e).context("cannot write the checkpoint");
-        }
-        if let Some(path) = &args.checkpoint {
-            pathlab_render::film_file::write(path, self.header, &film)
-                .context("cannot write the checkpoint")?;
-        }
-        Ok((film, stats, estimated_error))
     }
 }
