@@ -4,14 +4,12 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use pathlab_lab::expr::parse_constant;
-use pathlab_lab::integrate::{convergence, point_text, Integral};
+use pathlab_lab::integrate::{convergence, Integral, IntegralRun};
 use pathlab_lab::plot;
-use pathlab_mc::estimator::looks_heavy_tailed;
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_mc::stats::z_test;
 use serde_json::{json, Value};
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// Raw command-line arguments of `pathlab integrate`.
 #[derive(Args, Debug)]
@@ -131,33 +129,12 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
     for w in &problem.warnings {
         eprintln!("warning: {w}");
     }
-
-    let start = Instant::now();
-    let est = problem.estimate_with_error(args.sampler, n, args.reps, args.seed);
-    let seconds = start.elapsed().as_secs_f64();
-    if !est.mean.is_finite() {
-        let at = problem
-            .find_non_finite(args.sampler, n, args.seed)
-            .map(|x| format!(" at {}", point_text(&x[..problem.domains.len()])))
-            .unwrap_or_default();
-        bail!(
-            "the integrand \"{}\" is not finite{at}: its integral cannot be estimated",
-            args.expression
-        );
+    let run = problem.run(args.sampler, n, args.reps, args.seed)?;
+    if run.heavy_tailed {
+        if let Some(w) = run.warnings.last() {
+            eprintln!("warning: {w}");
+        }
     }
-    let rate = est.n as f64 / seconds.max(1e-9);
-    let share = problem.largest_share(args.sampler, n, args.seed, est.mean);
-    let heavy = looks_heavy_tailed(share, n as u64);
-    let mut warnings = problem.warnings.clone();
-    if heavy {
-        let w = format!(
-            "one of the {n} samples carries {:.0}% of the sample variance: f/p looks heavy-tailed (infinite variance, or a divergent integral such as 1/x at 0), so the standard error and interval are not to be trusted; sample in proportion to the integrand's peak (--importance) or change variables",
-            100.0 * share
-        );
-        eprintln!("warning: {w}");
-        warnings.push(w);
-    }
-
     let convergence = match &args.convergence {
         Some(path) => Some(convergence_report(
             &problem,
@@ -169,39 +146,57 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
         )?),
         None => None,
     };
-
     if args.json {
-        let mut out = json!({
-            "expression": args.expression,
-            "domain": problem.domains.iter().map(|d| [d.0, d.1]).collect::<Vec<_>>(),
-            "importance": args.importance,
-            "sampler": args.sampler.name(),
-            "samples": est.n,
-            "seed": args.seed,
-            "estimate": est.mean,
-            "std_error": est.std_error,
-            "ci95": [est.ci95.0, est.ci95.1],
-            "relative_error": est.relative_error(),
-            "variance_per_sample": est.variance,
-            "seconds": seconds,
-            "samples_per_second": rate,
-            "largest_sample_share": share,
-            "heavy_tailed": heavy,
-            "warnings": warnings,
-        });
-        if let Some(x) = exact {
-            let z = z_test(est.mean, est.std_error, x);
-            out["exact"] = json!(x);
-            out["error"] = json!(est.mean - x);
-            out["z"] = json!(z.z);
-        }
-        if let Some(c) = convergence {
-            out["convergence"] = c;
-        }
-        println!("{}", serde_json::to_string_pretty(&out)?);
-        return Ok(());
+        print_json(args, &problem, &run, exact, convergence)
+    } else {
+        print_text(args, &problem, &run, exact);
+        Ok(())
     }
+}
 
+/// The `--json` report.
+fn print_json(
+    args: &IntegrateArgs,
+    problem: &Integral,
+    run: &IntegralRun,
+    exact: Option<f64>,
+    convergence: Option<Value>,
+) -> Result<()> {
+    let est = &run.estimate;
+    let mut out = json!({
+        "expression": args.expression,
+        "domain": problem.domains.iter().map(|d| [d.0, d.1]).collect::<Vec<_>>(),
+        "importance": args.importance,
+        "sampler": args.sampler.name(),
+        "samples": est.n,
+        "seed": args.seed,
+        "estimate": est.mean,
+        "std_error": est.std_error,
+        "ci95": [est.ci95.0, est.ci95.1],
+        "relative_error": est.relative_error(),
+        "variance_per_sample": est.variance,
+        "seconds": run.seconds,
+        "samples_per_second": est.n as f64 / run.seconds.max(1e-9),
+        "largest_sample_share": run.largest_share,
+        "heavy_tailed": run.heavy_tailed,
+        "warnings": run.warnings,
+    });
+    if let Some(x) = exact {
+        let z = z_test(est.mean, est.std_error, x);
+        out["exact"] = json!(x);
+        out["error"] = json!(est.mean - x);
+        out["z"] = json!(z.z);
+    }
+    if let Some(c) = convergence {
+        out["convergence"] = c;
+    }
+    println!("{}", serde_json::to_string_pretty(&out)?);
+    Ok(())
+}
+
+/// The text report.
+fn print_text(args: &IntegrateArgs, problem: &Integral, run: &IntegralRun, exact: Option<f64>) {
+    let est = &run.estimate;
     println!(
         "integral of {} over {}",
         args.expression,
@@ -238,11 +233,11 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
             z.z
         );
     }
-    println!("  {:.3} s, {:.3e} samples/s", seconds, rate);
+    let rate = est.n as f64 / run.seconds.max(1e-9);
+    println!("  {:.3} s, {:.3e} samples/s", run.seconds, rate);
     if let Some(path) = &args.convergence {
         println!("  convergence plot written to {}", path.display());
     }
-    Ok(())
 }
 
 /// The convergence study of the three samplers, plotted to `path`, as JSON.

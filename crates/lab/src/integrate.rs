@@ -10,7 +10,8 @@ use anyhow::{bail, Result};
 use glam::Vec2;
 use pathlab_mc::distribution::{PiecewiseConstant1D, PiecewiseConstant2D};
 use pathlab_mc::estimator::{
-    integrate_parallel, largest_term_share, replicate_estimate, Estimate, RunningStats,
+    integrate_parallel, largest_term_share, looks_heavy_tailed, replicate_estimate, Estimate,
+    RunningStats,
 };
 use pathlab_mc::sampler::{AnySampler, Sampler, SamplerKind};
 use rayon::prelude::*;
@@ -255,6 +256,42 @@ impl Integral {
         })
     }
 
+    /// The integral estimated from `n` samples of `kind` (stratified and Sobol with `reps`
+    /// randomisations for their error), timed, with the check that f/p is not heavy-tailed
+    /// (a warning in [`IntegralRun::warnings`], after the problem's own). An integrand that is
+    /// not finite somewhere is an error naming a point where it is not.
+    pub fn run(&self, kind: SamplerKind, n: u32, reps: u32, seed: u64) -> Result<IntegralRun> {
+        let start = std::time::Instant::now();
+        let estimate = self.estimate_with_error(kind, n, reps, seed);
+        let seconds = start.elapsed().as_secs_f64();
+        if !estimate.mean.is_finite() {
+            let at = self
+                .find_non_finite(kind, n, seed)
+                .map(|x| format!(" at {}", point_text(&x[..self.domains.len()])))
+                .unwrap_or_default();
+            bail!(
+                "the integrand \"{}\" is not finite{at}: its integral cannot be estimated",
+                self.f.text()
+            );
+        }
+        let largest_share = self.largest_share(kind, n, seed, estimate.mean);
+        let heavy_tailed = looks_heavy_tailed(largest_share, n as u64);
+        let mut warnings = self.warnings.clone();
+        if heavy_tailed {
+            warnings.push(format!(
+                "one of the {n} samples carries {:.0}% of the sample variance: f/p looks heavy-tailed (infinite variance, or a divergent integral such as 1/x at 0), so the standard error and interval are not to be trusted; sample in proportion to the integrand's peak (--importance) or change variables",
+                100.0 * largest_share
+            ));
+        }
+        Ok(IntegralRun {
+            estimate,
+            seconds,
+            largest_share,
+            heavy_tailed,
+            warnings,
+        })
+    }
+
     /// The box as `[a, b] x [c, d]`.
     pub fn domain_text(&self) -> String {
         let parts: Vec<String> = self
@@ -264,6 +301,21 @@ impl Integral {
             .collect();
         parts.join(" x ")
     }
+}
+
+/// What [`Integral::run`] found.
+#[derive(Clone, Debug)]
+pub struct IntegralRun {
+    /// The estimate, its standard error and interval.
+    pub estimate: Estimate,
+    /// Seconds the estimate took.
+    pub seconds: f64,
+    /// The share of the sample variance carried by the largest term f/p.
+    pub largest_share: f64,
+    /// Whether that share says f/p is heavy-tailed.
+    pub heavy_tailed: bool,
+    /// The problem's warnings, then the heavy-tail warning if any.
+    pub warnings: Vec<String>,
 }
 
 /// A bound rounded to 9 decimals for display.
