@@ -344,46 +344,55 @@ fn fit(dist: &Distribution, kind: SamplerKind, n: u32, seed: u64, want_plot: boo
         Distribution::Hemisphere
         | Distribution::Cosine
         | Distribution::Sphere
-        | Distribution::Cone(_) => {
-            let (z0, f): (f64, Box<dyn Fn(Vec3) -> f32>) = match dist {
-                Distribution::Hemisphere => (0.0, Box::new(|_| uniform_hemisphere_pdf())),
-                Distribution::Cosine => (0.0, Box::new(|w: Vec3| cosine_hemisphere_pdf(w.z))),
-                Distribution::Sphere => (-1.0, Box::new(|_| uniform_sphere_pdf())),
-                Distribution::Cone(c) => {
-                    let c = *c;
-                    (
-                        c as f64,
-                        Box::new(move |w: Vec3| if w.z >= c { uniform_cone_pdf(c) } else { 0.0 }),
-                    )
-                }
-                _ => unreachable!("only direction distributions reach this arm"),
-            };
-            let pdf = |z: f64, phi: f64| {
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                f(Vec3::new(
-                    (r * phi.cos()) as f32,
-                    (r * phi.sin()) as f32,
-                    z as f32,
-                )) as f64
-            };
-            let dom = [[z0, 1.0], [0.0, TAU]];
-            let test = chi2_test_2d(draw().map(cos_theta_phi), pdf, dom, RES);
-            let plot = want_plot.then(|| {
-                // Points seen from above the pole: (x, y) of each direction.
-                let xy = |p: [f64; 3]| [p[0], p[1]];
-                let square = [[-1.0, 1.0], [-1.0, 1.0]];
-                plot::SamplePlot::two_d(
-                    draw(),
-                    (xy, square),
-                    (cos_theta_phi, dom),
-                    pdf,
-                    RES,
-                    ["cos θ", "φ"],
-                )
-            });
-            Fit { test, plot }
-        }
+        | Distribution::Cone(_) => direction_fit(dist, draw, want_plot),
     }
+}
+
+/// [`fit`] of a distribution of directions, in (cos θ, φ), where the pdf per solid angle is a
+/// density per unit area.
+fn direction_fit<I: Iterator<Item = [f64; 3]>>(
+    dist: &Distribution,
+    draw: impl Fn() -> I,
+    want_plot: bool,
+) -> Fit {
+    const RES: [usize; 2] = [32, 32];
+    let (z0, f): (f64, Box<dyn Fn(Vec3) -> f32>) = match dist {
+        Distribution::Hemisphere => (0.0, Box::new(|_| uniform_hemisphere_pdf())),
+        Distribution::Cosine => (0.0, Box::new(|w: Vec3| cosine_hemisphere_pdf(w.z))),
+        Distribution::Sphere => (-1.0, Box::new(|_| uniform_sphere_pdf())),
+        Distribution::Cone(c) => {
+            let c = *c;
+            (
+                c as f64,
+                Box::new(move |w: Vec3| if w.z >= c { uniform_cone_pdf(c) } else { 0.0 }),
+            )
+        }
+        _ => unreachable!("only direction distributions reach this arm"),
+    };
+    let pdf = |z: f64, phi: f64| {
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        f(Vec3::new(
+            (r * phi.cos()) as f32,
+            (r * phi.sin()) as f32,
+            z as f32,
+        )) as f64
+    };
+    let dom = [[z0, 1.0], [0.0, TAU]];
+    let test = chi2_test_2d(draw().map(cos_theta_phi), pdf, dom, RES);
+    let plot = want_plot.then(|| {
+        // Points seen from above the pole: (x, y) of each direction.
+        let xy = |p: [f64; 3]| [p[0], p[1]];
+        let square = [[-1.0, 1.0], [-1.0, 1.0]];
+        plot::SamplePlot::two_d(
+            draw(),
+            (xy, square),
+            (cos_theta_phi, dom),
+            pdf,
+            RES,
+            ["cos θ", "φ"],
+        )
+    });
+    Fit { test, plot }
 }
 
 /// What sampling a distribution showed.

@@ -124,6 +124,18 @@ fn draw_convergence<DB: DrawingBackend>(
     }
     legend(&mut chart, SeriesLabelPosition::UpperRight)?;
 
+    draw_rmse_panel(&panels[1], series, (nmin, nmax), vs_exact)
+}
+
+/// The right panel of [`convergence`]: each series' RMSE against N on log-log axes,
+/// with its fitted slope and a reference line of slope -1/2 (N from `nmin` to `nmax`).
+fn draw_rmse_panel<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
+    series: &[ConvergenceSeries],
+    (nmin, nmax): (f64, f64),
+    vs_exact: bool,
+) -> Result<()> {
+    let all = || series.iter().flat_map(|s| s.points.iter());
     let errs = || all().map(|p| p.rmse).filter(|&e| e > 0.0 && e.is_finite());
     let emin = errs().fold(f64::INFINITY, f64::min);
     let emax = errs().fold(0.0, f64::max);
@@ -137,7 +149,7 @@ fn draw_convergence<DB: DrawingBackend>(
     } else {
         "RMSE vs the pooled largest runs"
     };
-    let mut chart = ChartBuilder::on(&panels[1])
+    let mut chart = ChartBuilder::on(panel)
         .caption(format!("{what} (log-log)"), ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(40)
