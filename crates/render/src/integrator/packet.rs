@@ -163,38 +163,14 @@ impl PathIntegrator {
         let all_triangles = scene.tests_all_triangles();
         let mut rays = RayLanes::default();
         loop {
-            // Idle lanes take the next samples.
-            for (lane, smp) in lanes.iter_mut().zip(&mut samplers) {
-                if lane.is_none() && more {
-                    match samples.next() {
-                        Some(s) => {
-                            let ray = camera_ray(scene, smp, s);
-                            *lane = Some(Lane {
-                                tag: s.tag,
-                                st: PathState::new(ray),
-                            });
-                        }
-                        None => more = false,
-                    }
-                }
+            if more {
+                more = start_paths(scene, &mut lanes, &mut samplers, samples);
             }
             if lanes.iter().all(Option::is_none) {
                 break;
             }
             // Small scenes: every lane's ray against every triangle at once.
-            let nearest = all_triangles.then(|| {
-                let mut t_max = F8::splat(f32::NEG_INFINITY);
-                for (i, lane) in lanes.iter().enumerate() {
-                    if let Some(lane) = lane {
-                        let ray = &lane.st.ray;
-                        rays.o.set(i, ray.o);
-                        rays.d.set(i, ray.d);
-                        rays.t_min.0[i] = ray.t_min;
-                        t_max.0[i] = ray.t_max;
-                    }
-                }
-                scene.nearest_of_rays(&rays, t_max)
-            });
+            let nearest = all_triangles.then(|| nearest_of_lanes(scene, &lanes, &mut rays));
             // Trace every lane; scatter the ones at other materials now, and gather the
             // Lambertian ones' inputs.
             let mut lambert_lanes = 0u32;
@@ -314,6 +290,48 @@ impl PathIntegrator {
                 && self.survive(st, si, b.wi.get(i), b.pdf.0[i], false, u_rr)
         }
     }
+}
+
+/// Idle lanes take the next samples' camera rays; returns whether samples remain.
+fn start_paths(
+    scene: &Scene,
+    lanes: &mut [Option<Lane>; W],
+    samplers: &mut [AnySampler; W],
+    samples: &mut dyn Iterator<Item = SampleRef>,
+) -> bool {
+    for (lane, smp) in lanes.iter_mut().zip(samplers.iter_mut()) {
+        if lane.is_none() {
+            let Some(s) = samples.next() else {
+                return false;
+            };
+            let ray = camera_ray(scene, smp, s);
+            *lane = Some(Lane {
+                tag: s.tag,
+                st: PathState::new(ray),
+            });
+        }
+    }
+    true
+}
+
+/// Every busy lane's ray against every triangle at once (the small scenes' trace); idle lanes
+/// get an empty interval.
+fn nearest_of_lanes(
+    scene: &Scene,
+    lanes: &[Option<Lane>; W],
+    rays: &mut RayLanes,
+) -> crate::accel::Nearest {
+    let mut t_max = F8::splat(f32::NEG_INFINITY);
+    for (i, lane) in lanes.iter().enumerate() {
+        if let Some(lane) = lane {
+            let ray = &lane.st.ray;
+            rays.o.set(i, ray.o);
+            rays.d.set(i, ray.d);
+            rays.t_min.0[i] = ray.t_min;
+            t_max.0[i] = ray.t_max;
+        }
+    }
+    scene.nearest_of_rays(rays, t_max)
 }
 
 /// Lane `i`'s light choice from `u_select`: an emitting triangle's data go to the lane of `a`
