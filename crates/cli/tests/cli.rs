@@ -1381,7 +1381,7 @@ fn interrupt(args: &[&str], signal: &str, after: std::time::Duration) -> std::pr
 
 #[test]
 #[cfg(unix)]
-fn a_stopped_render_writes_whole_passes_and_a_checkpoint_resumes_to_the_same_image() {
+fn a_stopped_render_writes_whole_passes_and_exits_with_the_signals_status() {
     // Stopped at a moment the test does not choose precisely: every pixel holds whole passes
     // (or one pass more), the image is an unbiased estimate, the exit status 130.
     let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -1451,6 +1451,11 @@ fn a_stopped_render_writes_whole_passes_and_a_checkpoint_resumes_to_the_same_ima
         std::time::Duration::from_millis(800),
     );
     assert_eq!(o.status.code(), Some(143));
+}
+
+#[test]
+#[cfg(unix)]
+fn a_checkpoint_resumes_to_the_same_image_and_another_renders_is_refused() {
     // A checkpoint resumes to the image an uninterrupted render gives, bit for bit.
     let ck2 = scratch("resume.plf");
     let whole = scratch("whole.plf");
