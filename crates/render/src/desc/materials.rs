@@ -1,0 +1,305 @@
+//! Materials and textures as scene descriptions give them.
+
+use super::*;
+
+/// How an image texture is read between texel centres.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TextureFilter {
+    /// The nearest texel.
+    Nearest,
+    /// Bilinear interpolation of the four nearest texels.
+    #[default]
+    Bilinear,
+}
+
+/// What an image texture shows outside [0, 1]².
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WrapMode {
+    /// The image repeats.
+    #[default]
+    Repeat,
+    /// The image repeats, every other copy mirrored.
+    Mirror,
+    /// The border texels extend.
+    Clamp,
+}
+
+/// A quantity that varies over a surface: a colour, or a number (read as the luminance of the
+/// colour, which for grey values is the value itself).
+///
+/// Surface coordinates are pathlab's (u, v), v growing upwards (OBJ, OpenGL); `to_uv` maps
+/// them to the texture's own coordinates: an image's are the same convention (its bottom-left
+/// corner at (0, 0)), a checkerboard's are Mitsuba's (v growing downwards).
+#[derive(Clone, Debug, PartialEq)]
+pub enum TextureDesc {
+    /// The same value everywhere.
+    Constant(Rgb),
+    /// An image.
+    Image {
+        /// The texels.
+        image: Arc<Texture>,
+        /// Interpolation.
+        filter: TextureFilter,
+        /// Outside [0, 1]².
+        wrap: WrapMode,
+        /// Surface (u, v) to image coordinates.
+        to_uv: Affine2,
+    },
+    /// Mitsuba's checkerboard: `color0` where the fractional parts of u and v are both below
+    /// or both above ½, `color1` elsewhere.
+    Checkerboard {
+        /// The first colour.
+        color0: Rgb,
+        /// The second colour.
+        color1: Rgb,
+        /// Surface (u, v) to checkerboard coordinates.
+        to_uv: Affine2,
+    },
+    /// A per-vertex (interpolated) or per-face attribute of the mesh, by name.
+    MeshAttribute {
+        /// The attribute's name (e.g. `vertex_color`, `face_weight`).
+        name: String,
+    },
+}
+
+impl TextureDesc {
+    /// The same number everywhere.
+    pub fn value(v: f32) -> Self {
+        TextureDesc::Constant(Rgb::splat(v))
+    }
+
+    /// An image, read bilinearly and repeating, in surface coordinates.
+    pub fn image(image: Arc<Texture>) -> Self {
+        TextureDesc::Image {
+            image,
+            filter: TextureFilter::Bilinear,
+            wrap: WrapMode::Repeat,
+            to_uv: Affine2::IDENTITY,
+        }
+    }
+
+    /// The constant value, if the texture is one.
+    pub fn as_constant(&self) -> Option<Rgb> {
+        match self {
+            TextureDesc::Constant(c) => Some(*c),
+            _ => None,
+        }
+    }
+
+    /// A summary value: the constant, the image's mean, the checkerboard's average colour.
+    pub fn mean(&self) -> Rgb {
+        match self {
+            TextureDesc::Constant(c) => *c,
+            TextureDesc::Image { image, .. } => image.mean(),
+            TextureDesc::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
+            TextureDesc::MeshAttribute { .. } => Rgb::splat(0.5),
+        }
+    }
+}
+
+/// A material.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialDesc {
+    /// Lambertian reflection: f = reflectance / π.
+    Diffuse {
+        /// Albedo per channel, in [0, 1].
+        reflectance: Rgb,
+        /// Whether the back side reflects too (otherwise it is black, as Mitsuba's `diffuse`).
+        two_sided: bool,
+    },
+    /// Lambertian reflection whose albedo comes from a texture (times `scale`).
+    TexturedDiffuse {
+        /// The albedo texture (linear RGB).
+        texture: TextureDesc,
+        /// Factor applied to the texture.
+        scale: Rgb,
+        /// Whether the back side reflects too.
+        two_sided: bool,
+    },
+    /// Perfect specular reflection.
+    Mirror {
+        /// Reflectance per channel.
+        reflectance: Rgb,
+    },
+    /// A smooth or rough dielectric.
+    Glass {
+        /// Reflectance scale.
+        reflectance: Rgb,
+        /// Transmittance scale.
+        transmittance: Rgb,
+        /// Roughness α of the microfacet distribution (0: smooth).
+        roughness: f32,
+        /// Index of refraction inside relative to outside.
+        ior: f32,
+        /// Microfacet distribution when rough.
+        distribution: NormalDistribution,
+        /// Fresnel reflectance of the smooth interface.
+        fresnel: FresnelModel,
+    },
+    /// A thin sheet of glass: reflection and straight-through transmission (Mitsuba's
+    /// `thindielectric`).
+    ThinGlass {
+        /// Reflectance scale.
+        reflectance: Rgb,
+        /// Transmittance scale.
+        transmittance: Rgb,
+        /// Index of refraction of the sheet relative to its surroundings.
+        ior: f32,
+    },
+    /// A conductor: smooth (α = 0) or rough (microfacet model).
+    Conductor {
+        /// Roughness α of the normal distribution.
+        alpha: f32,
+        /// Real part of the complex index of refraction, per channel.
+        eta: Rgb,
+        /// Imaginary part (absorption), per channel.
+        k: Rgb,
+        /// Microfacet distribution.
+        distribution: NormalDistribution,
+    },
+    /// A diffuse base under a smooth dielectric coat.
+    Plastic {
+        /// Diffuse reflectance of the base.
+        diffuse: Rgb,
+        /// Scale of the coat's reflection (1 is physical).
+        specular: Rgb,
+        /// Index of refraction of the coat relative to outside.
+        ior: f32,
+        /// Whether internal reflections are tinted by the base.
+        nonlinear: bool,
+    },
+    /// A conductor with textured, possibly anisotropic roughness (α along the surface's
+    /// u tangent and along v) and a reflectance scale (Mitsuba's `roughconductor`).
+    RoughConductor {
+        /// Roughness along the u tangent.
+        alpha_u: TextureDesc,
+        /// Roughness along the v tangent.
+        alpha_v: TextureDesc,
+        /// Real part of the complex index of refraction, per channel.
+        eta: Rgb,
+        /// Imaginary part, per channel.
+        k: Rgb,
+        /// Scale of the reflection.
+        specular: TextureDesc,
+        /// Microfacet distribution.
+        distribution: NormalDistribution,
+    },
+    /// A diffuse base under a rough dielectric coat (Mitsuba's `roughplastic`).
+    RoughPlastic {
+        /// Diffuse reflectance of the base.
+        diffuse: TextureDesc,
+        /// Scale of the coat's reflection.
+        specular: Rgb,
+        /// Roughness α of the coat.
+        alpha: f32,
+        /// Index of refraction of the coat relative to outside.
+        ior: f32,
+        /// Whether internal reflections are tinted by the base.
+        nonlinear: bool,
+        /// Microfacet distribution.
+        distribution: NormalDistribution,
+    },
+    /// A material seen through where `opacity` < 1: it counts `opacity` of the inner
+    /// material, the rest of the light passes straight through (Mitsuba's `mask`).
+    Mask {
+        /// Opacity in [0, 1].
+        opacity: TextureDesc,
+        /// The material where opaque.
+        inner: Box<MaterialDesc>,
+    },
+    /// `(1 - weight) first + weight second` (Mitsuba's `blendbsdf`).
+    Blend {
+        /// Weight of the second material, in [0, 1].
+        weight: TextureDesc,
+        /// The first material.
+        first: Box<MaterialDesc>,
+        /// The second material.
+        second: Box<MaterialDesc>,
+    },
+    /// Disney's principled BSDF (Mitsuba's `principled`, or `principledthin` for a thin
+    /// sheet).
+    Principled(Box<PrincipledDesc>),
+    /// One material on the front side (the shading normal's), another on the back.
+    TwoSided {
+        /// Front side.
+        front: Box<MaterialDesc>,
+        /// Back side (seen as its front).
+        back: Box<MaterialDesc>,
+    },
+    /// The inner material with its shading normal from a tangent-space normal map
+    /// (n = 2 × texture - 1 in the frame of the u tangent, the v bitangent and the normal).
+    NormalMap {
+        /// The normal map (read raw).
+        normals: TextureDesc,
+        /// The material.
+        inner: Box<MaterialDesc>,
+    },
+    /// The inner material with its shading normal from a height field's gradient (Mitsuba's
+    /// `bumpmap`: the surface displaced by `scale` × height along its normal).
+    BumpMap {
+        /// Heights (read raw).
+        height: TextureDesc,
+        /// Scale of the displacement.
+        scale: f32,
+        /// The material.
+        inner: Box<MaterialDesc>,
+    },
+}
+
+impl MaterialDesc {
+    /// The kind of material, for summaries.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            MaterialDesc::Diffuse { .. } => "diffuse",
+            MaterialDesc::TexturedDiffuse { .. } => "textured diffuse",
+            MaterialDesc::Mirror { .. } => "mirror",
+            MaterialDesc::Glass { .. } => "glass",
+            MaterialDesc::ThinGlass { .. } => "thin glass",
+            MaterialDesc::Conductor { .. } => "conductor",
+            MaterialDesc::Plastic { .. } => "plastic",
+            MaterialDesc::RoughConductor { .. } => "rough conductor",
+            MaterialDesc::RoughPlastic { .. } => "rough plastic",
+            MaterialDesc::Principled(p) if p.thin => "principled thin",
+            MaterialDesc::Principled(_) => "principled",
+            MaterialDesc::Mask { .. } => "mask",
+            MaterialDesc::Blend { .. } => "blend",
+            MaterialDesc::TwoSided { .. } => "two-sided",
+            MaterialDesc::NormalMap { .. } => "normal map",
+            MaterialDesc::BumpMap { .. } => "bump map",
+        }
+    }
+}
+
+/// The parameters of a principled material, each a texture (numbers read as luminance), with
+/// `Some` for the optional ones the scene gives (Mitsuba switches lobes on that way).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrincipledDesc {
+    /// Base colour.
+    pub base_color: TextureDesc,
+    /// Roughness.
+    pub roughness: TextureDesc,
+    /// Anisotropy.
+    pub anisotropic: Option<TextureDesc>,
+    /// Specular transmission.
+    pub spec_trans: Option<TextureDesc>,
+    /// Metalness (solid only).
+    pub metallic: Option<TextureDesc>,
+    /// Clear coat (solid only).
+    pub clearcoat: Option<TextureDesc>,
+    /// Clear coat glossiness (solid only).
+    pub clearcoat_gloss: TextureDesc,
+    /// Sheen.
+    pub sheen: Option<TextureDesc>,
+    /// Sheen tint.
+    pub sheen_tint: Option<TextureDesc>,
+    /// Specular tint.
+    pub spec_tint: Option<TextureDesc>,
+    /// Flatness.
+    pub flatness: Option<TextureDesc>,
+    /// Diffuse transmission, 0 to 2 (thin only).
+    pub diff_trans: Option<TextureDesc>,
+    /// Relative index of refraction (a texture for the thin sheet, a number for a solid).
+    pub eta: TextureDesc,
+    /// A thin sheet.
+    pub thin: bool,
+}
