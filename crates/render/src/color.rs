@@ -1,4 +1,5 @@
-//! Colour: linear sRGB / Rec. 709 radiance and reflectance, and its luminance.
+//! Colour: linear sRGB / Rec. 709 radiance and reflectance, and the two luminances the
+//! renderer uses (its own, and Mitsuba's where its definitions are followed).
 
 use glam::Vec3;
 
@@ -20,4 +21,14 @@ pub fn luminance(c: Rgb) -> f32 {
 pub fn luminance_f64(c: glam::DVec3) -> f64 {
     let [r, g, b] = LUMINANCE_WEIGHTS;
     r * c.x + g * c.y + b * c.z
+}
+
+/// Mitsuba 3's luminance: the Y row of its linear sRGB to XYZ matrix, at full precision. What
+/// follows Mitsuba's definitions uses it (the principled BSDF's tints, a colour texture read
+/// as a number: roughness, opacity, a bump map's height), so that it matches Mitsuba's
+/// references; what needs only *a* luminance (choosing lights, adaptive sampling, image
+/// statistics) uses [`luminance`].
+#[inline]
+pub fn mitsuba_luminance(c: Rgb) -> f32 {
+    0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
 }

@@ -250,7 +250,7 @@ impl Tex {
         };
         let q = to_uv.transform_point2(p.uv);
         let (w, h) = (image.width as f32, image.height as f32);
-        let lum = |c: Rgb| 0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z;
+        let lum = crate::color::mitsuba_luminance;
         let x = q.x * w - 0.5;
         let y = (1.0 - q.y) * h - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
@@ -289,7 +289,7 @@ impl Tex {
             .eval(p),
             other => other.eval(p),
         };
-        0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
+        crate::color::mitsuba_luminance(c)
     }
 }
 

@@ -9,6 +9,7 @@ use super::fresnel::fresnel_dielectric;
 use super::microfacet::{Microfacet, NormalDistribution};
 use super::scattering::{reflect, refract_about};
 use super::LocalSample;
+use crate::color::mitsuba_luminance as luminance;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
 use pathlab_mc::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
@@ -101,11 +102,6 @@ fn calc_schlick(r0: Rgb, cos_i: f32, eta: f32) -> Rgb {
         schlick_weight(cos_t)
     };
     r0 + (Rgb::ONE - r0) * w
-}
-
-#[inline]
-fn luminance(c: Rgb) -> f32 {
-    0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
 }
 
 /// The base colour normalised by its luminance (white for black).
