@@ -27,45 +27,44 @@ pub struct CoatTable {
 
 /// The directional albedo of microfacet reflection off a dielectric of relative index `eta`
 /// for light arriving at cos θ = `mu`: ∫ D_wi(m) F(wi·m) G1(wo, m) dm over the visible
-/// normals, by Gauss–Legendre quadrature through the distribution's own sampling of normals.
+/// normals ([`visible_normal_integral`]).
 pub fn rough_reflectance(
     distribution: &Microfacet,
     mu: f32,
     eta: f32,
     rule: &(Vec<f64>, Vec<f64>),
 ) -> f64 {
-    let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-    let (nodes, weights) = rule;
-    let mut sum = 0.0f64;
-    for (i, &xi) in nodes.iter().enumerate() {
-        for (j, &xj) in nodes.iter().enumerate() {
-            let u = Vec2::new((0.5 * xi + 0.5) as f32, (0.5 * xj + 0.5) as f32);
-            let m = distribution.sample_wm(wi, u);
-            let wo = reflect(wi, m);
-            let cos_im = wi.dot(m);
-            if wo.z <= 0.0 || cos_im <= 0.0 {
-                continue;
-            }
-            // The sampled normals' density against the visible normals' D_wi.
-            let correction = match distribution.kind {
-                NormalDistribution::Ggx => 1.0,
-                NormalDistribution::Beckmann => distribution.g1(wi, m) * cos_im / (mu * m.z),
-            };
-            let value = fresnel_dielectric(cos_im, eta) * distribution.g1(wo, m) * correction;
-            sum += weights[i] * weights[j] * value as f64;
-        }
-    }
-    0.25 * sum
+    visible_normal_integral(distribution, mu, rule, |wi, m, cos_im| {
+        let wo = reflect(wi, m);
+        (wo.z > 0.0).then(|| fresnel_dielectric(cos_im, eta) * distribution.g1(wo, m))
+    })
 }
 
 /// The directional transmittance of a rough dielectric interface of relative index `eta` for
 /// light arriving at cos θ = `mu`: ∫ D_wi(m) (1 - F(wi·m)) G1(wt, m) dm, wt the refraction of
-/// wi through the facet m, by the same quadrature as [`rough_reflectance`].
+/// wi through the facet m ([`visible_normal_integral`]).
 pub fn rough_transmittance(
     distribution: &Microfacet,
     mu: f32,
     eta: f32,
     rule: &(Vec<f64>, Vec<f64>),
+) -> f64 {
+    visible_normal_integral(distribution, mu, rule, |wi, m, cos_im| {
+        let (wt, _) = refract_about(wi, m, eta)?;
+        (wt.z * wi.z < 0.0)
+            .then(|| (1.0 - fresnel_dielectric(cos_im, eta)) * distribution.g1(wt, m))
+    })
+}
+
+/// ∫ D_wi(m) g(m) dm over the normals visible from the direction at cos θ = `mu`, by the
+/// Gauss–Legendre `rule` (nodes, weights on [-1, 1]) in both dimensions of the distribution's
+/// own sampling of normals. `g(wi, m, wi·m)` is the rest of the integrand, `None` where it
+/// vanishes; it is asked only where wi·m > 0.
+fn visible_normal_integral(
+    distribution: &Microfacet,
+    mu: f32,
+    rule: &(Vec<f64>, Vec<f64>),
+    g: impl Fn(Vec3, Vec3, f32) -> Option<f32>,
 ) -> f64 {
     let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let (nodes, weights) = rule;
@@ -78,19 +77,15 @@ pub fn rough_transmittance(
             if cos_im <= 0.0 {
                 continue;
             }
-            let Some((wt, _)) = refract_about(wi, m, eta) else {
+            let Some(rest) = g(wi, m, cos_im) else {
                 continue;
             };
-            if wt.z * wi.z >= 0.0 {
-                continue;
-            }
+            // The sampled normals' density against the visible normals' D_wi.
             let correction = match distribution.kind {
                 NormalDistribution::Ggx => 1.0,
                 NormalDistribution::Beckmann => distribution.g1(wi, m) * cos_im / (mu * m.z),
             };
-            let value =
-                (1.0 - fresnel_dielectric(cos_im, eta)) * distribution.g1(wt, m) * correction;
-            sum += weights[i] * weights[j] * value as f64;
+            sum += weights[i] * weights[j] * (rest * correction) as f64;
         }
     }
     0.25 * sum
