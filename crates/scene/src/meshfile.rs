@@ -13,9 +13,12 @@ use std::path::Path;
 /// Default image size of standalone meshes.
 pub const DEFAULT_RESOLUTION: [u32; 2] = [640, 480];
 
-/// Loads a Wavefront OBJ file and the MTL files it names.
-pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
-    let (models, materials) = tobj::load_obj(
+/// The materials of an OBJ file's MTL files, or why they could not be read.
+type MtlResult = Result<Vec<tobj::Material>, tobj::LoadError>;
+
+/// An OBJ file's models, triangulated with one index per vertex, and its materials.
+fn read_obj(path: &Path) -> Result<(Vec<tobj::Model>, MtlResult), Error> {
+    tobj::load_obj(
         path,
         &tobj::LoadOptions {
             triangulate: true,
@@ -23,7 +26,12 @@ pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
             ..Default::default()
         },
     )
-    .map_err(|e| obj_error(path, e))?;
+    .map_err(|e| obj_error(path, e))
+}
+
+/// Loads a Wavefront OBJ file and the MTL files it names.
+pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
+    let (models, materials) = read_obj(path)?;
     let mut desc = SceneDesc::default();
     let mtl = match materials {
         Ok(m) => m,
@@ -128,15 +136,7 @@ fn model_mesh(path: &Path, model: tobj::Model) -> Result<MeshDesc, Error> {
 
 /// The meshes of an OBJ file, without its materials (for scene formats that bring their own).
 pub fn obj_meshes(path: &Path) -> Result<Vec<MeshDesc>, Error> {
-    let (models, _) = tobj::load_obj(
-        path,
-        &tobj::LoadOptions {
-            triangulate: true,
-            single_index: true,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| obj_error(path, e))?;
+    let (models, _) = read_obj(path)?;
     models.into_iter().map(|m| model_mesh(path, m)).collect()
 }
 
