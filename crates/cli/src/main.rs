@@ -8,6 +8,7 @@ mod info_cmd;
 mod integrate;
 mod render_cmd;
 mod sample;
+mod view_cmd;
 
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
@@ -41,6 +42,8 @@ enum Command {
     Diff(image_cmd::DiffArgs),
     /// Add the films of a render's shards (`render --shard I/N -o PART.plf`) into its image.
     Merge(farm::MergeArgs),
+    /// Watch a scene render in the browser, switching estimators live (a local web server).
+    View(view_cmd::ViewArgs),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
             Err(e) => Err(e),
         },
         Command::Merge(args) => farm::run_merge(args),
+        Command::View(args) => view_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
         Command::Converge(args) => converge_cmd::run(args),

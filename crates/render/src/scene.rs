@@ -156,6 +156,11 @@ impl Scene {
         &self.camera
     }
 
+    /// Replaces the camera (a viewer that moves it keeps the rest of the scene).
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera = camera;
+    }
+
     /// Build statistics.
     pub fn stats(&self) -> BuildStats {
         self.stats

@@ -358,14 +358,7 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
             args.checkpoint_every
         );
     }
-    let params = args
-        .define
-        .iter()
-        .map(|d| match d.split_once('=') {
-            Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.to_string())),
-            _ => bail!("-D {d}: expected NAME=VALUE"),
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let params = parse_defines(&args.define)?;
     if let Some(e) = args.target_error {
         if !(e.is_finite() && e > 0.0) {
             bail!("--target-error {e}: must be a positive number such as 0.02");
@@ -405,4 +398,15 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
         progressive,
         adaptive,
     })
+}
+
+/// `-D NAME=VALUE` scene parameters.
+pub fn parse_defines(define: &[String]) -> Result<Vec<(String, String)>> {
+    define
+        .iter()
+        .map(|d| match d.split_once('=') {
+            Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.to_string())),
+            _ => bail!("-D {d}: expected NAME=VALUE"),
+        })
+        .collect()
 }

@@ -11,7 +11,7 @@ mod outputs;
 mod report;
 mod setup;
 
-pub use args::{parse_depth_arg, RenderArgs, ToneMapName};
+pub use args::{parse_defines, parse_depth_arg, RenderArgs, ToneMapName};
 pub use setup::apply_resolution;
 
 use anyhow::{Context, Result};

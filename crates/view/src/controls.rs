@@ -1,0 +1,211 @@
+//! What the page can change while the render runs: the integrator and its strategy, the
+//! depth, the sampler, the exposure and the camera's orbit, and the messages that change them.
+
+use glam::{Mat3, Vec3};
+use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::desc::CameraDesc;
+use pathlab_render::integrator::{
+    DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
+};
+use serde_json::{json, Value};
+
+/// The settings the page controls.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Controls {
+    /// "path" or "direct".
+    pub integrator: String,
+    /// The direct integrator's strategy.
+    pub direct: DirectStrategy,
+    /// The path tracer's largest bounce.
+    pub max_depth: u32,
+    /// Where the random numbers come from.
+    pub sampler: SamplerKind,
+    /// Stops of exposure before the sRGB encoding of the frames sent.
+    pub exposure: f32,
+    /// Degrees of the camera's orbit about its target: around the up axis, and up or down.
+    pub orbit: [f32; 2],
+    /// The camera's distance to its target relative to the scene's.
+    pub zoom: f32,
+}
+
+impl Default for Controls {
+    fn default() -> Self {
+        Controls {
+            integrator: "path".into(),
+            direct: DirectStrategy::Mis,
+            max_depth: 5,
+            sampler: SamplerKind::Independent,
+            exposure: 0.0,
+            orbit: [0.0, 0.0],
+            zoom: 1.0,
+        }
+    }
+}
+
+impl Controls {
+    /// Applies a message of the page: a JSON object of settings (`integrator`, `direct`,
+    /// `max_depth`, `sampler`, `exposure`), an `orbit` step `[yaw, pitch]` in degrees or a
+    /// `zoom` factor. Returns whether the image must restart (the exposure alone does not
+    /// change the samples); an unknown setting or a bad value is an error, and nothing changes.
+    pub fn apply(&mut self, message: &str) -> Result<bool, String> {
+        let v: Value =
+            serde_json::from_str(message).map_err(|e| format!("not a JSON message: {e}"))?;
+        let Some(fields) = v.as_object() else {
+            return Err("expected a JSON object of settings".into());
+        };
+        let mut next = self.clone();
+        for (key, value) in fields {
+            let bad = || format!("{key}: {value} is not a valid value");
+            match key.as_str() {
+                "integrator" => match value.as_str() {
+                    Some(s @ ("path" | "direct")) => next.integrator = s.to_string(),
+                    _ => {
+                        return Err(format!(
+                            "integrator: expected \"path\" or \"direct\", got {value}"
+                        ))
+                    }
+                },
+                "direct" => {
+                    next.direct = value
+                        .as_str()
+                        .ok_or_else(bad)?
+                        .parse()
+                        .map_err(|e: String| format!("direct: {e}"))?
+                }
+                "max_depth" => {
+                    next.max_depth = value
+                        .as_u64()
+                        .filter(|&d| (1..=1000).contains(&d))
+                        .ok_or_else(|| format!("max_depth: expected 1 to 1000, got {value}"))?
+                        as u32
+                }
+                "sampler" => {
+                    next.sampler = value
+                        .as_str()
+                        .ok_or_else(bad)?
+                        .parse()
+                        .map_err(|e: String| format!("sampler: {e}"))?
+                }
+                "exposure" => {
+                    next.exposure = value
+                        .as_f64()
+                        .filter(|e| e.is_finite() && e.abs() <= 20.0)
+                        .ok_or_else(|| format!("exposure: expected -20 to 20 stops, got {value}"))?
+                        as f32
+                }
+                "orbit" => {
+                    let step = value
+                        .as_array()
+                        .filter(|a| a.len() == 2)
+                        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
+                        .filter(|s| s.iter().all(|x| x.is_finite()))
+                        .ok_or_else(|| {
+                            format!("orbit: expected [yaw, pitch] in degrees, got {value}")
+                        })?;
+                    next.orbit[0] = (next.orbit[0] + step[0] as f32).rem_euclid(360.0);
+                    next.orbit[1] = (next.orbit[1] + step[1] as f32).clamp(-85.0, 85.0);
+                }
+                "zoom" => {
+                    let f = value
+                        .as_f64()
+                        .filter(|f| f.is_finite() && *f > 0.0)
+                        .ok_or_else(|| format!("zoom: expected a positive factor, got {value}"))?;
+                    next.zoom = (next.zoom * f as f32).clamp(0.05, 20.0);
+                }
+                other => return Err(format!("unknown setting '{other}'")),
+            }
+        }
+        let restart = Controls {
+            exposure: self.exposure,
+            ..next.clone()
+        } != *self;
+        *self = next;
+        Ok(restart)
+    }
+
+    /// The integrator these settings choose.
+    pub fn integrator(&self) -> IntegratorKind {
+        if self.integrator == "direct" {
+            IntegratorKind::Direct(DirectIntegrator {
+                strategy: self.direct,
+                ..Default::default()
+            })
+        } else {
+            IntegratorKind::Path(PathIntegrator {
+                max_depth: self.max_depth,
+                ..Default::default()
+            })
+        }
+    }
+
+    /// `camera` orbited about its target by [`Controls::orbit`] and moved by the zoom.
+    pub fn camera(&self, camera: &CameraDesc) -> CameraDesc {
+        let up = camera.up.normalize_or(Vec3::Y);
+        let offset = camera.origin - camera.target;
+        let right = offset.cross(up).normalize_or(Vec3::X);
+        let [yaw, pitch] = self.orbit.map(f32::to_radians);
+        let turn = Mat3::from_axis_angle(up, yaw) * Mat3::from_axis_angle(right, pitch);
+        CameraDesc {
+            origin: camera.target + turn * offset * self.zoom,
+            up: turn * up,
+            ..*camera
+        }
+    }
+
+    /// The settings as the page shows them.
+    pub fn to_json(&self) -> Value {
+        json!({
+            "integrator": self.integrator,
+            "direct": self.direct.name(),
+            "max_depth": self.max_depth,
+            "sampler": self.sampler.name(),
+            "exposure": self.exposure,
+            "orbit": self.orbit,
+            "zoom": self.zoom,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_change_atomically_and_only_samples_restart_the_image() {
+        let mut c = Controls::default();
+        assert_eq!(c.apply(r#"{"exposure": 1.5}"#), Ok(false));
+        assert_eq!(c.exposure, 1.5);
+        assert_eq!(
+            c.apply(r#"{"integrator": "direct", "direct": "cosine"}"#),
+            Ok(true)
+        );
+        assert_eq!(c.direct, DirectStrategy::Cosine);
+        // One bad field and nothing changes.
+        let before = c.clone();
+        assert!(c.apply(r#"{"max_depth": 3, "sampler": "magic"}"#).is_err());
+        assert_eq!(c, before);
+        assert!(c.apply("[1, 2]").unwrap_err().contains("JSON object"));
+        // The orbit accumulates, its pitch stays short of the poles.
+        c.apply(r#"{"orbit": [350, 80]}"#).unwrap();
+        c.apply(r#"{"orbit": [20, 20]}"#).unwrap();
+        assert_eq!(c.orbit, [10.0, 85.0]);
+        assert!(c.apply(r#"{"zoom": -1}"#).is_err());
+    }
+
+    #[test]
+    fn the_orbit_keeps_the_target_and_the_distance() {
+        let camera = CameraDesc {
+            origin: Vec3::new(0.0, 1.0, 5.0),
+            target: Vec3::new(0.0, 1.0, 0.0),
+            ..Default::default()
+        };
+        let mut c = Controls::default();
+        c.apply(r#"{"orbit": [90, 30]}"#).unwrap();
+        let moved = c.camera(&camera);
+        assert_eq!(moved.target, camera.target);
+        assert!(((moved.origin - moved.target).length() - 5.0).abs() < 1e-4);
+        assert!(moved.origin.y > 1.0 + 1.0, "pitched up: {}", moved.origin);
+        c.apply(r#"{"zoom": 0.5}"#).unwrap();
+        assert!(((c.camera(&camera).origin - camera.target).length() - 2.5).abs() < 1e-4);
+    }
+}

@@ -1,0 +1,177 @@
+//! # pathlab-view: watch a render converge in the browser
+//!
+//! [`serve`] starts a local web server (axum on tokio) for one scene: `GET /` is the viewer
+//! page (one static HTML file compiled in, no build step, nothing fetched from elsewhere),
+//! `GET /ws` a WebSocket. The scene renders in its own threads ([`renderer`]), pass by pass;
+//! after each pass every connected page gets a text message with the frame's statistics (JSON:
+//! `generation`, `width`, `height`, `spp`, `samples_per_second`, `relative_error`, `mean`,
+//! `controls`) and a binary message of its sRGB pixels (RGBA, rows from the top). The page
+//! sends JSON objects of [`controls::Controls`] settings; a change restarts the image, a bad
+//! message gets `{"error": "..."}` back and changes nothing. A slow page skips frames; it never
+//! holds up the render.
+
+pub mod controls;
+pub mod renderer;
+
+use anyhow::{Context, Result};
+use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::State;
+use axum::response::{Html, IntoResponse};
+use axum::routing::get;
+use axum::Router;
+use pathlab_render::desc::SceneDesc;
+use pathlab_render::scene::Scene;
+use renderer::{Frame, Shared};
+use serde_json::json;
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+use tokio::sync::watch;
+
+/// The viewer page.
+const PAGE: &str = include_str!("page.html");
+
+/// Where to listen.
+#[derive(Clone, Debug)]
+pub struct ViewOptions {
+    /// The address to bind: 127.0.0.1 keeps the viewer to this machine.
+    pub host: String,
+    /// The port (0: any free one).
+    pub port: u16,
+    /// The scene's name, shown on the page.
+    pub title: String,
+}
+
+/// Serves the viewer for `desc` until `stop` is set; `ready` gets the address bound (before
+/// the first request is answered).
+pub fn serve(
+    desc: SceneDesc,
+    options: &ViewOptions,
+    stop: Arc<AtomicBool>,
+    ready: impl FnOnce(SocketAddr),
+) -> Result<()> {
+    let scene = Scene::build(&desc).context("cannot build the scene")?;
+    let (frames, _) = watch::channel(Arc::new(Frame::default()));
+    let shared = Arc::new(Shared {
+        controls: Mutex::new(controls::Controls::default()),
+        generation: AtomicU64::new(0),
+        restart: AtomicBool::new(false),
+        stop: AtomicBool::new(false),
+        frames,
+    });
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .context("cannot start the web server's runtime")?;
+    let listener = runtime
+        .block_on(tokio::net::TcpListener::bind((
+            options.host.as_str(),
+            options.port,
+        )))
+        .with_context(|| format!("cannot listen on {}:{}", options.host, options.port))?;
+    let addr = listener.local_addr()?;
+    let render = {
+        let shared = Arc::clone(&shared);
+        std::thread::spawn(move || renderer::run(&desc, scene, &shared))
+    };
+    ready(addr);
+    let state = AppState {
+        shared: Arc::clone(&shared),
+        title: options.title.clone(),
+    };
+    let app = Router::new()
+        .route("/", get(page))
+        .route("/ws", get(socket))
+        .with_state(state);
+    let served = runtime.block_on(async {
+        axum::serve(listener, app)
+            .with_graceful_shutdown(async move {
+                while !stop.load(Ordering::Relaxed) {
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                }
+            })
+            .await
+    });
+    shared.stop.store(true, Ordering::SeqCst);
+    shared.restart.store(true, Ordering::SeqCst);
+    let _ = render.join();
+    runtime.shutdown_timeout(Duration::from_millis(200));
+    served.context("the web server failed")
+}
+
+#[derive(Clone)]
+struct AppState {
+    shared: Arc<Shared>,
+    title: String,
+}
+
+async fn page(State(state): State<AppState>) -> Html<String> {
+    let title = state
+        .title
+        .replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;");
+    Html(PAGE.replace("{{TITLE}}", &title))
+}
+
+async fn socket(ws: WebSocketUpgrade, State(state): State<AppState>) -> impl IntoResponse {
+    ws.on_upgrade(move |socket| client(socket, state.shared))
+}
+
+/// One page: frames out as they come (the latest only, when the page is slower than the
+/// render), settings in.
+async fn client(mut socket: WebSocket, shared: Arc<Shared>) {
+    let mut frames = shared.frames.subscribe();
+    frames.mark_changed();
+    loop {
+        tokio::select! {
+            message = socket.recv() => match message {
+                Some(Ok(Message::Text(text))) => {
+                    if let Err(e) = shared.apply(text.as_str()) {
+                        let reply = json!({ "error": e }).to_string();
+                        if socket.send(Message::Text(reply.into())).await.is_err() {
+                            return;
+                        }
+                    }
+                }
+                Some(Ok(Message::Binary(_))) => {
+                    let reply = json!({ "error": "expected a JSON text message" }).to_string();
+                    if socket.send(Message::Text(reply.into())).await.is_err() {
+                        return;
+                    }
+                }
+                Some(Ok(_)) => {}
+                Some(Err(_)) | None => return,
+            },
+            changed = frames.changed() => {
+                if changed.is_err() {
+                    return;
+                }
+                let frame = Arc::clone(&frames.borrow_and_update());
+                if frame.rgba.is_empty() {
+                    continue;
+                }
+                let stats = json!({
+                    "generation": frame.generation,
+                    "width": frame.size[0],
+                    "height": frame.size[1],
+                    "spp": frame.spp,
+                    "samples_per_second": frame.samples_per_second,
+                    "relative_error": frame.relative_error,
+                    "mean": frame.mean,
+                    "controls": frame.controls.as_ref().map(|c| c.to_json()),
+                });
+                if socket.send(Message::Text(stats.to_string().into())).await.is_err()
+                    || socket
+                        .send(Message::Binary(frame.rgba.as_ref().clone().into()))
+                        .await
+                        .is_err()
+                {
+                    return;
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,153 @@
+//! The render behind the page: passes of the whole frame (1, 1, 2, 4, ... samples per pixel,
+//! then steady passes) with the current controls, each finished pass published as a frame;
+//! a change of the controls stops the pass under way and starts the image again.
+
+use crate::controls::Controls;
+use pathlab_render::camera::Camera;
+use pathlab_render::desc::SceneDesc;
+use pathlab_render::film::Film;
+use pathlab_render::image_io::srgb_encode;
+use pathlab_render::progressive::estimated_relative_rmse;
+use pathlab_render::render::{render_from, RenderSettings};
+use pathlab_render::scene::Scene;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use tokio::sync::watch;
+
+/// Samples per pixel at which an image is done (it then waits for a change).
+pub const MAX_SPP: u32 = 65536;
+
+/// One finished pass, as the page gets it.
+#[derive(Clone, Debug, Default)]
+pub struct Frame {
+    /// Which image (it grows by one with each change of the controls).
+    pub generation: u64,
+    /// Width and height.
+    pub size: [u32; 2],
+    /// Samples per pixel so far.
+    pub spp: u32,
+    /// Samples per second of the image so far.
+    pub samples_per_second: f64,
+    /// The film's estimated relative RMSE.
+    pub relative_error: f64,
+    /// The mean luminance of the image (linear).
+    pub mean: [f64; 3],
+    /// The controls the image is rendered with.
+    pub controls: Option<Controls>,
+    /// sRGB pixels, four bytes each (alpha 255), rows from the top.
+    pub rgba: Arc<Vec<u8>>,
+}
+
+/// What the page and the render thread share.
+pub struct Shared {
+    /// The current controls.
+    pub controls: Mutex<Controls>,
+    /// Bumped by every change that restarts the image.
+    pub generation: AtomicU64,
+    /// Set to stop the pass under way (a change, or the server stopping).
+    pub restart: AtomicBool,
+    /// Set when the server stops.
+    pub stop: AtomicBool,
+    /// The latest frame.
+    pub frames: watch::Sender<Arc<Frame>>,
+}
+
+impl Shared {
+    /// Applies a message of the page (see [`Controls::apply`]); a change that alters the
+    /// samples restarts the image.
+    pub fn apply(&self, message: &str) -> Result<(), String> {
+        let mut c = self
+            .controls
+            .lock()
+            .map_err(|_| "the render stopped".to_string())?;
+        if c.apply(message)? {
+            self.generation.fetch_add(1, Ordering::SeqCst);
+            self.restart.store(true, Ordering::SeqCst);
+        }
+        Ok(())
+    }
+}
+
+/// Renders `desc` until `shared.stop`, publishing each pass.
+pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
+    let mut last_exposure = f32::NAN;
+    let mut last_film: Option<(u64, u32, Film, f64)> = None;
+    while !shared.stop.load(Ordering::SeqCst) {
+        shared.restart.store(false, Ordering::SeqCst);
+        let generation = shared.generation.load(Ordering::SeqCst);
+        let Ok(controls) = shared.controls.lock().map(|c| c.clone()) else {
+            return;
+        };
+        if let Some((g, spp, film, rate)) = &last_film {
+            // The image is done: only a new exposure is worth a frame.
+            if *g == generation {
+                if controls.exposure != last_exposure {
+                    last_exposure = controls.exposure;
+                    publish(shared, film, *g, *spp, *rate, &controls);
+                }
+                std::thread::sleep(Duration::from_millis(20));
+                continue;
+            }
+        }
+        let camera =
+            Camera::new(&controls.camera(&desc.camera), desc.resolution).with_filter(desc.filter);
+        scene.set_camera(camera);
+        let integrator = controls.integrator();
+        let settings = RenderSettings::new(MAX_SPP, 0, controls.sampler);
+        let [w, h] = desc.resolution;
+        let start = Instant::now();
+        let mut done = 0u32;
+        let (film, stats) = render_from(
+            &scene,
+            &integrator,
+            &settings,
+            Film::new(w, h),
+            &|_| {},
+            &shared.restart,
+            &mut |film, stats| {
+                done = film.sample_count_range().max as u32;
+                let rate = stats.samples as f64 / start.elapsed().as_secs_f64().max(1e-9);
+                let now = shared
+                    .controls
+                    .lock()
+                    .map(|c| c.clone())
+                    .unwrap_or_default();
+                publish(shared, film, generation, done, rate, &now);
+            },
+        );
+        if !stats.cancelled {
+            let rate = stats.samples as f64 / start.elapsed().as_secs_f64().max(1e-9);
+            last_exposure = controls.exposure;
+            last_film = Some((generation, done, film, rate));
+        } else {
+            last_film = None;
+        }
+    }
+}
+
+/// Sends `film` as a frame.
+fn publish(shared: &Shared, film: &Film, generation: u64, spp: u32, rate: f64, c: &Controls) {
+    let scale = 2f32.powf(c.exposure);
+    let rgba: Vec<u8> = film
+        .mean_image()
+        .iter()
+        .flat_map(|p| {
+            let v = (*p * scale)
+                .to_array()
+                .map(|x| (srgb_encode(x.clamp(0.0, 1.0)) * 255.0).round() as u8);
+            [v[0], v[1], v[2], 255]
+        })
+        .collect();
+    let mean = film.image_mean();
+    shared.frames.send_replace(Arc::new(Frame {
+        generation,
+        size: [film.width(), film.height()],
+        spp,
+        samples_per_second: rate,
+        relative_error: estimated_relative_rmse(film),
+        mean: [mean.x, mean.y, mean.z],
+        controls: Some(c.clone()),
+        rgba: Arc::new(rgba),
+    }));
+}

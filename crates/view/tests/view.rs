@@ -1,0 +1,159 @@
+//! The viewer end to end: a server on the built-in Cornell box, the page fetched over HTTP,
+//! and a WebSocket client that reads frames and changes settings as the page does.
+
+use futures_util::{SinkExt, StreamExt};
+use pathlab_view::{serve, ViewOptions};
+use serde_json::Value;
+use std::io::{Read, Write};
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+use tokio_tungstenite::tungstenite::Message;
+
+type Socket =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+
+/// A frame as the page gets it: the statistics, then the pixels.
+struct Frame {
+    stats: Value,
+    rgba: Vec<u8>,
+}
+
+/// The next message of `ws` (failing the test after a while).
+async fn next(ws: &mut Socket) -> Message {
+    tokio::time::timeout(Duration::from_secs(60), ws.next())
+        .await
+        .expect("no message within a minute")
+        .expect("the server closed the socket")
+        .expect("a WebSocket error")
+}
+
+/// The next frame whose statistics satisfy `want` (errors are returned as `Err`).
+async fn frame_where(ws: &mut Socket, want: impl Fn(&Value) -> bool) -> Frame {
+    loop {
+        let Message::Text(text) = next(ws).await else {
+            continue;
+        };
+        let stats: Value = serde_json::from_str(text.as_str()).unwrap();
+        assert!(stats.get("error").is_none(), "unexpected error {stats}");
+        let Message::Binary(rgba) = next(ws).await else {
+            panic!("statistics not followed by pixels");
+        };
+        if want(&stats) {
+            return Frame {
+                stats,
+                rgba: rgba.to_vec(),
+            };
+        }
+    }
+}
+
+/// The next error reply, skipping frames.
+async fn error_reply(ws: &mut Socket) -> String {
+    loop {
+        if let Message::Text(text) = next(ws).await {
+            let v: Value = serde_json::from_str(text.as_str()).unwrap();
+            if let Some(e) = v.get("error") {
+                return e.as_str().unwrap().to_string();
+            }
+        }
+    }
+}
+
+async fn send(ws: &mut Socket, text: &str) {
+    ws.send(Message::Text(text.into())).await.unwrap();
+}
+
+fn get_page(addr: SocketAddr) -> String {
+    let mut s = std::net::TcpStream::connect(addr).unwrap();
+    s.write_all(b"GET / HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n")
+        .unwrap();
+    let mut out = String::new();
+    s.read_to_string(&mut out).unwrap();
+    out
+}
+
+#[test]
+fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
+    let mut desc = pathlab_scene::builtin::load("cornell-box").unwrap();
+    desc.resolution = [48, 48];
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = std::sync::mpsc::channel();
+    let server = {
+        let stop = Arc::clone(&stop);
+        std::thread::spawn(move || {
+            let options = ViewOptions {
+                host: "127.0.0.1".into(),
+                port: 0,
+                title: "cornell <box>".into(),
+            };
+            serve(desc, &options, stop, |addr| tx.send(addr).unwrap())
+        })
+    };
+    let addr = rx.recv_timeout(Duration::from_secs(60)).unwrap();
+    assert!(addr.ip().is_loopback());
+    let page = get_page(addr);
+    assert!(page.starts_with("HTTP/1.1 200"), "{page}");
+    assert!(page.contains("<canvas") && page.contains("cornell &lt;box&gt;"));
+
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/ws"))
+            .await
+            .unwrap();
+        // Passes arrive with growing sample counts; the box is not black.
+        let first = frame_where(&mut ws, |_| true).await;
+        assert_eq!(first.stats["width"], 48);
+        assert_eq!(first.rgba.len(), 48 * 48 * 4);
+        let later = frame_where(&mut ws, |s| s["spp"].as_u64().unwrap() >= 8).await;
+        let bright = later.rgba.chunks(4).map(|p| p[1] as f64).sum::<f64>() / (48.0 * 48.0);
+        assert!(bright > 20.0, "mean green {bright}");
+        assert_eq!(later.stats["controls"]["integrator"], "path");
+
+        // Bad messages get an error reply and change nothing; the server goes on.
+        send(&mut ws, "not json").await;
+        assert!(error_reply(&mut ws).await.contains("not a JSON message"));
+        send(&mut ws, r#"{"bogus": 1}"#).await;
+        assert_eq!(error_reply(&mut ws).await, "unknown setting 'bogus'");
+        send(&mut ws, r#"{"max_depth": 0}"#).await;
+        assert!(error_reply(&mut ws).await.starts_with("max_depth"));
+        send(&mut ws, r#"{"direct": "sideways"}"#).await;
+        assert!(error_reply(&mut ws).await.contains("sideways"));
+
+        // The course's comparison: uniform hemisphere sampling against light sampling at the
+        // same samples per pixel; each change restarts the image.
+        send(
+            &mut ws,
+            r#"{"integrator": "direct", "direct": "hemisphere"}"#,
+        )
+        .await;
+        let hemisphere = frame_where(&mut ws, |s| {
+            s["controls"]["direct"] == "hemisphere" && s["spp"].as_u64().unwrap() >= 16
+        })
+        .await;
+        let generation = hemisphere.stats["generation"].as_u64().unwrap();
+        assert!(generation >= 1);
+        send(&mut ws, r#"{"direct": "light"}"#).await;
+        let restarted = frame_where(&mut ws, |s| s["controls"]["direct"] == "light").await;
+        assert_eq!(restarted.stats["spp"], 1, "a change starts the image again");
+        assert_eq!(restarted.stats["generation"], generation + 1);
+        let light = frame_where(&mut ws, |s| {
+            s["controls"]["direct"] == "light" && s["spp"] == hemisphere.stats["spp"]
+        })
+        .await;
+        let (eh, el) = (
+            hemisphere.stats["relative_error"].as_f64().unwrap(),
+            light.stats["relative_error"].as_f64().unwrap(),
+        );
+        assert!(
+            el < 0.75 * eh,
+            "relative error: light {el}, hemisphere {eh}"
+        );
+    });
+    stop.store(true, Ordering::SeqCst);
+    server.join().unwrap().unwrap();
+}
