@@ -53,13 +53,16 @@ pub fn write_heat_map(
 ) -> Result<(), ImageError> {
     let bytes: Vec<u8> = values
         .iter()
-        .flat_map(|&n| {
-            let t = (n / max.max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
-            let ramp = |c: f32| ((1.5 - (4.0 * t - c).abs()).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-            [ramp(3.0), ramp(2.0), ramp(1.0)]
-        })
+        .flat_map(|&n| heat_colour(n / max.max(f32::MIN_POSITIVE)))
         .collect();
     write_rgb8(path, width, height, &bytes)
+}
+
+/// The heat maps' colour of `t` in [0, 1] (clamped): blue through green to red.
+pub fn heat_colour(t: f32) -> [u8; 3] {
+    let t = t.clamp(0.0, 1.0);
+    let ramp = |c: f32| ((1.5 - (4.0 * t - c).abs()).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    [ramp(3.0), ramp(2.0), ramp(1.0)]
 }
 
 /// The smallest and largest of the film's per-pixel means (their first channel: a debug

@@ -22,6 +22,9 @@ pub struct Controls {
     pub sampler: SamplerKind,
     /// Stops of exposure before the sRGB encoding of the frames sent.
     pub exposure: f32,
+    /// What the frames show: "image", or a heat map of "variance" (of a sample's luminance),
+    /// "relative_error" (of the pixel's mean) or "samples" (per pixel).
+    pub display: String,
     /// Degrees of the camera's orbit about its target: around the up axis, and up or down.
     pub orbit: [f32; 2],
     /// The camera's distance to its target relative to the scene's.
@@ -36,6 +39,7 @@ impl Default for Controls {
             max_depth: 5,
             sampler: SamplerKind::Independent,
             exposure: 0.0,
+            display: "image".into(),
             orbit: [0.0, 0.0],
             zoom: 1.0,
         }
@@ -44,9 +48,10 @@ impl Default for Controls {
 
 impl Controls {
     /// Applies a message of the page: a JSON object of settings (`integrator`, `direct`,
-    /// `max_depth`, `sampler`, `exposure`), an `orbit` step `[yaw, pitch]` in degrees or a
-    /// `zoom` factor. Returns whether the image must restart (the exposure alone does not
-    /// change the samples); an unknown setting or a bad value is an error, and nothing changes.
+    /// `max_depth`, `sampler`, `exposure`, `display`), an `orbit` step `[yaw, pitch]` in
+    /// degrees or a `zoom` factor. Returns whether the image must restart (the exposure and
+    /// the display do not change the samples); an unknown setting or a bad value is an error,
+    /// and nothing changes.
     pub fn apply(&mut self, message: &str) -> Result<bool, String> {
         let v: Value =
             serde_json::from_str(message).map_err(|e| format!("not a JSON message: {e}"))?;
@@ -93,6 +98,16 @@ impl Controls {
                         .ok_or_else(|| format!("exposure: expected -20 to 20 stops, got {value}"))?
                         as f32
                 }
+                "display" => match value.as_str() {
+                    Some(d @ ("image" | "variance" | "relative_error" | "samples")) => {
+                        next.display = d.to_string()
+                    }
+                    _ => {
+                        return Err(format!(
+                            "display: expected \"image\", \"variance\", \"relative_error\" or \"samples\", got {value}"
+                        ))
+                    }
+                },
                 "orbit" => {
                     let step = value
                         .as_array()
@@ -117,6 +132,7 @@ impl Controls {
         }
         let restart = Controls {
             exposure: self.exposure,
+            display: self.display.clone(),
             ..next.clone()
         } != *self;
         *self = next;
@@ -160,6 +176,7 @@ impl Controls {
             "max_depth": self.max_depth,
             "sampler": self.sampler.name(),
             "exposure": self.exposure,
+            "display": self.display,
             "orbit": self.orbit,
             "zoom": self.zoom,
         })

@@ -5,7 +5,7 @@
 //! `GET /ws` a WebSocket. The scene renders in its own threads ([`renderer`]), pass by pass;
 //! after each pass every connected page gets a text message with the frame's statistics (JSON:
 //! `generation`, `width`, `height`, `spp`, `samples_per_second`, `relative_error`, `mean`,
-//! `controls`) and a binary message of its sRGB pixels (RGBA, rows from the top). The page
+//! `controls`, `display_range`, and `pixel` for a page that inspects one) and a binary message of its sRGB pixels (RGBA, rows from the top). The page
 //! sends JSON objects of [`controls::Controls`] settings; a change restarts the image, a bad
 //! message gets `{"error": "..."}` back and changes nothing. A slow page skips frames; it never
 //! holds up the render.
@@ -59,6 +59,7 @@ pub fn serve(
         restart: AtomicBool::new(false),
         stop: AtomicBool::new(false),
         frames,
+        inspected: Mutex::new(Default::default()),
     });
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
@@ -101,6 +102,58 @@ pub fn serve(
     served.context("the web server failed")
 }
 
+/// A page's inspected pixel, registered with the render while the page is connected.
+struct Inspector {
+    shared: Arc<Shared>,
+    pixel: Option<[u32; 2]>,
+}
+
+impl Drop for Inspector {
+    fn drop(&mut self) {
+        self.shared.inspect(self.pixel, None);
+    }
+}
+
+/// The image size of the latest frame.
+fn size(frames: &watch::Receiver<Arc<Frame>>) -> [u32; 2] {
+    frames.borrow().size
+}
+
+/// `{"inspect": [x, y]}`: the pixel a page inspects (`None` for any other message; an error
+/// for a pixel outside the image).
+fn inspect_request(text: &str, [w, h]: [u32; 2]) -> Option<Result<[u32; 2], String>> {
+    let v: serde_json::Value = serde_json::from_str(text).ok()?;
+    let fields = v.as_object()?;
+    let p = fields.get("inspect")?;
+    if fields.len() != 1 {
+        return Some(Err("inspect: send it on its own".into()));
+    }
+    let xy = p
+        .as_array()
+        .filter(|a| a.len() == 2)
+        .and_then(|a| Some([a[0].as_u64()?, a[1].as_u64()?]));
+    Some(match xy {
+        Some([x, y]) if x < w as u64 && y < h as u64 => Ok([x as u32, y as u32]),
+        _ => Err(format!("inspect: {p} is not a pixel of the {w}x{h} image")),
+    })
+}
+
+/// What the inspector shows of pixel `p` in `frame`: its samples, mean luminance and the 95%
+/// confidence interval of that mean.
+fn pixel_json(frame: &Frame, p: [u32; 2]) -> Option<serde_json::Value> {
+    let (_, stats) = frame.inspected.iter().find(|(q, _)| *q == p)?;
+    let l = stats.luminance();
+    let half = 1.96 * l.std_error();
+    Some(json!({
+        "x": p[0],
+        "y": p[1],
+        "samples": stats.count(),
+        "mean": l.mean(),
+        "ci95": [l.mean() - half, l.mean() + half],
+        "rgb": stats.mean().to_array(),
+    }))
+}
+
 #[derive(Clone)]
 struct AppState {
     shared: Arc<Shared>,
@@ -125,11 +178,25 @@ async fn socket(ws: WebSocketUpgrade, State(state): State<AppState>) -> impl Int
 async fn client(mut socket: WebSocket, shared: Arc<Shared>) {
     let mut frames = shared.frames.subscribe();
     frames.mark_changed();
+    // The page's inspected pixel, given back when the page goes.
+    let mut inspector = Inspector {
+        shared: Arc::clone(&shared),
+        pixel: None,
+    };
     loop {
         tokio::select! {
             message = socket.recv() => match message {
                 Some(Ok(Message::Text(text))) => {
-                    if let Err(e) = shared.apply(text.as_str()) {
+                    let handled = match inspect_request(text.as_str(), size(&frames)) {
+                        Some(Ok(pixel)) => {
+                            inspector.shared.inspect(inspector.pixel, Some(pixel));
+                            inspector.pixel = Some(pixel);
+                            Ok(())
+                        }
+                        Some(Err(e)) => Err(e),
+                        None => shared.apply(text.as_str()),
+                    };
+                    if let Err(e) = handled {
                         let reply = json!({ "error": e }).to_string();
                         if socket.send(Message::Text(reply.into())).await.is_err() {
                             return;
@@ -162,6 +229,8 @@ async fn client(mut socket: WebSocket, shared: Arc<Shared>) {
                     "relative_error": frame.relative_error,
                     "mean": frame.mean,
                     "controls": frame.controls.as_ref().map(|c| c.to_json()),
+                    "display_range": frame.display_range,
+                    "pixel": inspector.pixel.and_then(|p| pixel_json(&frame, p)),
                 });
                 if socket.send(Message::Text(stats.to_string().into())).await.is_err()
                     || socket

@@ -4,12 +4,15 @@
 
 use crate::controls::Controls;
 use pathlab_render::camera::Camera;
+use pathlab_render::color::luminance_f64;
 use pathlab_render::desc::SceneDesc;
-use pathlab_render::film::Film;
+use pathlab_render::film::{Film, PixelStats};
+use pathlab_render::film_image::heat_colour;
 use pathlab_render::image_io::srgb_encode;
 use pathlab_render::progressive::estimated_relative_rmse;
 use pathlab_render::render::{render_from, RenderSettings};
 use pathlab_render::scene::Scene;
+use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -35,6 +38,10 @@ pub struct Frame {
     pub mean: [f64; 3],
     /// The controls the image is rendered with.
     pub controls: Option<Controls>,
+    /// The range a heat-map display's colours run over (zero for the image).
+    pub display_range: [f64; 2],
+    /// The statistics of the pixels pages inspect.
+    pub inspected: Vec<([u32; 2], PixelStats)>,
     /// sRGB pixels, four bytes each (alpha 255), rows from the top.
     pub rgba: Arc<Vec<u8>>,
 }
@@ -51,9 +58,30 @@ pub struct Shared {
     pub stop: AtomicBool,
     /// The latest frame.
     pub frames: watch::Sender<Arc<Frame>>,
+    /// The pixels pages inspect, with how many pages inspect each (each frame carries their
+    /// statistics).
+    pub inspected: Mutex<BTreeMap<[u32; 2], usize>>,
 }
 
 impl Shared {
+    /// Moves a page's inspected pixel from `from` to `to` (either may be none).
+    pub fn inspect(&self, from: Option<[u32; 2]>, to: Option<[u32; 2]>) {
+        let Ok(mut set) = self.inspected.lock() else {
+            return;
+        };
+        if let Some(p) = to {
+            *set.entry(p).or_insert(0) += 1;
+        }
+        if let Some(p) = from {
+            if let Some(n) = set.get_mut(&p) {
+                *n -= 1;
+                if *n == 0 {
+                    set.remove(&p);
+                }
+            }
+        }
+    }
+
     /// Applies a message of the page (see [`Controls::apply`]); a change that alters the
     /// samples restarts the image.
     pub fn apply(&self, message: &str) -> Result<(), String> {
@@ -72,6 +100,7 @@ impl Shared {
 /// Renders `desc` until `shared.stop`, publishing each pass.
 pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
     let mut last_exposure = f32::NAN;
+    let mut last_display = String::new();
     let mut last_film: Option<(u64, u32, Film, f64)> = None;
     while !shared.stop.load(Ordering::SeqCst) {
         shared.restart.store(false, Ordering::SeqCst);
@@ -82,8 +111,9 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
         if let Some((g, spp, film, rate)) = &last_film {
             // The image is done: only a new exposure is worth a frame.
             if *g == generation {
-                if controls.exposure != last_exposure {
+                if (controls.exposure, &controls.display) != (last_exposure, &last_display) {
                     last_exposure = controls.exposure;
+                    last_display = controls.display.clone();
                     publish(shared, film, *g, *spp, *rate, &controls);
                 }
                 std::thread::sleep(Duration::from_millis(20));
@@ -119,6 +149,7 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
         if !stats.cancelled {
             let rate = stats.samples as f64 / start.elapsed().as_secs_f64().max(1e-9);
             last_exposure = controls.exposure;
+            last_display = controls.display.clone();
             last_film = Some((generation, done, film, rate));
         } else {
             last_film = None;
@@ -126,19 +157,9 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
     }
 }
 
-/// Sends `film` as a frame.
+/// Sends `film` as a frame, drawn as `c.display` says.
 fn publish(shared: &Shared, film: &Film, generation: u64, spp: u32, rate: f64, c: &Controls) {
-    let scale = 2f32.powf(c.exposure);
-    let rgba: Vec<u8> = film
-        .mean_image()
-        .iter()
-        .flat_map(|p| {
-            let v = (*p * scale)
-                .to_array()
-                .map(|x| (srgb_encode(x.clamp(0.0, 1.0)) * 255.0).round() as u8);
-            [v[0], v[1], v[2], 255]
-        })
-        .collect();
+    let (rgba, display_range) = draw(film, c);
     let mean = film.image_mean();
     shared.frames.send_replace(Arc::new(Frame {
         generation,
@@ -148,6 +169,89 @@ fn publish(shared: &Shared, film: &Film, generation: u64, spp: u32, rate: f64, c
         relative_error: estimated_relative_rmse(film),
         mean: [mean.x, mean.y, mean.z],
         controls: Some(c.clone()),
+        display_range,
+        inspected: shared
+            .inspected
+            .lock()
+            .map(|set| {
+                set.keys()
+                    .map(|&[x, y]| ([x, y], *film.pixel(x, y)))
+                    .collect()
+            })
+            .unwrap_or_default(),
         rgba: Arc::new(rgba),
     }));
+}
+
+/// The frame's pixels: the image in sRGB after the exposure, or a heat map of a per-pixel
+/// statistic over its range (returned); non-finite values (a relative error of a black pixel)
+/// are left out of the range and drawn black.
+fn draw(film: &Film, c: &Controls) -> (Vec<u8>, [f64; 2]) {
+    let stat: fn(&PixelStats) -> f64 = match c.display.as_str() {
+        "variance" => |p| luminance_f64(p.variance()),
+        "relative_error" => {
+            |p| luminance_f64(p.variance_of_mean()).sqrt() / luminance_f64(p.mean())
+        }
+        "samples" => |p| p.count() as f64,
+        _ => {
+            let scale = 2f32.powf(c.exposure);
+            let rgba = film
+                .mean_image()
+                .iter()
+                .flat_map(|p| {
+                    let v = (*p * scale)
+                        .to_array()
+                        .map(|x| (srgb_encode(x.clamp(0.0, 1.0)) * 255.0).round() as u8);
+                    [v[0], v[1], v[2], 255]
+                })
+                .collect();
+            return (rgba, [0.0, 0.0]);
+        }
+    };
+    let values: Vec<f64> = film.pixels().iter().map(stat).collect();
+    let hi = values
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max);
+    let rgba = values
+        .iter()
+        .flat_map(|&v| {
+            let [r, g, b] = if v.is_finite() {
+                heat_colour((v / hi.max(f64::MIN_POSITIVE)) as f32)
+            } else {
+                [0, 0, 0]
+            };
+            [r, g, b, 255]
+        })
+        .collect();
+    (rgba, [0.0, hi])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn heat_maps_run_over_their_statistic_and_draw_undefined_values_black() {
+        let mut film = Film::new(2, 1);
+        for l in [0.5, 1.5, 1.0] {
+            film.pixel_mut(0, 0).add(Vec3::splat(l));
+        }
+        film.pixel_mut(1, 0).add(Vec3::ZERO);
+        let mut c = Controls::default();
+        let (rgba, range) = draw(&film, &c);
+        assert_eq!((rgba.len(), range), (8, [0.0, 0.0]));
+        c.display = "samples".into();
+        assert_eq!(draw(&film, &c).1, [0.0, 3.0]);
+        c.display = "variance".into();
+        let (_, [_, hi]) = draw(&film, &c);
+        assert!((hi - 0.25).abs() < 1e-6, "{hi}");
+        // The black pixel's relative error is 0/0: left out of the range, drawn black.
+        c.display = "relative_error".into();
+        let (rgba, [_, hi]) = draw(&film, &c);
+        assert!(hi.is_finite() && hi > 0.0);
+        assert_eq!(&rgba[4..8], &[0, 0, 0, 255]);
+    }
 }

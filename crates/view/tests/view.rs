@@ -124,6 +124,35 @@ fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
         send(&mut ws, r#"{"direct": "sideways"}"#).await;
         assert!(error_reply(&mut ws).await.contains("sideways"));
 
+        // A heat map of the samples per pixel runs over 0 to the samples taken; the display
+        // changes without restarting the image.
+        let generation = later.stats["generation"].clone();
+        send(&mut ws, r#"{"display": "samples"}"#).await;
+        let heat = frame_where(&mut ws, |s| s["controls"]["display"] == "samples").await;
+        assert_eq!(heat.stats["generation"], generation);
+        assert_eq!(
+            heat.stats["display_range"][1],
+            heat.stats["spp"].as_f64().unwrap()
+        );
+        send(&mut ws, r#"{"display": "image"}"#).await;
+
+        // The inspector: the pixel's samples, mean luminance and 95% interval, every frame.
+        send(&mut ws, r#"{"inspect": [24, 30]}"#).await;
+        let inspected = frame_where(&mut ws, |s| s["pixel"].is_object()).await;
+        let p = &inspected.stats["pixel"];
+        assert_eq!((p["x"].as_u64(), p["y"].as_u64()), (Some(24), Some(30)));
+        assert_eq!(p["samples"], inspected.stats["spp"]);
+        let (lo, mean, hi) = (
+            p["ci95"][0].as_f64().unwrap(),
+            p["mean"].as_f64().unwrap(),
+            p["ci95"][1].as_f64().unwrap(),
+        );
+        assert!(lo <= mean && mean <= hi && mean > 0.0, "{p}");
+        send(&mut ws, r#"{"inspect": [48, 0]}"#).await;
+        assert!(error_reply(&mut ws)
+            .await
+            .contains("not a pixel of the 48x48 image"));
+
         // The course's comparison: uniform hemisphere sampling against light sampling at the
         // same samples per pixel; each change restarts the image.
         send(
