@@ -662,3 +662,20 @@ fn refused_command_lines_are_one_line_errors_that_name_the_argument() {
     assert_one_line_error(&pathlab(&["render", "--bogus"]), "'--bogus'");
     assert_one_line_error(&pathlab(&["render", "-s", "x"]), "'--spp <SPP>'");
 }
+
+#[test]
+fn view_refuses_bad_scenes_and_addresses_with_one_line_errors() {
+    assert_one_line_error(&pathlab(&["view", "missing.xml"]), "missing.xml");
+    assert_one_line_error(
+        &pathlab(&["view", "--host", "not a host", "--port", "0"]),
+        "cannot listen on not a host:0",
+    );
+    // A port another program holds.
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = taken.local_addr().unwrap().port().to_string();
+    assert_one_line_error(
+        &pathlab(&["view", "-r", "8", "8", "--port", &port]),
+        &format!("cannot listen on 127.0.0.1:{port}"),
+    );
+    assert_one_line_error(&pathlab(&["view", "-D", "novalue"]), "-D novalue");
+}
