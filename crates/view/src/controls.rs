@@ -5,19 +5,26 @@ use glam::{Mat3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::desc::CameraDesc;
 use pathlab_render::integrator::{
-    DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
+    DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
 };
 use serde_json::{json, Value};
 
 /// The settings the page controls.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Controls {
-    /// "path" or "direct".
+    /// "path", "direct", or a debug view: "normals", "depth", "bvh" (nodes visited per
+    /// camera ray, shown as a heat map over its range).
     pub integrator: String,
     /// The direct integrator's strategy.
     pub direct: DirectStrategy,
     /// The path tracer's largest bounce.
     pub max_depth: u32,
+    /// The path tracer's bounce from which Russian roulette may end paths.
+    pub rr_depth: u32,
+    /// Only the light of this bounce (0: emission seen directly, 1: direct lighting, ...).
+    pub only_bounce: Option<u32>,
+    /// Light samples per vertex (the direct integrator's per camera ray).
+    pub light_samples: u32,
     /// Where the random numbers come from.
     pub sampler: SamplerKind,
     /// Stops of exposure before the sRGB encoding of the frames sent.
@@ -37,6 +44,9 @@ impl Default for Controls {
             integrator: "path".into(),
             direct: DirectStrategy::Mis,
             max_depth: 5,
+            rr_depth: 5,
+            only_bounce: None,
+            light_samples: 1,
             sampler: SamplerKind::Independent,
             exposure: 0.0,
             display: "image".into(),
@@ -63,13 +73,37 @@ impl Controls {
             let bad = || format!("{key}: {value} is not a valid value");
             match key.as_str() {
                 "integrator" => match value.as_str() {
-                    Some(s @ ("path" | "direct")) => next.integrator = s.to_string(),
+                    Some(s @ ("path" | "direct" | "normals" | "depth" | "bvh")) => {
+                        next.integrator = s.to_string()
+                    }
                     _ => {
                         return Err(format!(
-                            "integrator: expected \"path\" or \"direct\", got {value}"
+                            "integrator: expected path, direct, normals, depth or bvh, got {value}"
                         ))
                     }
                 },
+                "rr_depth" => {
+                    next.rr_depth = value
+                        .as_u64()
+                        .filter(|&d| d <= 1000)
+                        .ok_or_else(|| format!("rr_depth: expected 0 to 1000, got {value}"))?
+                        as u32
+                }
+                "only_bounce" => {
+                    next.only_bounce = match value {
+                        Value::Null => None,
+                        v => Some(v.as_u64().filter(|&k| k <= 1000).ok_or_else(|| {
+                            format!("only_bounce: expected 0 to 1000 or null, got {value}")
+                        })? as u32),
+                    }
+                }
+                "light_samples" => {
+                    next.light_samples = value
+                        .as_u64()
+                        .filter(|&n| (1..=256).contains(&n))
+                        .ok_or_else(|| format!("light_samples: expected 1 to 256, got {value}"))?
+                        as u32
+                }
                 "direct" => {
                     next.direct = value
                         .as_str()
@@ -141,16 +175,22 @@ impl Controls {
 
     /// The integrator these settings choose.
     pub fn integrator(&self) -> IntegratorKind {
-        if self.integrator == "direct" {
-            IntegratorKind::Direct(DirectIntegrator {
+        match self.integrator.as_str() {
+            "direct" => IntegratorKind::Direct(DirectIntegrator {
                 strategy: self.direct,
+                samples: self.light_samples,
                 ..Default::default()
-            })
-        } else {
-            IntegratorKind::Path(PathIntegrator {
+            }),
+            "normals" => IntegratorKind::Debug(DebugView::Normals),
+            "depth" => IntegratorKind::Debug(DebugView::Depth),
+            "bvh" => IntegratorKind::Debug(DebugView::BvhHeat),
+            _ => IntegratorKind::Path(PathIntegrator {
                 max_depth: self.max_depth,
+                rr_depth: self.rr_depth,
+                only_bounce: self.only_bounce,
+                light_samples: self.light_samples,
                 ..Default::default()
-            })
+            }),
         }
     }
 
@@ -174,6 +214,9 @@ impl Controls {
             "integrator": self.integrator,
             "direct": self.direct.name(),
             "max_depth": self.max_depth,
+            "rr_depth": self.rr_depth,
+            "only_bounce": self.only_bounce,
+            "light_samples": self.light_samples,
             "sampler": self.sampler.name(),
             "exposure": self.exposure,
             "display": self.display,
@@ -207,6 +250,27 @@ mod tests {
         c.apply(r#"{"orbit": [20, 20]}"#).unwrap();
         assert_eq!(c.orbit, [10.0, 85.0]);
         assert!(c.apply(r#"{"zoom": -1}"#).is_err());
+        // The path tracer's course settings, and the debug views.
+        c.apply(r#"{"integrator": "path", "only_bounce": 2, "rr_depth": 0, "light_samples": 4}"#)
+            .unwrap();
+        match c.integrator() {
+            IntegratorKind::Path(p) => {
+                assert_eq!(
+                    (p.only_bounce, p.rr_depth, p.light_samples),
+                    (Some(2), 0, 4)
+                )
+            }
+            other => panic!("{other:?}"),
+        }
+        c.apply(r#"{"only_bounce": null, "integrator": "bvh"}"#)
+            .unwrap();
+        assert_eq!(c.only_bounce, None);
+        assert!(matches!(
+            c.integrator(),
+            IntegratorKind::Debug(DebugView::BvhHeat)
+        ));
+        assert!(c.apply(r#"{"light_samples": 0}"#).is_err());
+        assert!(c.apply(r#"{"integrator": "bdpt"}"#).is_err());
     }
 
     #[test]

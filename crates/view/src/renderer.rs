@@ -188,6 +188,8 @@ fn publish(shared: &Shared, film: &Film, generation: u64, spp: u32, rate: f64, c
 /// are left out of the range and drawn black.
 fn draw(film: &Film, c: &Controls) -> (Vec<u8>, [f64; 2]) {
     let stat: fn(&PixelStats) -> f64 = match c.display.as_str() {
+        // The BVH view's value is a count, shown over its range whatever the display.
+        _ if c.integrator == "bvh" => |p| p.mean().x,
         "variance" => |p| luminance_f64(p.variance()),
         "relative_error" => {
             |p| luminance_f64(p.variance_of_mean()).sqrt() / luminance_f64(p.mean())

@@ -136,6 +136,12 @@ fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
         );
         send(&mut ws, r#"{"display": "image"}"#).await;
 
+        // The BVH view is a heat map of the nodes each camera ray visits, over their range.
+        send(&mut ws, r#"{"integrator": "bvh"}"#).await;
+        let bvh = frame_where(&mut ws, |s| s["controls"]["integrator"] == "bvh").await;
+        assert!(bvh.stats["display_range"][1].as_f64().unwrap() >= 1.0);
+        send(&mut ws, r#"{"integrator": "path"}"#).await;
+
         // The inspector: the pixel's samples, mean luminance and 95% interval, every frame.
         send(&mut ws, r#"{"inspect": [24, 30]}"#).await;
         let inspected = frame_where(&mut ws, |s| s["pixel"].is_object()).await;
