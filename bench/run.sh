@@ -6,7 +6,8 @@
 #
 #   bench/run.sh            # everything
 #   bench/run.sh rays       # Embree only
-#   bench/run.sh render     # Mitsuba only
+#   bench/run.sh render     # Mitsuba, the Cornell box in detail
+#   bench/run.sh scenes     # Mitsuba, every reference scene (speed and equal-time error)
 #
 # Results go to target/bench/ (JSON per measurement) and a table on stdout.
 set -euo pipefail
@@ -54,7 +55,7 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
     python3 "$root/bench/rays_table.py" "$work" "$reps" "${meshes[@]}"
 fi
 
-if [ "$what" = all ] || [ "$what" = render ]; then
+mitsuba_venv() {
     venv="$work/venv"
     [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
     "$venv/bin/python" -c "import mitsuba, numpy" 2>/dev/null || "$venv/bin/pip" install --quiet mitsuba numpy
@@ -63,8 +64,19 @@ if [ "$what" = all ] || [ "$what" = render ]; then
         apt_install libllvm19 || true
         llvm="$(ls /usr/lib/x86_64-linux-gnu/libLLVM-19.so 2>/dev/null || true)"
     fi
+}
+
+if [ "$what" = all ] || [ "$what" = render ]; then
+    mitsuba_venv
     DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/mitsuba_bench.py" \
         --pathlab "$pathlab" --scene "$root/crates/scene/tests/data/cornell-box/scene.xml" \
         --reference "$root/crates/scene/tests/data/cornell-box/mean-maxdepth-inf.exr" \
         --work "$work"
+fi
+
+if [ "$what" = all ] || [ "$what" = scenes ]; then
+    mitsuba_venv
+    DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/scenes.py" \
+        --pathlab "$pathlab" --data "$root/crates/scene/tests/data" --work "$work" \
+        --spp "${PATHLAB_BENCH_SPP:-256}" --reps "${PATHLAB_BENCH_REPS:-3}"
 fi

@@ -20,6 +20,7 @@ cases=(
     "target-error|-r 64 64 --target-error 0.03"
     "crop|-r 96 96 -s 16 --crop 10 10 50 40"
     "mitsuba-spheres|$data/cornell-spheres/scene.xml -r 64 64 -s 16"
+    "mitsuba-sky|$data/sky-spheres/scene.xml -r 64 64 -s 16"
     "mitsuba-roughplastic|$data/mitsuba-suite/tests/scenes/bsdf_spheres/test_roughplastic_nonlinear_path.xml -r 48 48 -s 8"
     "mitsuba-principled|$data/mitsuba-suite/tests/scenes/bsdf_spheres/test_texturedprincipled1_path.xml -r 48 48 -s 8"
     "mitsuba-bumpmap|$data/mitsuba-suite/tests/scenes/bsdf_spheres/test_bumpmap_path.xml -r 48 48 -s 8"

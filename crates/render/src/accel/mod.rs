@@ -10,7 +10,9 @@ mod wide;
 
 pub use bvh::{Bvh, BvhNode, BvhParams};
 #[cfg(target_arch = "x86_64")]
-pub(crate) use tri_block::{AvxNearest, AvxRays};
+pub(crate) use tri_block::{
+    nearest_for_rays_pair_avx512, Avx512Nearest, Avx512Rays, AvxNearest, AvxRays,
+};
 pub use tri_block::{BlockHit, Nearest, RayLanes, TriBlock, TRIS_PER_BLOCK};
 pub use wide::{BoxTest, Bvh4, Bvh8, Node, Portable, WideBvh, BVH_WIDTH, MAX_PRIMITIVES};
 

@@ -359,6 +359,165 @@ impl TriBlock {
     }
 }
 
+/// Two triangles against the same eight rays in one sixteen-lane AVX-512 pass: lanes 0–7 test
+/// triangle `a` (lane `a.1` of block `a.0`, leaf slot `a.2`), lanes 8–15 triangle `b`, each
+/// with [`TriBlock::nearest_for_rays_avx`]'s operations in its order (so the same distances
+/// and barycentrics to the bit). Each half keeps its own nearest hit, so that one pair's
+/// result does not wait for the other half's; [`Avx512Nearest::lanes`] joins them.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+#[inline]
+pub(crate) fn nearest_for_rays_pair_avx512(
+    a: (&TriBlock, usize, u32),
+    b: (&TriBlock, usize, u32),
+    rays: &Avx512Rays,
+    nearest: &mut Avx512Nearest,
+) {
+    use std::arch::x86_64::*;
+    // Triangle a's value in the low eight lanes, b's in the high eight.
+    let halves =
+        |x: f32, y: f32| _mm512_mask_blend_ps(0xff00, _mm512_set1_ps(x), _mm512_set1_ps(y));
+    let pair = |fa: &[[f32; TRIS_PER_BLOCK]; 3], fb: &[[f32; TRIS_PER_BLOCK]; 3], axis: usize| {
+        halves(fa[axis][a.1], fb[axis][b.1])
+    };
+    let splat = |fa, fb| [pair(fa, fb, 0), pair(fa, fb, 1), pair(fa, fb, 2)];
+    let v0 = splat(&a.0.v0, &b.0.v0);
+    let e1 = splat(&a.0.e1, &b.0.e1);
+    let e2 = splat(&a.0.e2, &b.0.e2);
+    let mul = |x, y| _mm512_mul_ps(x, y);
+    let sub = |x, y| _mm512_sub_ps(x, y);
+    let add = |x, y| _mm512_add_ps(x, y);
+    let dot = |x: &[__m512; 3], y: &[__m512; 3]| {
+        add(add(mul(x[0], y[0]), mul(x[1], y[1])), mul(x[2], y[2]))
+    };
+    let d = &rays.d;
+    let pvec = [
+        sub(mul(d[1], e2[2]), mul(e2[1], d[2])),
+        sub(mul(d[2], e2[0]), mul(e2[2], d[0])),
+        sub(mul(d[0], e2[1]), mul(e2[0], d[1])),
+    ];
+    let det = dot(&e1, &pvec);
+    let inv_det = _mm512_div_ps(_mm512_set1_ps(1.0), det);
+    let tvec = [
+        sub(rays.o[0], v0[0]),
+        sub(rays.o[1], v0[1]),
+        sub(rays.o[2], v0[2]),
+    ];
+    let u = mul(dot(&tvec, &pvec), inv_det);
+    let qvec = [
+        sub(mul(tvec[1], e1[2]), mul(e1[1], tvec[2])),
+        sub(mul(tvec[2], e1[0]), mul(e1[2], tvec[0])),
+        sub(mul(tvec[0], e1[1]), mul(e1[0], tvec[1])),
+    ];
+    let v = mul(dot(d, &qvec), inv_det);
+    let t = mul(dot(&e2, &qvec), inv_det);
+    let (zero, one) = (_mm512_setzero_ps(), _mm512_set1_ps(1.0));
+    let abs_det = _mm512_andnot_ps(_mm512_set1_ps(-0.0), det);
+    let hit: __mmask16 = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs_det, _mm512_set1_ps(f32::INFINITY))
+        & _mm512_cmp_ps_mask::<_CMP_GE_OQ>(u, zero)
+        & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(u, one)
+        & _mm512_cmp_ps_mask::<_CMP_GE_OQ>(v, zero)
+        & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(add(u, v), one)
+        & _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, rays.t_min)
+        & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, nearest.t);
+    nearest.t = _mm512_mask_blend_ps(hit, nearest.t, t);
+    nearest.b1 = _mm512_mask_blend_ps(hit, nearest.b1, u);
+    nearest.b2 = _mm512_mask_blend_ps(hit, nearest.b2, v);
+    let slots = halves(f32::from_bits(a.2), f32::from_bits(b.2));
+    nearest.slot = _mm512_mask_blend_ps(hit, nearest.slot, slots);
+    nearest.pair = _mm512_mask_blend_ps(hit, nearest.pair, nearest.this_pair);
+    nearest.this_pair = _mm512_castsi512_ps(_mm512_add_epi32(
+        _mm512_castps_si512(nearest.this_pair),
+        _mm512_set1_epi32(1),
+    ));
+}
+
+/// The nearest hits of [`nearest_for_rays_pair_avx512`]: lanes 0–7 those among the first
+/// triangles of the pairs, lanes 8–15 among the second ones, each with the index of its
+/// pair.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+pub(crate) struct Avx512Nearest {
+    t: std::arch::x86_64::__m512,
+    b1: std::arch::x86_64::__m512,
+    b2: std::arch::x86_64::__m512,
+    slot: std::arch::x86_64::__m512,
+    /// The pair each lane's hit came from (`u32` bits).
+    pair: std::arch::x86_64::__m512,
+    /// The next pair's index in every lane.
+    this_pair: std::arch::x86_64::__m512,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Avx512Nearest {
+    /// No hits yet, for rays ending at `t_max`.
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+    #[inline]
+    pub(crate) fn new(t_max: F8) -> Avx512Nearest {
+        use std::arch::x86_64::*;
+        Avx512Nearest {
+            t: _mm512_broadcast_f32x8(to_avx(t_max)),
+            b1: _mm512_setzero_ps(),
+            b2: _mm512_setzero_ps(),
+            slot: _mm512_set1_ps(f32::from_bits(u32::MAX)),
+            pair: _mm512_setzero_ps(),
+            this_pair: _mm512_setzero_ps(),
+        }
+    }
+
+    /// Each ray's hit as testing the triangles one by one, in order, would find it: the
+    /// nearer of its two halves' hits, and of two at the same distance the earlier one (the
+    /// lower pair, or the first triangle of the same pair).
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+    #[inline]
+    pub(crate) fn lanes(self) -> Nearest {
+        use std::arch::x86_64::*;
+        let low = |x: __m512| _mm512_castps512_ps256(x);
+        let high = |x: __m512| _mm512_extractf32x8_ps::<1>(x);
+        let (t_low, t_high) = (low(self.t), high(self.t));
+        let pair = _mm512_castps_si512(self.pair);
+        let (pair_low, pair_high) = (
+            _mm512_castsi512_si256(pair),
+            _mm512_extracti64x4_epi64::<1>(pair),
+        );
+        let take_high: __mmask8 = _mm256_cmp_ps_mask::<_CMP_LT_OQ>(t_high, t_low)
+            | (_mm256_cmp_ps_mask::<_CMP_EQ_OQ>(t_high, t_low)
+                & _mm256_cmplt_epu32_mask(pair_high, pair_low));
+        let pick = |x: __m512| from_avx(_mm256_mask_blend_ps(take_high, low(x), high(x)));
+        Nearest {
+            t: pick(self.t),
+            b1: pick(self.b1),
+            b2: pick(self.b2),
+            slot: pick(self.slot),
+        }
+    }
+}
+
+/// [`RayLanes`] twice over in AVX-512 registers (lanes 8–15 repeat lanes 0–7), for
+/// [`nearest_for_rays_pair_avx512`].
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+pub(crate) struct Avx512Rays {
+    o: [std::arch::x86_64::__m512; 3],
+    d: [std::arch::x86_64::__m512; 3],
+    t_min: std::arch::x86_64::__m512,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Avx512Rays {
+    /// The rays of `rays`, each twice.
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+    #[inline]
+    pub(crate) fn new(rays: &AvxRays) -> Avx512Rays {
+        use std::arch::x86_64::_mm512_broadcast_f32x8 as twice;
+        Avx512Rays {
+            o: [twice(rays.o[0]), twice(rays.o[1]), twice(rays.o[2])],
+            d: [twice(rays.d[0]), twice(rays.d[1]), twice(rays.d[2])],
+            t_min: twice(rays.t_min),
+        }
+    }
+}
+
 /// [`RayLanes`] in AVX registers.
 #[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy)]

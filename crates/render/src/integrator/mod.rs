@@ -285,6 +285,6 @@ pub(crate) fn emitted(
 pub(crate) fn escaped(scene: &Scene, ray: &Ray) -> Option<(Rgb, f32)> {
     let index = scene.environment()?;
     let light = &scene.lights()[index as usize];
-    let pdf = scene.light_sampler().pmf(index as usize) * light.pdf_li_towards(ray.d);
-    Some((scene.environment_le(ray.d), pdf))
+    let (le, pdf) = light.le_and_pdf_towards(ray.d);
+    Some((le, scene.light_sampler().pmf(index as usize) * pdf))
 }

@@ -182,10 +182,23 @@ impl EnvironmentMap {
         top * (1.0 - fy) + bottom * fy
     }
 
+    /// The local direction of world direction `w`, and its (u, v).
+    #[inline]
+    fn local(&self, w: Vec3) -> (Vec3, Vec2) {
+        let d = (self.to_local * w).normalize_or_zero();
+        (d, Self::direction_to_uv(d))
+    }
+
     /// Radiance arriving from world direction `w` (pointing into the environment).
     pub fn eval(&self, w: Vec3) -> Rgb {
-        let d = (self.to_local * w).normalize_or_zero();
-        self.eval_uv(Self::direction_to_uv(d))
+        self.eval_uv(self.local(w).1)
+    }
+
+    /// [`EnvironmentMap::eval`] and [`EnvironmentMap::pdf`] of one direction, which find its
+    /// (u, v) once.
+    pub fn eval_and_pdf(&self, w: Vec3) -> (Rgb, f32) {
+        let (d, uv) = self.local(w);
+        (self.eval_uv(uv), self.pdf_local(d, uv))
     }
 
     /// A world direction, its density per solid angle and the radiance from it.
@@ -207,12 +220,17 @@ impl EnvironmentMap {
 
     /// Density per solid angle with which [`EnvironmentMap::sample`] returns `w`.
     pub fn pdf(&self, w: Vec3) -> f32 {
-        let d = (self.to_local * w).normalize_or_zero();
+        let (d, uv) = self.local(w);
+        self.pdf_local(d, uv)
+    }
+
+    /// [`EnvironmentMap::pdf`] of local direction `d`, whose (u, v) is `uv`.
+    #[inline]
+    fn pdf_local(&self, d: Vec3, uv: Vec2) -> f32 {
         let sin2 = d.x * d.x + d.z * d.z;
         if sin2 <= 0.0 {
             return 0.0;
         }
-        let uv = Self::direction_to_uv(d);
         let a = uv.x - self.half_texel();
         let cell_uv = Vec2::new(a - a.floor(), uv.y);
         self.distribution.pdf(cell_uv) / (2.0 * PI * PI * sin2.sqrt())
@@ -278,6 +296,7 @@ mod tests {
             if let Some((d, pdf, l)) = m.sample(u) {
                 let p = m.pdf(d);
                 assert!((p - pdf).abs() <= 2e-3 * pdf, "{p} vs {pdf}");
+                assert_eq!(m.eval_and_pdf(d), (m.eval(d), p));
                 assert!((m.eval(d) - l).abs().max_element() <= 1e-3 * l.max_element());
             }
         }

@@ -378,6 +378,16 @@ impl Light {
         }
     }
 
+    /// [`Light::le_environment`] and [`Light::pdf_li_towards`] of one direction (an
+    /// environment map finds the direction's place in its image once).
+    #[inline]
+    pub fn le_and_pdf_towards(&self, wi: Vec3) -> (Rgb, f32) {
+        match *self {
+            Light::EnvironmentMap { ref map, .. } => map.eval_and_pdf(wi),
+            _ => (self.le_environment(wi), self.pdf_li_towards(wi)),
+        }
+    }
+
     /// Total emitted power (luminance), for choosing lights.
     pub fn phi(&self) -> f32 {
         match *self {

@@ -12,7 +12,7 @@ use crate::geometry::Ray;
 use crate::shape::Triangle;
 use crate::simd::lanes::F8;
 #[cfg(target_arch = "x86_64")]
-use crate::simd::Avx2;
+use crate::simd::{Avx2, Avx512};
 use glam::Vec3;
 
 /// Where a ray's nearest hit is, before the surface interaction is made from it, and how
@@ -240,6 +240,12 @@ impl Scene {
     /// another than the BVH would. Only for scenes where [`Scene::tests_all_triangles`].
     pub(crate) fn nearest_of_rays(&self, rays: &RayLanes, t_max: F8) -> Nearest {
         #[cfg(target_arch = "x86_64")]
+        if let Some(avx512) = Avx512::detect() {
+            // SAFETY: `nearest_of_rays_avx512` requires AVX-512 F, VL and DQ, AVX2 and FMA,
+            // which `avx512` proves this CPU has. Its body is safe code.
+            return unsafe { self.nearest_of_rays_avx512(avx512, rays, t_max) };
+        }
+        #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = Avx2::detect() {
             // SAFETY: `nearest_of_rays_avx2` requires AVX2 and FMA, which `avx2` proves this
             // CPU has. Its body is safe code.
@@ -261,6 +267,49 @@ impl Scene {
         nearest.lanes()
     }
 
+    /// [`Scene::nearest_of_rays`] with AVX-512: the triangles in pairs, sixteen lanes (two
+    /// triangles against the eight rays) at a time, with the same result as one at a time
+    /// (an odd last triangle is paired with itself).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+    fn nearest_of_rays_avx512(&self, _: Avx512, rays: &RayLanes, t_max: F8) -> Nearest {
+        use crate::accel::{nearest_for_rays_pair_avx512, Avx512Nearest, Avx512Rays, AvxRays};
+        let rays = Avx512Rays::new(&AvxRays::new(rays));
+        let mut nearest = Avx512Nearest::new(t_max);
+        let mut first = None;
+        self.for_each_triangle(|block, lane, slot| match first.take() {
+            None => first = Some((block, lane, slot)),
+            Some(a) => nearest_for_rays_pair_avx512(a, (block, lane, slot), &rays, &mut nearest),
+        });
+        if let Some(a) = first {
+            nearest_for_rays_pair_avx512(a, a, &rays, &mut nearest);
+        }
+        nearest.lanes()
+    }
+
+    /// [`Scene::nearest_of_rays`] at every SIMD level this CPU has (AVX-512, AVX2, then the
+    /// portable lane loops), named, for the tests that compare them.
+    #[cfg(test)]
+    fn nearest_of_rays_each_level(&self, rays: &RayLanes, t_max: F8) -> Vec<(&str, Nearest)> {
+        let mut all = vec![("portable", self.nearest_of_rays_lanes(rays, t_max))];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if let Some(avx2) = Avx2::detect() {
+                // SAFETY: `avx2` proves the features `nearest_of_rays_avx2` requires.
+                all.push(("AVX2", unsafe {
+                    self.nearest_of_rays_avx2(avx2, rays, t_max)
+                }));
+            }
+            if let Some(avx512) = Avx512::detect() {
+                // SAFETY: `avx512` proves the features `nearest_of_rays_avx512` requires.
+                all.push(("AVX-512", unsafe {
+                    self.nearest_of_rays_avx512(avx512, rays, t_max)
+                }));
+            }
+        }
+        all
+    }
+
     #[inline(always)]
     fn nearest_of_rays_lanes(&self, rays: &RayLanes, t_max: F8) -> Nearest {
         let mut nearest = Nearest::new(t_max);
@@ -272,7 +321,7 @@ impl Scene {
 
     /// `f(block, lane, leaf slot)` for every used lane of every leaf block.
     #[inline(always)]
-    fn for_each_triangle(&self, mut f: impl FnMut(&TriBlock, usize, u32)) {
+    fn for_each_triangle<'a>(&'a self, mut f: impl FnMut(&'a TriBlock, usize, u32)) {
         for (block, info) in self.blocks.iter().zip(&self.block_info) {
             for (lane, &slot) in info.slots.iter().enumerate() {
                 if slot != u32::MAX {
@@ -560,10 +609,12 @@ mod tests {
                 rays.t_min.0[i] = ray.t_min;
                 t_max.0[i] = ray.t_max;
             }
-            let all = [
-                scene.nearest_of_rays(&rays, t_max),
-                scene.nearest_of_rays_lanes(&rays, t_max),
-            ];
+            let mut all: Vec<Nearest> = scene
+                .nearest_of_rays_each_level(&rays, t_max)
+                .into_iter()
+                .map(|(_, n)| n)
+                .collect();
+            all.push(scene.nearest_of_rays(&rays, t_max));
             for (i, ray) in each.iter().enumerate() {
                 let mut r = *ray;
                 let bvh = scene.closest_hit(&mut r, RayKind::Indirect);
@@ -596,5 +647,57 @@ mod tests {
             hits > 10_000 && ties < hits / 100,
             "{hits} hits, {ties} ties"
         );
+    }
+
+    #[test]
+    fn every_simd_level_finds_the_same_triangles_to_the_bit() {
+        // Each box twice (every triangle has a twin at exactly its distance, so which of
+        // the two a ray keeps shows the order of the tests) and one triangle more, so that
+        // the AVX-512 pairs end with an odd triangle.
+        let mut desc = boxes();
+        let twins: Vec<MeshDesc> = desc.meshes.clone();
+        desc.meshes.extend(twins);
+        desc.meshes.push(MeshDesc {
+            name: "odd".into(),
+            positions: vec![
+                Vec3::new(-0.9, -0.9, 0.5),
+                Vec3::new(0.9, -0.9, 0.5),
+                Vec3::new(0.0, 0.9, 0.5),
+            ],
+            indices: vec![0, 1, 2],
+            ..Default::default()
+        });
+        let scene = Scene::build(&desc).unwrap();
+        assert!(scene.tests_all_triangles());
+        assert_eq!(scene.triangles.len() % 2, 1);
+        let mut rng = pathlab_mc::rng::Pcg32::new(11, 3);
+        let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+        let bits = |n: &Nearest| [n.t, n.b1, n.b2, n.slot].map(|f| f.0.map(f32::to_bits));
+        let mut hits = 0;
+        for k in 0..3000 {
+            let mut rays = RayLanes::default();
+            let mut t_max = F8::splat(f32::INFINITY);
+            for i in 0..8 {
+                let o = point() * 3.0 - 1.5;
+                let target = if (k + i) % 2 == 0 {
+                    point() * 2.0 - 1.0
+                } else {
+                    point().round() * 2.0 - 1.0
+                };
+                rays.o.set(i, o);
+                rays.d.set(i, target - o);
+                rays.t_min.0[i] = if i % 3 == 0 { 1e-3 } else { 0.0 };
+                if i % 4 == 3 {
+                    t_max.0[i] = 0.7;
+                }
+            }
+            let all = scene.nearest_of_rays_each_level(&rays, t_max);
+            let (_, portable) = &all[0];
+            for (name, n) in &all[1..] {
+                assert_eq!(bits(n), bits(portable), "{name} against the portable lanes");
+            }
+            hits += (0..8).filter(|&i| portable.lane(i).is_some()).count();
+        }
+        assert!(hits > 15_000, "{hits} hits");
     }
 }

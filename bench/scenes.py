@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""pathlab against Mitsuba 3 on every reference scene of crates/scene/tests/data, in one run on
+one machine (bench/run.sh scenes starts it with a venv holding `mitsuba`):
+
+1. speed: samples per second of both renderers on the same scene file at the same resolution,
+   spp and depth (Mitsuba's max_depth is ours + 1), pathlab with the independent sampler as
+   Mitsuba's scenes use; each rate the median of --reps runs, the two renderers taking turns;
+2. equal-time error: Mitsuba renders at --spp and its time is the budget; pathlab, with its
+   default settings (sampler and all), renders at the spp its own measured rate allows in that
+   time; each image's RMSE against the scene's reference (Mitsuba, 16 x 256 spp).
+
+Mitsuba's variant is llvm_ad_rgb (JIT-compiled, as wide as the CPU's vectors: 16 lanes with
+AVX-512); its first render of each configuration compiles kernels and is not timed. Each
+Mitsuba measurement runs in a process of its own, gone before pathlab starts (after a render
+Mitsuba's worker threads keep a core busy for seconds)."""
+import argparse, json, os, platform, subprocess, sys, tempfile, time
+import numpy as np
+import mitsuba as mi
+
+if len(sys.argv) > 1 and sys.argv[1] == "--mitsuba-child":
+    # One timed Mitsuba render: VARIANT SCENE MAX_DEPTH SPP OUT.npy; prints the seconds.
+    _, _, variant, scene_path, max_depth, spp, out = sys.argv
+    mi.set_variant(variant)
+    scene = mi.load_file(scene_path, spp=int(spp), max_depth=int(max_depth))
+    mi.render(scene, spp=int(spp), seed=1)  # compiles the kernels
+    start = time.perf_counter()
+    img = np.array(mi.render(scene, spp=int(spp), seed=2))
+    print(time.perf_counter() - start)
+    np.save(out, img)
+    sys.exit(0)
+
+# (name in the table, folder under crates/scene/tests/data, pathlab -m, reference's depth)
+CASES = [
+    ("cornell-box", "cornell-box", "inf", "inf"),
+    ("cornell-box -m 1", "cornell-box", "1", "2"),
+    ("cornell-rough", "cornell-rough", "inf", "inf"),
+    ("cornell-spheres", "cornell-spheres", "inf", "inf"),
+    ("sky-spheres", "sky-spheres", "inf", "inf"),
+    ("cornell-thinlens", "cornell-thinlens", "inf", "inf"),
+]
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--pathlab", required=True)
+ap.add_argument("--data", required=True, help="crates/scene/tests/data")
+ap.add_argument("--work", required=True)
+ap.add_argument("--spp", type=int, default=256)
+ap.add_argument("--reps", type=int, default=3, help="speed runs per renderer, taken in turns")
+ap.add_argument("--only", nargs="*", help="names of the cases to run (default: all)")
+args = ap.parse_args()
+
+variant = "llvm_ad_rgb"
+try:
+    mi.set_variant(variant)
+except Exception as e:  # no LLVM: the scalar variant, much slower
+    variant = "scalar_rgb"
+    mi.set_variant(variant)
+    print(f"note: llvm_ad_rgb unavailable ({e}); using scalar_rgb", file=sys.stderr)
+
+
+def cpu_line():
+    try:
+        info = open("/proc/cpuinfo").read()
+    except OSError:
+        return platform.processor()
+    model = next((l.split(":", 1)[1].strip() for l in info.splitlines() if l.startswith("model name")), "?")
+    flags = next((l.split(":", 1)[1].split() for l in info.splitlines() if l.startswith("flags")), [])
+    isa = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
+    return f"{model}, {os.cpu_count()} threads, {isa}"
+
+
+def rmse(img, ref):
+    return float(np.sqrt(np.mean((np.asarray(img, dtype=np.float64)[..., :3] - ref) ** 2)))
+
+
+def mitsuba_render(scene, max_depth, spp):
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "img.npy")
+        cmd = [sys.executable, __file__, "--mitsuba-child", variant, scene, str(max_depth), str(spp), out]
+        seconds = float(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+        return seconds, np.load(out)
+
+
+def pathlab_render(scene, depth, extra, name):
+    out = f"{args.work}/{name}.exr"
+    cmd = [args.pathlab, "render", scene, "-m", depth, "-q", "--json", "-o", out] + extra
+    stats = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+    img = np.asarray(mi.Bitmap(out), dtype=np.float64)[..., :3]
+    return stats, img
+
+
+print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; pathlab on all threads; {args.spp} spp;"
+      f" rates are medians of {args.reps} runs taken in turns")
+print(f"{'scene':<18} {'Mitsuba S/s':>12} {'pathlab S/s':>12} {'ratio':>6}   {'Mitsuba RMSE':>12}"
+      f" {'pathlab spp':>11} {'pathlab RMSE':>12} {'RMSE ratio':>10}")
+results = {"cpu": cpu_line(), "variant": variant, "spp": args.spp, "cases": {}}
+for name, folder, depth, ref_depth in CASES:
+    if args.only and name not in args.only:
+        continue
+    scene = os.path.join(args.data, folder, "scene.xml")
+    ref = np.asarray(mi.Bitmap(os.path.join(args.data, folder, f"mean-maxdepth-{ref_depth}.exr")),
+                     dtype=np.float64)[..., :3]
+    pixels = ref.shape[0] * ref.shape[1]
+    mitsuba_depth = -1 if depth == "inf" else int(depth) + 1
+    tag = folder + ("" if depth == "inf" else f"-m{depth}")
+    rates_m, rates_p, times_m, errs_m = [], [], [], []
+    for _ in range(args.reps):
+        t_m, img_m = mitsuba_render(scene, mitsuba_depth, args.spp)
+        rates_m.append(pixels * args.spp / t_m)
+        times_m.append(t_m)
+        errs_m.append(rmse(img_m, ref))
+        stats, _ = pathlab_render(scene, depth, ["-s", str(args.spp), "--sampler", "independent"], f"speed-{tag}")
+        rates_p.append(stats["samples_per_second"])
+    rate_m, rate_p = float(np.median(rates_m)), float(np.median(rates_p))
+    # Equal time: Mitsuba's median time is the budget; pathlab's default settings at the spp
+    # its own rate (measured at the default settings) allows.
+    t_m, e_m = float(np.median(times_m)), float(np.median(errs_m))
+    probe, _ = pathlab_render(scene, depth, ["-s", "16"], f"probe-{tag}")
+    spp_p = max(1, int(t_m * probe["samples_per_second"] / pixels))
+    stats, img = pathlab_render(scene, depth, ["-s", str(spp_p)], f"equal-time-{tag}")
+    e_p = rmse(img, ref)
+    results["cases"][name] = {
+        "mitsuba_rate": rate_m, "pathlab_rate": rate_p, "ratio": rate_p / rate_m,
+        "mitsuba_runs": rates_m, "pathlab_runs": rates_p, "mitsuba_seconds": t_m,
+        "mitsuba_rmse": e_m, "pathlab_spp": spp_p, "pathlab_seconds": stats["seconds"],
+        "pathlab_rmse": e_p, "rmse_ratio": e_p / e_m,
+    }
+    print(f"{name:<18} {rate_m:12.3e} {rate_p:12.3e} {rate_p / rate_m:6.2f}   {e_m:12.5f}"
+          f" {spp_p:11d} {e_p:12.5f} {e_p / e_m:10.2f}", flush=True)
+json.dump(results, open(f"{args.work}/scenes.json", "w"), indent=1)
