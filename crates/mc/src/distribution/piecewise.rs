@@ -30,11 +30,15 @@ pub struct DiscreteSample {
     pub u_remapped: f32,
 }
 
+/// CDF entries per block of [`PiecewiseConstant1D`]'s coarse search level (one cache line).
+const CDF_BLOCK: usize = 16;
+
 /// A piecewise-constant density on `[min, max]`: `n` equal pieces with values `f[i]`,
 /// normalised so that it integrates to one.
 ///
 /// Construction builds the CDF (running sums in `f64`, stored in `f32`); sampling inverts it by
-/// binary search for the piece and linear interpolation inside the piece. A function that is
+/// search for the piece (a coarse level of every 16th CDF entry, then one block of 16) and
+/// linear interpolation inside the piece. A function that is
 /// zero everywhere is treated as uniform, so that sampling is always defined.
 ///
 /// ```
@@ -48,6 +52,10 @@ pub struct DiscreteSample {
 pub struct PiecewiseConstant1D {
     func: Vec<f32>,
     cdf: Vec<f32>,
+    /// Every [`CDF_BLOCK`]th CDF entry (`cdf[0]`, `cdf[16]`, ...): the search finds the block
+    /// here, then the entry within one block, so that it touches two or three cache lines of
+    /// a long CDF rather than one per halving.
+    coarse: Vec<f32>,
     min: f32,
     max: f32,
     func_int: f32,
@@ -83,6 +91,7 @@ impl PiecewiseConstant1D {
         cdf[n] = 1.0;
         Ok(PiecewiseConstant1D {
             func: func.to_vec(),
+            coarse: cdf.iter().step_by(CDF_BLOCK).copied().collect(),
             cdf,
             min,
             max,
@@ -124,8 +133,25 @@ impl PiecewiseConstant1D {
     #[inline]
     fn find_piece(&self, u: f32) -> usize {
         // Number of CDF entries <= u, minus one, kept within 0..n.
-        let upper = self.cdf.partition_point(|&c| c <= u);
-        upper.saturating_sub(1).min(self.func.len() - 1)
+        self.cdf_entries_at_most(u)
+            .saturating_sub(1)
+            .min(self.func.len() - 1)
+    }
+
+    /// The number of CDF entries `<= u` (the CDF does not decrease, so they are its first
+    /// ones): the blocks whose first entry is `<= u` from the coarse level, then the entries
+    /// of the last of them. The same count as a binary search over the whole CDF.
+    #[inline]
+    fn cdf_entries_at_most(&self, u: f32) -> usize {
+        let blocks = self.coarse.partition_point(|&c| c <= u);
+        if blocks == 0 {
+            return 0;
+        }
+        // Entry `CDF_BLOCK * (blocks - 1)` is <= u and entry `CDF_BLOCK * blocks` (if any)
+        // is not: count the ones between.
+        let first = CDF_BLOCK * (blocks - 1) + 1;
+        let end = (CDF_BLOCK * blocks).min(self.cdf.len());
+        first + self.cdf[first..end].iter().filter(|&&c| c <= u).count()
     }
 
     /// Density of piece `o` with respect to x.
@@ -299,5 +325,39 @@ impl PiecewiseConstant2D {
             self.conditional[v].invert_sample(p.x),
             self.marginal.invert_sample(p.y),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Pcg32;
+
+    #[test]
+    fn the_two_level_search_counts_what_a_binary_search_counts() {
+        let mut rng = Pcg32::new(3, 7);
+        for n in [1, 2, 15, 16, 17, 31, 32, 33, 255, 256, 512, 1000] {
+            // Runs of zero pieces (flat CDF stretches), a few large pieces and small ones.
+            let func: Vec<f32> = (0..n)
+                .map(|i| match rng.uniform_f32() {
+                    x if x < 0.3 => 0.0,
+                    x if x < 0.35 => 1e4 * x,
+                    x => x * (i % 7) as f32,
+                })
+                .collect();
+            let d = PiecewiseConstant1D::new(&func, 0.0, 1.0).unwrap();
+            let mut us: Vec<f32> = vec![0.0, 1.0, 1.0f32.next_down(), -0.0, f32::NAN];
+            for &c in d.cdf() {
+                us.extend([c, c.next_up(), c.next_down()]);
+            }
+            us.extend((0..2000).map(|_| rng.uniform_f32()));
+            for u in us {
+                assert_eq!(
+                    d.cdf_entries_at_most(u),
+                    d.cdf().partition_point(|&c| c <= u),
+                    "n = {n}, u = {u}"
+                );
+            }
+        }
     }
 }
