@@ -22,8 +22,8 @@ if len(sys.argv) > 1 and sys.argv[1] == "--mitsuba-child":
     _, _, variant, scene_path, max_depth, spp, out = sys.argv
     mi.set_variant(variant)
     scene = mi.load_file(scene_path, spp=int(spp), max_depth=int(max_depth))
-    # Seeds far from those of the reference images (16 runs, seeds from 0 up), so that the
-    # timed image is no part of the reference its error is measured against.
+    # Seeds far from the small ones the reference images' 16 runs may have used, so that the
+    # timed image is not one of the runs its error is measured against.
     mi.render(scene, spp=int(spp), seed=1_000_001)  # compiles the kernels
     start = time.perf_counter()
     img = np.array(mi.render(scene, spp=int(spp), seed=1_000_002))
