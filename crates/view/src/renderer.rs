@@ -99,8 +99,8 @@ impl Shared {
 
 /// Renders `desc` until `shared.stop`, publishing each pass.
 pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
-    let mut last_exposure = f32::NAN;
-    let mut last_display = String::new();
+    // What the last frame showed: its controls and the pixels it carried.
+    let mut shown: Option<(Controls, Vec<[u32; 2]>)> = None;
     let mut last_film: Option<(u64, u32, Film, f64)> = None;
     while !shared.stop.load(Ordering::SeqCst) {
         shared.restart.store(false, Ordering::SeqCst);
@@ -109,12 +109,13 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
             return;
         };
         if let Some((g, spp, film, rate)) = &last_film {
-            // The image is done: only a new exposure is worth a frame.
+            // The image is done: only a new display (exposure, heat map) or a newly inspected
+            // pixel is worth a frame.
             if *g == generation {
-                if (controls.exposure, &controls.display) != (last_exposure, &last_display) {
-                    last_exposure = controls.exposure;
-                    last_display = controls.display.clone();
-                    publish(shared, film, *g, *spp, *rate, &controls);
+                let now = (controls, inspected_pixels(shared));
+                if shown.as_ref() != Some(&now) {
+                    publish(shared, film, *g, *spp, *rate, &now.0);
+                    shown = Some(now);
                 }
                 std::thread::sleep(Duration::from_millis(20));
                 continue;
@@ -144,17 +145,25 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
                     .map(|c| c.clone())
                     .unwrap_or_default();
                 publish(shared, film, generation, done, rate, &now);
+                shown = Some((now, inspected_pixels(shared)));
             },
         );
         if !stats.cancelled {
             let rate = stats.samples as f64 / start.elapsed().as_secs_f64().max(1e-9);
-            last_exposure = controls.exposure;
-            last_display = controls.display.clone();
             last_film = Some((generation, done, film, rate));
         } else {
             last_film = None;
         }
     }
+}
+
+/// The pixels pages inspect.
+fn inspected_pixels(shared: &Shared) -> Vec<[u32; 2]> {
+    shared
+        .inspected
+        .lock()
+        .map(|set| set.keys().copied().collect())
+        .unwrap_or_default()
 }
 
 /// Sends `film` as a frame, drawn as `c.display` says.
@@ -170,15 +179,10 @@ fn publish(shared: &Shared, film: &Film, generation: u64, spp: u32, rate: f64, c
         mean: [mean.x, mean.y, mean.z],
         controls: Some(c.clone()),
         display_range,
-        inspected: shared
-            .inspected
-            .lock()
-            .map(|set| {
-                set.keys()
-                    .map(|&[x, y]| ([x, y], *film.pixel(x, y)))
-                    .collect()
-            })
-            .unwrap_or_default(),
+        inspected: inspected_pixels(shared)
+            .into_iter()
+            .map(|[x, y]| ([x, y], *film.pixel(x, y)))
+            .collect(),
         rgba: Arc::new(rgba),
     }));
 }

@@ -74,10 +74,16 @@ fn get_page(addr: SocketAddr) -> String {
     out
 }
 
-#[test]
-fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
+/// A server on the built-in Cornell box at `size`: its address, its stop flag and its thread.
+fn start(
+    size: u32,
+) -> (
+    SocketAddr,
+    Arc<AtomicBool>,
+    std::thread::JoinHandle<anyhow::Result<()>>,
+) {
     let mut desc = pathlab_scene::builtin::load("cornell-box").unwrap();
-    desc.resolution = [48, 48];
+    desc.resolution = [size, size];
     let stop = Arc::new(AtomicBool::new(false));
     let (tx, rx) = std::sync::mpsc::channel();
     let server = {
@@ -92,6 +98,12 @@ fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
         })
     };
     let addr = rx.recv_timeout(Duration::from_secs(60)).unwrap();
+    (addr, stop, server)
+}
+
+#[test]
+fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
+    let (addr, stop, server) = start(48);
     assert!(addr.ip().is_loopback());
     let page = get_page(addr);
     assert!(page.starts_with("HTTP/1.1 200"), "{page}");
@@ -188,6 +200,31 @@ fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
             el < 0.75 * eh,
             "relative error: light {el}, hemisphere {eh}"
         );
+    });
+    stop.store(true, Ordering::SeqCst);
+    server.join().unwrap().unwrap();
+}
+
+#[test]
+fn a_finished_image_is_sent_again_for_a_new_display_or_inspected_pixel() {
+    // 2 x 2 pixels reach the last pass quickly; then the render waits for a change.
+    let (addr, stop, server) = start(2);
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/ws"))
+            .await
+            .unwrap();
+        let max = pathlab_view::renderer::MAX_SPP as u64;
+        frame_where(&mut ws, |s| s["spp"].as_u64() == Some(max)).await;
+        send(&mut ws, r#"{"inspect": [1, 1]}"#).await;
+        let inspected = frame_where(&mut ws, |s| s["pixel"].is_object()).await;
+        assert_eq!(inspected.stats["pixel"]["samples"].as_u64(), Some(max));
+        send(&mut ws, r#"{"exposure": 2}"#).await;
+        let brighter = frame_where(&mut ws, |s| s["controls"]["exposure"] == 2.0).await;
+        assert_eq!(brighter.stats["generation"], inspected.stats["generation"]);
     });
     stop.store(true, Ordering::SeqCst);
     server.join().unwrap().unwrap();
