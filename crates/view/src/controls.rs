@@ -3,7 +3,7 @@
 
 use glam::{Mat3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::desc::CameraDesc;
+use pathlab_render::desc::{CameraDesc, RenderHints};
 use pathlab_render::integrator::{
     DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
 };
@@ -36,6 +36,8 @@ pub struct Controls {
     pub orbit: [f32; 2],
     /// The camera's distance to its target relative to the scene's.
     pub zoom: f32,
+    /// Whether camera rays do not see emitters (the scene's choice; not switchable).
+    pub hide_emitters: bool,
 }
 
 impl Default for Controls {
@@ -52,11 +54,25 @@ impl Default for Controls {
             display: "image".into(),
             orbit: [0.0, 0.0],
             zoom: 1.0,
+            hide_emitters: false,
         }
     }
 }
 
 impl Controls {
+    /// The defaults, with what the scene file asks for: its largest bounce (an unbounded one
+    /// as 1000, the most the page offers), Russian-roulette depth, sampler and hidden emitters.
+    pub fn for_scene(hints: &RenderHints) -> Controls {
+        let d = Controls::default();
+        Controls {
+            max_depth: hints.max_depth.map_or(d.max_depth, |m| m.clamp(1, 1000)),
+            rr_depth: hints.rr_depth.map_or(d.rr_depth, |r| r.min(1000)),
+            sampler: hints.sampler.unwrap_or(d.sampler),
+            hide_emitters: hints.hide_emitters,
+            ..d
+        }
+    }
+
     /// Applies a message of the page: a JSON object of settings (`integrator`, `direct`,
     /// `max_depth`, `sampler`, `exposure`, `display`), an `orbit` step `[yaw, pitch]` in
     /// degrees or a `zoom` factor. Returns whether the image must restart (the exposure and
@@ -179,6 +195,7 @@ impl Controls {
             "direct" => IntegratorKind::Direct(DirectIntegrator {
                 strategy: self.direct,
                 samples: self.light_samples,
+                hide_emitters: self.hide_emitters,
                 ..Default::default()
             }),
             "normals" => IntegratorKind::Debug(DebugView::Normals),
@@ -189,6 +206,7 @@ impl Controls {
                 rr_depth: self.rr_depth,
                 only_bounce: self.only_bounce,
                 light_samples: self.light_samples,
+                hide_emitters: self.hide_emitters,
                 ..Default::default()
             }),
         }
@@ -271,6 +289,35 @@ mod tests {
         ));
         assert!(c.apply(r#"{"light_samples": 0}"#).is_err());
         assert!(c.apply(r#"{"integrator": "bdpt"}"#).is_err());
+    }
+
+    #[test]
+    fn a_scenes_depth_sampler_and_hidden_emitters_are_the_starting_controls() {
+        let hints = RenderHints {
+            max_depth: Some(3),
+            rr_depth: Some(2),
+            sampler: Some(SamplerKind::Sobol),
+            hide_emitters: true,
+            ..Default::default()
+        };
+        let c = Controls::for_scene(&hints);
+        assert_eq!(
+            (c.max_depth, c.rr_depth, c.sampler),
+            (3, 2, SamplerKind::Sobol)
+        );
+        match c.integrator() {
+            IntegratorKind::Path(p) => assert!(p.hide_emitters && p.max_depth == 3),
+            other => panic!("{other:?}"),
+        }
+        let unbounded = RenderHints {
+            max_depth: Some(u32::MAX),
+            ..Default::default()
+        };
+        assert_eq!(Controls::for_scene(&unbounded).max_depth, 1000);
+        assert_eq!(
+            Controls::for_scene(&RenderHints::default()),
+            Controls::default()
+        );
     }
 
     #[test]

@@ -54,7 +54,7 @@ pub fn serve(
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let (frames, _) = watch::channel(Arc::new(Frame::default()));
     let shared = Arc::new(Shared {
-        controls: Mutex::new(controls::Controls::default()),
+        controls: Mutex::new(controls::Controls::for_scene(&desc.hints)),
         generation: AtomicU64::new(0),
         restart: AtomicBool::new(false),
         stop: AtomicBool::new(false),
