@@ -114,7 +114,7 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
             if *g == generation {
                 let now = (controls, inspected_pixels(shared));
                 if shown.as_ref() != Some(&now) {
-                    publish(shared, film, *g, *spp, *rate, &now.0);
+                    publish(shared, film, *g, *spp, *rate, &now.0, &now.1);
                     shown = Some(now);
                 }
                 std::thread::sleep(Duration::from_millis(20));
@@ -144,8 +144,11 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
                     .lock()
                     .map(|c| c.clone())
                     .unwrap_or_default();
-                publish(shared, film, generation, done, rate, &now);
-                shown = Some((now, inspected_pixels(shared)));
+                // `shown` is what this frame carries: a pixel inspected after the set was
+                // read gets a frame of its own once the image is done.
+                let pixels = inspected_pixels(shared);
+                publish(shared, film, generation, done, rate, &now, &pixels);
+                shown = Some((now, pixels));
             },
         );
         if !stats.cancelled {
@@ -166,8 +169,16 @@ fn inspected_pixels(shared: &Shared) -> Vec<[u32; 2]> {
         .unwrap_or_default()
 }
 
-/// Sends `film` as a frame, drawn as `c.display` says.
-fn publish(shared: &Shared, film: &Film, generation: u64, spp: u32, rate: f64, c: &Controls) {
+/// Sends `film` as a frame, drawn as `c.display` says, with the statistics of `pixels`.
+fn publish(
+    shared: &Shared,
+    film: &Film,
+    generation: u64,
+    spp: u32,
+    rate: f64,
+    c: &Controls,
+    pixels: &[[u32; 2]],
+) {
     let (rgba, display_range) = draw(film, c);
     let mean = film.image_mean();
     shared.frames.send_replace(Arc::new(Frame {
@@ -179,9 +190,9 @@ fn publish(shared: &Shared, film: &Film, generation: u64, spp: u32, rate: f64, c
         mean: [mean.x, mean.y, mean.z],
         controls: Some(c.clone()),
         display_range,
-        inspected: inspected_pixels(shared)
-            .into_iter()
-            .map(|[x, y]| ([x, y], *film.pixel(x, y)))
+        inspected: pixels
+            .iter()
+            .map(|&[x, y]| ([x, y], *film.pixel(x, y)))
             .collect(),
         rgba: Arc::new(rgba),
     }));
