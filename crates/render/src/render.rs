@@ -140,6 +140,39 @@ pub fn sample_pixel(
     (ok, bad)
 }
 
+/// The radiance of each of the samples with indices `range` of pixel `pixel`, in order: the
+/// samples a render with `sampler` built for `spp` samples and `seed` adds to that pixel (a
+/// NaN or infinite one as black, as the film adds it). For looking at one pixel's samples
+/// (their histogram, their split by bounce) beside its film statistics.
+pub fn pixel_sample_values(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    (sampler, spp, seed): (SamplerKind, u32, u64),
+    pixel: [u32; 2],
+    range: std::ops::Range<u32>,
+) -> Vec<crate::desc::Rgb> {
+    let mut sampler = sampler.build(spp, seed);
+    let mut values = vec![crate::desc::Rgb::ZERO; range.len()];
+    let first = range.start;
+    let mut samples = range.map(|index| SampleRef {
+        pixel,
+        index,
+        tag: index - first,
+    });
+    integrator.li_samples(
+        scene,
+        &mut sampler,
+        &mut samples,
+        &mut |tag, l| {
+            if l.is_finite() {
+                values[tag as usize] = l;
+            }
+        },
+        &mut PathStats::default(),
+    );
+    values
+}
+
 /// Adds radiance `l` to `px` when it is finite (counting it in `ok`); a NaN or infinite
 /// sample is added as black and counted in `bad` (as pbrt does), so that a pixel's count is
 /// always the number of its sample indices done.

@@ -268,3 +268,39 @@ fn progressive_and_adaptive_renders_resume_to_the_same_film_to_the_bit() {
     .0;
     assert!(resumed == whole, "resumed adaptive film differs");
 }
+
+#[test]
+fn one_pixels_sample_values_are_the_samples_its_film_pixel_sums() {
+    // A pixel's samples one by one (the viewer's histogram) sum to what the render put in
+    // the pixel, exactly, for the default path tracer (eight paths at a time) and with the
+    // Sobol sampler, starting at any sample index.
+    let scene = Scene::build(&big_light()).unwrap();
+    let settings = RenderSettings::new(32, 7, SamplerKind::Sobol);
+    let (film, _) = render(
+        &scene,
+        &path(u32::MAX),
+        &settings,
+        &|_| {},
+        &Default::default(),
+    );
+    for pixel in [[0, 0], [3, 5], [7, 7]] {
+        let values = pathlab_render::render::pixel_sample_values(
+            &scene,
+            &path(u32::MAX),
+            (SamplerKind::Sobol, 32, 7),
+            pixel,
+            0..32,
+        );
+        let mut stats = pathlab_render::film::PixelStats::default();
+        values.iter().for_each(|&l| stats.add(l));
+        assert_eq!(&stats, film.pixel(pixel[0], pixel[1]), "pixel {pixel:?}");
+        let later = pathlab_render::render::pixel_sample_values(
+            &scene,
+            &path(u32::MAX),
+            (SamplerKind::Sobol, 32, 7),
+            pixel,
+            20..32,
+        );
+        assert_eq!(later, values[20..]);
+    }
+}

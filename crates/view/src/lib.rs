@@ -11,6 +11,7 @@
 //! holds up the render.
 
 pub mod controls;
+pub mod probe;
 pub mod renderer;
 
 use anyhow::{Context, Result};
@@ -144,7 +145,21 @@ fn pixel_json(frame: &Frame, p: [u32; 2]) -> Option<serde_json::Value> {
     let (_, stats) = frame.inspected.iter().find(|(q, _)| *q == p)?;
     let l = stats.luminance();
     let half = 1.96 * l.std_error();
+    let probe = frame
+        .probes
+        .iter()
+        .find(|(q, _)| *q == p)
+        .map(|(_, probe)| {
+            json!({
+                "samples": probe.samples,
+                "zero": probe.zero,
+                "log10_range": probe.log10_range,
+                "counts": probe.counts,
+                "bounces": probe.bounces,
+            })
+        });
     Some(json!({
+        "probe": probe,
         "x": p[0],
         "y": p[1],
         "samples": stats.count(),

@@ -3,6 +3,7 @@
 //! a change of the controls stops the pass under way and starts the image again.
 
 use crate::controls::Controls;
+use crate::probe::{probe, probe_size, Probe};
 use pathlab_render::camera::Camera;
 use pathlab_render::color::luminance_f64;
 use pathlab_render::desc::SceneDesc;
@@ -12,7 +13,7 @@ use pathlab_render::image_io::srgb_encode;
 use pathlab_render::progressive::estimated_relative_rmse;
 use pathlab_render::render::{render_from, RenderSettings};
 use pathlab_render::scene::Scene;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -20,6 +21,12 @@ use tokio::sync::watch;
 
 /// Samples per pixel at which an image is done (it then waits for a change).
 pub const MAX_SPP: u32 = 65536;
+
+/// An inspected pixel and its probe.
+pub type PixelProbe = ([u32; 2], Arc<Probe>);
+
+/// The seed of every image.
+const SEED: u64 = 0;
 
 /// One finished pass, as the page gets it.
 #[derive(Clone, Debug, Default)]
@@ -42,6 +49,8 @@ pub struct Frame {
     pub display_range: [f64; 2],
     /// The statistics of the pixels pages inspect.
     pub inspected: Vec<([u32; 2], PixelStats)>,
+    /// The histograms and bounce splits of the pixels pages inspect.
+    pub probes: Vec<PixelProbe>,
     /// sRGB pixels, four bytes each (alpha 255), rows from the top.
     pub rgba: Arc<Vec<u8>>,
 }
@@ -102,6 +111,7 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
     // What the last frame showed: its controls and the pixels it carried.
     let mut shown: Option<(Controls, Vec<[u32; 2]>)> = None;
     let mut last_film: Option<(u64, u32, Film, f64)> = None;
+    let mut probes = Probes::default();
     while !shared.stop.load(Ordering::SeqCst) {
         shared.restart.store(false, Ordering::SeqCst);
         let generation = shared.generation.load(Ordering::SeqCst);
@@ -114,7 +124,8 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
             if *g == generation {
                 let now = (controls, inspected_pixels(shared));
                 if shown.as_ref() != Some(&now) {
-                    publish(shared, film, *g, *spp, *rate, &now.0, &now.1);
+                    let probed = probes.of(&scene, &now.0, *g, film, &now.1);
+                    publish(shared, film, *g, *spp, *rate, &now.0, (&now.1, probed));
                     shown = Some(now);
                 }
                 std::thread::sleep(Duration::from_millis(20));
@@ -125,7 +136,7 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
             Camera::new(&controls.camera(&desc.camera), desc.resolution).with_filter(desc.filter);
         scene.set_camera(camera);
         let integrator = controls.integrator();
-        let settings = RenderSettings::new(MAX_SPP, 0, controls.sampler);
+        let settings = RenderSettings::new(MAX_SPP, SEED, controls.sampler);
         let [w, h] = desc.resolution;
         let start = Instant::now();
         let mut done = 0u32;
@@ -147,7 +158,16 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
                 // `shown` is what this frame carries: a pixel inspected after the set was
                 // read gets a frame of its own once the image is done.
                 let pixels = inspected_pixels(shared);
-                publish(shared, film, generation, done, rate, &now, &pixels);
+                let probed = probes.of(&scene, &controls, generation, film, &pixels);
+                publish(
+                    shared,
+                    film,
+                    generation,
+                    done,
+                    rate,
+                    &now,
+                    (&pixels, probed),
+                );
                 shown = Some((now, pixels));
             },
         );
@@ -169,7 +189,47 @@ fn inspected_pixels(shared: &Shared) -> Vec<[u32; 2]> {
         .unwrap_or_default()
 }
 
-/// Sends `film` as a frame, drawn as `c.display` says, with the statistics of `pixels`.
+/// The probes of inspected pixels, each kept until its image changes or its pixel holds
+/// twice the samples it was made from.
+#[derive(Default)]
+struct Probes {
+    made: HashMap<[u32; 2], (u64, u32, Arc<Probe>)>,
+}
+
+impl Probes {
+    /// The probes of `pixels` in image `generation` (rendered with `c`), made where missing.
+    fn of(
+        &mut self,
+        scene: &Scene,
+        c: &Controls,
+        generation: u64,
+        film: &Film,
+        pixels: &[[u32; 2]],
+    ) -> Vec<PixelProbe> {
+        self.made.retain(|p, _| pixels.contains(p));
+        pixels
+            .iter()
+            .map(|&[x, y]| {
+                let n = probe_size(film.pixel(x, y).count() as u32);
+                let entry = self
+                    .made
+                    .entry([x, y])
+                    .or_insert((u64::MAX, 0, Arc::default()));
+                if (entry.0, entry.1) != (generation, n) {
+                    *entry = (
+                        generation,
+                        n,
+                        Arc::new(probe(scene, c, (MAX_SPP, SEED), [x, y], n)),
+                    );
+                }
+                ([x, y], Arc::clone(&entry.2))
+            })
+            .collect()
+    }
+}
+
+/// Sends `film` as a frame, drawn as `c.display` says, with the statistics and probes of the
+/// inspected pixels.
 fn publish(
     shared: &Shared,
     film: &Film,
@@ -177,7 +237,7 @@ fn publish(
     spp: u32,
     rate: f64,
     c: &Controls,
-    pixels: &[[u32; 2]],
+    (pixels, probes): (&[[u32; 2]], Vec<PixelProbe>),
 ) {
     let (rgba, display_range) = draw(film, c);
     let mean = film.image_mean();
@@ -194,6 +254,7 @@ fn publish(
             .iter()
             .map(|&[x, y]| ([x, y], *film.pixel(x, y)))
             .collect(),
+        probes,
         rgba: Arc::new(rgba),
     }));
 }

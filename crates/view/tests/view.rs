@@ -166,6 +166,14 @@ fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
             p["ci95"][1].as_f64().unwrap(),
         );
         assert!(lo <= mean && mean <= hi && mean > 0.0, "{p}");
+        // Its first samples' histogram (every one counted once) and their split by bounce.
+        let probe = &p["probe"];
+        let n = probe["samples"].as_u64().unwrap();
+        assert!(n >= 1 && n <= p["samples"].as_u64().unwrap(), "{p}");
+        let counts = probe["counts"].as_array().unwrap().iter();
+        let counted = counts.map(|c| c.as_u64().unwrap()).sum::<u64>();
+        assert_eq!(counted + probe["zero"].as_u64().unwrap(), n);
+        assert!(!probe["bounces"].as_array().unwrap().is_empty());
         send(&mut ws, r#"{"inspect": [48, 0]}"#).await;
         assert!(error_reply(&mut ws)
             .await

@@ -74,7 +74,7 @@ def page(server):
         "--disable-component-update",
         "--disable-sync",
         "--no-first-run",
-        "--window-size=1200,900",
+        "--window-size=1200,1150",
     ):
         options.add_argument(flag)
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
@@ -196,6 +196,8 @@ def test_a_clicked_pixels_interval_holds_its_value(page, shots, tmp_path):
     px, py = int(where.group(1)), int(where.group(2))
     assert abs(px - x) <= 1 and abs(py - y) <= 1, f"clicked ({x}, {y}), the page took ({px}, {py})"
     x, y = px, py
+    hist = page.find_element(By.ID, "hist_text").text
+    assert re.match(r"histogram of the luminance of the first \d+ samples", hist), hist
     page.save_screenshot(os.path.join(shots, "view-inspector.png"))
     lo, hi = float(m.group(3)), float(m.group(4))
     # The pixel's value: the same estimator over 16384 samples, the pixel alone rendered (the
@@ -207,4 +209,12 @@ def test_a_clicked_pixels_interval_holds_its_value(page, shots, tmp_path):
     rgb = [c * SIZE * SIZE for c in json.loads(report)["image_mean_rgb"]]
     value = sum(w * c for w, c in zip(LUMINANCE, rgb))
     assert lo <= value <= hi, f"pixel ({x}, {y}): {value} outside [{lo}, {hi}] ({text})"
+    # The path tracer splits the pixel's light by bounce.
+    Select(page.find_element(By.ID, "integrator")).select_by_value("path")
+    end = time.time() + 60
+    while page.find_element(By.ID, "bounces").get_attribute("hidden") is not None:
+        assert time.time() < end, "no bounce split for the path tracer"
+        time.sleep(0.05)
+    wait_for(page, lambda s: s[0] >= 256, "256 spp of the path tracer")
+    page.save_screenshot(os.path.join(shots, "view-bounces.png"))
     assert not js_errors(page)
