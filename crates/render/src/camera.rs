@@ -150,6 +150,25 @@ impl Camera {
         self.clip(Ray::new(o, d), d.dot(self.forward))
     }
 
+    /// The film position (pixel units, as [`Camera::film_position`] gives them) where world
+    /// point `p` appears: the inverse of [`Camera::generate_ray`] through the lens's centre.
+    /// `None` behind a perspective camera or for a non-finite point.
+    pub fn raster_position(&self, p: Vec3) -> Option<Vec2> {
+        let v = p - self.origin;
+        let (x, y, z) = (v.dot(self.right), v.dot(self.up), v.dot(self.forward));
+        let ndc = if self.orthographic {
+            Vec2::new(x / self.half.x, y / self.half.y)
+        } else {
+            if z <= 0.0 {
+                return None;
+            }
+            Vec2::new(x / (z * self.half.x), y / (z * self.half.y))
+        } - self.shift;
+        let [w, h] = self.resolution.map(|r| r as f32);
+        let film = Vec2::new((ndc.x + 1.0) * 0.5 * w, (1.0 - ndc.y) * 0.5 * h);
+        film.is_finite().then_some(film)
+    }
+
     /// `ray` limited to the depths between the near and far clipping planes (`cos`: the cosine
     /// between the ray and the viewing direction).
     #[inline]
@@ -257,6 +276,40 @@ impl FilterSampler {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn raster_positions_invert_camera_rays() {
+        let mut desc = CameraDesc {
+            origin: Vec3::new(0.3, 0.5, 3.9),
+            target: Vec3::new(0.0, 0.2, 0.0),
+            up: Vec3::Y,
+            fov_degrees: 50.0,
+            principal_point_offset: Vec2::new(0.1, -0.05),
+            ..Default::default()
+        };
+        let ortho = Projection::Orthographic {
+            half_extent: Vec2::new(2.0, 1.2),
+        };
+        for projection in [Projection::Perspective, ortho] {
+            desc.projection = projection;
+            let cam = Camera::new(&desc, [160, 90]);
+            for film in [
+                Vec2::new(0.0, 0.0),
+                Vec2::new(80.0, 45.0),
+                Vec2::new(151.3, 7.9),
+            ] {
+                let ray = cam.generate_ray(film, Vec2::ZERO);
+                let back = cam.raster_position(ray.o + 2.5 * ray.d).unwrap();
+                assert!(
+                    (back - film).length() < 1e-3,
+                    "{projection:?}: {film} -> {back}"
+                );
+            }
+        }
+        desc.projection = Projection::Perspective;
+        let cam = Camera::new(&desc, [160, 90]);
+        assert_eq!(cam.raster_position(desc.origin * 2.0 - desc.target), None);
+    }
 
     #[test]
     fn centre_and_corners() {

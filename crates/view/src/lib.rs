@@ -13,6 +13,7 @@
 pub mod controls;
 pub mod probe;
 pub mod renderer;
+pub mod samples;
 
 use anyhow::{Context, Result};
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
@@ -61,6 +62,7 @@ pub fn serve(
         stop: AtomicBool::new(false),
         frames,
         inspected: Mutex::new(Default::default()),
+        sample_view: Mutex::new(None),
     });
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
@@ -169,6 +171,34 @@ fn pixel_json(frame: &Frame, p: [u32; 2]) -> Option<serde_json::Value> {
     }))
 }
 
+/// A page's request to see the samples at a point (`{"samples_at": ...}`), checked against
+/// an image of `size`; `None` for any other message.
+fn samples_request(text: &str, size: [u32; 2]) -> Option<Result<Option<samples::Request>, String>> {
+    let v: serde_json::Value = serde_json::from_str(text).ok()?;
+    let fields = v.as_object()?;
+    fields
+        .contains_key("samples_at")
+        .then(|| samples::Request::parse(fields, size))
+}
+
+/// The samples at a point, as the page draws them.
+fn sample_view_json(v: &samples::SampleView) -> serde_json::Value {
+    json!({
+        "x": v.request.pixel[0],
+        "y": v.request.pixel[1],
+        "strategy": v.request.strategy,
+        "n": v.request.n,
+        "origin": v.origin,
+        "ends": v.samples.iter().map(|s| s.end).collect::<Vec<_>>(),
+        "escaped": v.samples.iter().map(|s| s.escaped).collect::<Vec<_>>(),
+        "weights": v.samples.iter().map(|s| s.weight).collect::<Vec<_>>(),
+        "contributions": v.samples.iter().map(|s| s.contribution).collect::<Vec<_>>(),
+        "estimate": v.estimate,
+        "luminance": v.luminance,
+        "std_error": v.std_error,
+    })
+}
+
 #[derive(Clone)]
 struct AppState {
     shared: Arc<Shared>,
@@ -209,7 +239,15 @@ async fn client(mut socket: WebSocket, shared: Arc<Shared>) {
                             Ok(())
                         }
                         Some(Err(e)) => Err(e),
-                        None => shared.apply(text.as_str()),
+                        None => match samples_request(text.as_str(), size(&frames)) {
+                            Some(Ok(request)) => shared
+                                .sample_view
+                                .lock()
+                                .map(|mut r| *r = request)
+                                .map_err(|_| "the render stopped".to_string()),
+                            Some(Err(e)) => Err(e),
+                            None => shared.apply(text.as_str()),
+                        },
                     };
                     if let Err(e) = handled {
                         let reply = json!({ "error": e }).to_string();
@@ -246,6 +284,7 @@ async fn client(mut socket: WebSocket, shared: Arc<Shared>) {
                     "controls": frame.controls.as_ref().map(|c| c.to_json()),
                     "display_range": frame.display_range,
                     "pixel": inspector.pixel.and_then(|p| pixel_json(&frame, p)),
+                    "sample_view": frame.sample_view.as_deref().map(sample_view_json),
                 });
                 if socket.send(Message::Text(stats.to_string().into())).await.is_err()
                     || socket

@@ -4,6 +4,7 @@
 
 use crate::controls::Controls;
 use crate::probe::{probe, probe_size, Probe};
+use crate::samples::{sample_view, Request, SampleView};
 use pathlab_render::camera::Camera;
 use pathlab_render::color::luminance_f64;
 use pathlab_render::desc::SceneDesc;
@@ -51,6 +52,8 @@ pub struct Frame {
     pub inspected: Vec<([u32; 2], PixelStats)>,
     /// The histograms and bounce splits of the pixels pages inspect.
     pub probes: Vec<PixelProbe>,
+    /// The samples at a point a page asked to see.
+    pub sample_view: Option<Arc<SampleView>>,
     /// sRGB pixels, four bytes each (alpha 255), rows from the top.
     pub rgba: Arc<Vec<u8>>,
 }
@@ -70,6 +73,8 @@ pub struct Shared {
     /// The pixels pages inspect, with how many pages inspect each (each frame carries their
     /// statistics).
     pub inspected: Mutex<BTreeMap<[u32; 2], usize>>,
+    /// The samples at a point a page asked to see (the last request of any page).
+    pub sample_view: Mutex<Option<crate::samples::Request>>,
 }
 
 impl Shared {
@@ -108,8 +113,9 @@ impl Shared {
 
 /// Renders `desc` until `shared.stop`, publishing each pass.
 pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
-    // What the last frame showed: its controls and the pixels it carried.
-    let mut shown: Option<(Controls, Vec<[u32; 2]>)> = None;
+    // What the last frame showed: its controls, the pixels it carried and the samples a
+    // page asked to see.
+    let mut shown: Option<(Controls, Vec<[u32; 2]>, Option<Request>)> = None;
     let mut last_film: Option<(u64, u32, Film, f64)> = None;
     let mut probes = Probes::default();
     while !shared.stop.load(Ordering::SeqCst) {
@@ -122,10 +128,19 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
             // The image is done: only a new display (exposure, heat map) or a newly inspected
             // pixel is worth a frame.
             if *g == generation {
-                let now = (controls, inspected_pixels(shared));
+                let now = (controls, inspected_pixels(shared), requested(shared));
                 if shown.as_ref() != Some(&now) {
                     let probed = probes.of(&scene, &now.0, *g, film, &now.1);
-                    publish(shared, film, *g, *spp, *rate, &now.0, (&now.1, probed));
+                    let view = probes.view(&scene, *g, now.2.as_ref());
+                    publish(
+                        shared,
+                        film,
+                        *g,
+                        *spp,
+                        *rate,
+                        &now.0,
+                        (&now.1, probed, view),
+                    );
                     shown = Some(now);
                 }
                 std::thread::sleep(Duration::from_millis(20));
@@ -157,8 +172,9 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
                     .unwrap_or_default();
                 // `shown` is what this frame carries: a pixel inspected after the set was
                 // read gets a frame of its own once the image is done.
-                let pixels = inspected_pixels(shared);
+                let (pixels, request) = (inspected_pixels(shared), requested(shared));
                 let probed = probes.of(&scene, &controls, generation, film, &pixels);
+                let view = probes.view(&scene, generation, request.as_ref());
                 publish(
                     shared,
                     film,
@@ -166,9 +182,9 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
                     done,
                     rate,
                     &now,
-                    (&pixels, probed),
+                    (&pixels, probed, view),
                 );
-                shown = Some((now, pixels));
+                shown = Some((now, pixels, request));
             },
         );
         if !stats.cancelled {
@@ -178,6 +194,11 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
             last_film = None;
         }
     }
+}
+
+/// The samples at a point a page asked to see.
+fn requested(shared: &Shared) -> Option<Request> {
+    shared.sample_view.lock().ok().and_then(|r| r.clone())
 }
 
 /// The pixels pages inspect.
@@ -194,9 +215,29 @@ fn inspected_pixels(shared: &Shared) -> Vec<[u32; 2]> {
 #[derive(Default)]
 struct Probes {
     made: HashMap<[u32; 2], (u64, u32, Arc<Probe>)>,
+    /// The last sample view made, and for which image.
+    view: Option<(u64, Arc<SampleView>)>,
 }
 
 impl Probes {
+    /// The samples `request` asks to see in image `generation`, made when missing.
+    fn view(
+        &mut self,
+        scene: &Scene,
+        generation: u64,
+        request: Option<&Request>,
+    ) -> Option<Arc<SampleView>> {
+        let request = request?;
+        match &self.view {
+            Some((g, v)) if *g == generation && &v.request == request => Some(Arc::clone(v)),
+            _ => {
+                let v = Arc::new(sample_view(scene, request));
+                self.view = Some((generation, Arc::clone(&v)));
+                Some(v)
+            }
+        }
+    }
+
     /// The probes of `pixels` in image `generation` (rendered with `c`), made where missing.
     fn of(
         &mut self,
@@ -237,7 +278,7 @@ fn publish(
     spp: u32,
     rate: f64,
     c: &Controls,
-    (pixels, probes): (&[[u32; 2]], Vec<PixelProbe>),
+    (pixels, probes, sample_view): (&[[u32; 2]], Vec<PixelProbe>, Option<Arc<SampleView>>),
 ) {
     let (rgba, display_range) = draw(film, c);
     let mean = film.image_mean();
@@ -255,6 +296,7 @@ fn publish(
             .map(|&[x, y]| ([x, y], *film.pixel(x, y)))
             .collect(),
         probes,
+        sample_view,
         rgba: Arc::new(rgba),
     }));
 }

@@ -4,9 +4,10 @@
 
 use super::{emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats};
 use crate::desc::{RayKind, Rgb};
+use crate::geometry::Frame;
 use crate::geometry::{spawn_ray, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use pathlab_mc::sampler::{AnySampler, Sampler};
 use pathlab_mc::warp::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere,
@@ -96,20 +97,51 @@ impl DirectIntegrator {
         f_cos: Rgb,
         pdf: f32,
         stats: &mut PathStats,
-    ) -> (Rgb, Option<f32>) {
+    ) -> Gathered {
         if f_cos.max_element() <= 0.0 || pdf <= 0.0 {
-            return (Rgb::ZERO, None);
+            return Gathered::default();
         }
         let ray = spawn_ray(si.p, si.ng, wi);
-        let found = match trace(scene, &ray, RayKind::Indirect, stats) {
-            Some(hit) => emitted(scene, si.p, &ray, &hit),
+        let hit = trace(scene, &ray, RayKind::Indirect, stats);
+        let found = match &hit {
+            Some(hit) => emitted(scene, si.p, &ray, hit),
             None => escaped(scene, &ray),
         };
+        let end = hit.map(|h| h.p);
         match found {
-            Some((le, pdf_light)) => (f_cos * le / pdf, Some(pdf_light)),
-            None => (Rgb::ZERO, None),
+            Some((le, pdf_light)) => Gathered {
+                l: f_cos * le / pdf,
+                pdf_light: Some(pdf_light),
+                end,
+            },
+            None => Gathered {
+                end,
+                ..Gathered::default()
+            },
         }
     }
+
+    /// A direction of the uniform (`Hemisphere`) or cosine-weighted (`Cosine`) hemisphere
+    /// about `frame`'s normal from `u`, and its density.
+    fn hemisphere_direction(cosine: bool, frame: &Frame, u: Vec2) -> (Vec3, f32) {
+        let (w, pdf) = if cosine {
+            let w = sample_cosine_hemisphere(u);
+            (w, cosine_hemisphere_pdf(w.z))
+        } else {
+            (sample_uniform_hemisphere(u), uniform_hemisphere_pdf())
+        };
+        (frame.to_world(w), pdf)
+    }
+}
+
+/// What a direction drawn at a surface point found: `f |cos| Le / pdf` (zero where no light
+/// was found), the density with which light sampling would have chosen that light, and where
+/// the ray ended (none when it left the scene).
+#[derive(Clone, Copy, Debug, Default)]
+struct Gathered {
+    l: Rgb,
+    pdf_light: Option<f32>,
+    end: Option<Vec3>,
 }
 
 impl Integrator for DirectIntegrator {
@@ -134,16 +166,10 @@ impl Integrator for DirectIntegrator {
         for _ in 0..n {
             match self.strategy {
                 DirectStrategy::Hemisphere | DirectStrategy::Cosine => {
-                    let u = sampler.next_2d();
-                    let (w, pdf) = if self.strategy == DirectStrategy::Hemisphere {
-                        (sample_uniform_hemisphere(u), uniform_hemisphere_pdf())
-                    } else {
-                        let w = sample_cosine_hemisphere(u);
-                        (w, cosine_hemisphere_pdf(w.z))
-                    };
-                    let wi = frame.to_world(w);
+                    let cosine = self.strategy == DirectStrategy::Cosine;
+                    let (wi, pdf) = Self::hemisphere_direction(cosine, &frame, sampler.next_2d());
                     let f_cos = bsdf.f_cos(wo, wi);
-                    sum += Self::gather(scene, &si, wi, f_cos, pdf, stats).0;
+                    sum += Self::gather(scene, &si, wi, f_cos, pdf, stats).l;
                 }
                 DirectStrategy::Light | DirectStrategy::Mis => {
                     let u_select = sampler.next_1d();
@@ -186,8 +212,9 @@ impl DirectIntegrator {
             if i < k {
                 if let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) {
                     let f_cos = bs.f * bs.cos;
-                    let (c, pdf_light) = Self::gather(scene, si, bs.wi, f_cos, bs.pdf, stats);
-                    if let Some(pdf_light) = pdf_light {
+                    let found = Self::gather(scene, si, bs.wi, f_cos, bs.pdf, stats);
+                    let c = found.l;
+                    if let Some(pdf_light) = found.pdf_light {
                         let w = if bs.delta || m == 0 {
                             1.0
                         } else {
@@ -207,4 +234,128 @@ impl DirectIntegrator {
         }
         l
     }
+}
+
+/// How [`direct_samples`] draws directions at a surface point: the course's four ways.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleStrategy {
+    /// Uniformly over the hemisphere about the shading normal.
+    Hemisphere,
+    /// Cosine-weighted over that hemisphere.
+    Cosine,
+    /// From the BSDF.
+    Bsdf,
+    /// A point on a light (chosen by power), with a shadow ray.
+    Light,
+}
+
+impl std::str::FromStr for SampleStrategy {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "hemisphere" => Ok(SampleStrategy::Hemisphere),
+            "cosine" => Ok(SampleStrategy::Cosine),
+            "bsdf" => Ok(SampleStrategy::Bsdf),
+            "light" => Ok(SampleStrategy::Light),
+            _ => Err(format!(
+                "unknown sampling strategy '{s}' (expected hemisphere, cosine, bsdf or light)"
+            )),
+        }
+    }
+}
+
+/// One direct-lighting sample at a surface point, as the course's slides draw it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectSample {
+    /// The direction drawn (world space, away from the point).
+    pub wi: Vec3,
+    /// Where it ends: the surface the ray hits, or the point on the light (light sampling);
+    /// none where the ray leaves the scene.
+    pub end: Option<Vec3>,
+    /// f |cos θ| / pdf: what the light arriving along `wi` is multiplied by (for light
+    /// sampling, pdf includes the probability of choosing the light).
+    pub weight: Rgb,
+    /// The sample's estimate of the reflected direct light: the weight times the light
+    /// that arrives (zero where none does or the shadow ray is blocked).
+    pub contribution: Rgb,
+}
+
+/// `n` direct-lighting samples at `si` (seen from direction `wo`) drawn by `strategy` from
+/// the random numbers of `seed`: each an unbiased estimate of the light the point reflects
+/// towards `wo` directly (their mean is the strategy's `n`-sample estimate). The same
+/// pieces as [`DirectIntegrator`]'s and the path tracer's: the hemisphere warps, the BSDF's
+/// `sample_f`, the light sample of next-event estimation.
+pub fn direct_samples(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    wo: Vec3,
+    strategy: SampleStrategy,
+    n: u32,
+    seed: u64,
+) -> Vec<DirectSample> {
+    let bsdf = scene.bsdf(si, wo);
+    let frame = *bsdf.frame();
+    let mut rng = pathlab_mc::rng::Pcg32::new(seed, 0x5eed);
+    let mut u2 = || Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+    let stats = &mut PathStats::default();
+    (0..n)
+        .map(|_| match strategy {
+            SampleStrategy::Hemisphere | SampleStrategy::Cosine => {
+                let cosine = strategy == SampleStrategy::Cosine;
+                let (wi, pdf) = DirectIntegrator::hemisphere_direction(cosine, &frame, u2());
+                let f_cos = bsdf.f_cos(wo, wi);
+                let found = DirectIntegrator::gather(scene, si, wi, f_cos, pdf, stats);
+                DirectSample {
+                    wi,
+                    end: found.end,
+                    weight: f_cos / pdf,
+                    contribution: found.l,
+                }
+            }
+            SampleStrategy::Bsdf => {
+                let u = u2();
+                match bsdf.sample_f(wo, u.x, u2()) {
+                    Some(bs) => {
+                        let f_cos = bs.f * bs.cos;
+                        let found =
+                            DirectIntegrator::gather(scene, si, bs.wi, f_cos, bs.pdf, stats);
+                        DirectSample {
+                            wi: bs.wi,
+                            end: found.end,
+                            weight: f_cos / bs.pdf,
+                            contribution: found.l,
+                        }
+                    }
+                    None => DirectSample {
+                        wi: Vec3::ZERO,
+                        end: None,
+                        weight: Rgb::ZERO,
+                        contribution: Rgb::ZERO,
+                    },
+                }
+            }
+            SampleStrategy::Light => {
+                let (u_select, u_light) = (u2().x, u2());
+                // The estimate is next-event estimation's own; the point and the weight are
+                // read from the same light sample it draws.
+                let contribution =
+                    sample_light(scene, si, &bsdf, wo, u_select, u_light, 1, 0, stats);
+                let sample = scene.light_sampler().sample(u_select).and_then(|(i, pmf)| {
+                    let ls = scene.lights()[i].sample_li(si.p, u_light)?;
+                    Some((ls.wi, ls.p_light, bsdf.f_cos(wo, ls.wi) / (pmf * ls.pdf)))
+                });
+                let (wi, end, weight) = match sample {
+                    Some((wi, p, w)) if w.is_finite() => (wi, Some(p), w),
+                    Some((wi, p, _)) => (wi, Some(p), Rgb::ZERO),
+                    None => (Vec3::ZERO, None, Rgb::ZERO),
+                };
+                DirectSample {
+                    wi,
+                    end,
+                    weight,
+                    contribution,
+                }
+            }
+        })
+        .collect()
 }

@@ -13,7 +13,7 @@ mod packet;
 mod path;
 
 pub use debug::DebugView;
-pub use direct::{DirectIntegrator, DirectStrategy};
+pub use direct::{direct_samples, DirectIntegrator, DirectSample, DirectStrategy, SampleStrategy};
 pub use path::{PathIntegrator, PathLighting};
 
 use crate::bsdf::Bsdf;

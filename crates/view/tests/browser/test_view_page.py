@@ -218,3 +218,47 @@ def test_a_clicked_pixels_interval_holds_its_value(page, shots, tmp_path):
     wait_for(page, lambda s: s[0] >= 256, "256 spp of the path tracer")
     page.save_screenshot(os.path.join(shots, "view-bounces.png"))
     assert not js_errors(page)
+
+
+def test_samples_at_a_clicked_point_are_drawn_with_their_estimates(page, shots):
+    """The course's picture: N directions drawn at the point a pixel sees, by two strategies;
+    light sampling brings light with more of them, and both estimates agree."""
+    page.find_element(By.ID, "show_samples").click()
+    canvas = page.find_element(By.ID, "image")
+    estimates = {}
+    for strategy in ("hemisphere", "light"):
+        Select(page.find_element(By.ID, "strategy")).select_by_value(strategy)
+        count = page.find_element(By.ID, "sample_count")
+        count.clear()
+        count.send_keys("256\n")
+        x, y = SIZE * 20 // 64, SIZE * 44 // 64
+        box = page.execute_script(
+            "const c = arguments[0], r = c.getBoundingClientRect();"
+            "return [r.width, r.height, c.clientLeft, c.clientTop, c.clientWidth, c.clientHeight];",
+            canvas)
+        dx = box[2] + (x + 0.5) * box[4] / SIZE - box[0] / 2
+        dy = box[3] + (y + 0.5) * box[5] / SIZE - box[1] / 2
+        ActionChains(page).move_to_element_with_offset(canvas, round(dx), round(dy)).click().perform()
+        end = time.time() + 60
+        while True:
+            text = page.find_element(By.ID, "samples_text").text
+            m = re.match(r"256 samples at \((\d+), (\d+)\): (\d+) bring light", text)
+            shown = page.execute_script("return stats.sample_view && stats.sample_view.strategy")
+            if m and shown == strategy:
+                break
+            assert time.time() < end, f"no samples drawn by {strategy}: {text!r}"
+            time.sleep(0.05)
+        est = re.search(r"estimate ([\d.e+-]+) ± ([\d.e+-]+)", text)
+        assert est, text
+        estimates[strategy] = (int(m.group(3)), float(est.group(1)), float(est.group(2)))
+        # Lines are drawn over the image.
+        drawn = page.execute_script(
+            """const o = document.getElementById("overlay");
+            const d = o.getContext("2d").getImageData(0, 0, o.width, o.height).data;
+            let n = 0; for (let i = 3; i < d.length; i += 4) n += d[i] > 0; return n;""")
+        assert drawn > 1000, f"{strategy}: {drawn} overlay pixels drawn"
+        page.save_screenshot(os.path.join(shots, f"view-samples-{strategy}.png"))
+    (lit_h, e_h, se_h), (lit_l, e_l, se_l) = estimates["hemisphere"], estimates["light"]
+    assert lit_l > 4 * lit_h, estimates
+    assert abs(e_h - e_l) < 4 * math.hypot(se_h, se_l), estimates
+    assert not js_errors(page)
