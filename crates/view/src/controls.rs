@@ -36,6 +36,9 @@ pub struct Controls {
     pub orbit: [f32; 2],
     /// The camera's distance to its target relative to the scene's.
     pub zoom: f32,
+    /// How far the camera and its target have moved sideways and up (in the view's plane),
+    /// in units of their distance.
+    pub pan: [f32; 2],
     /// Whether camera rays do not see emitters (the scene's choice; not switchable).
     pub hide_emitters: bool,
 }
@@ -54,6 +57,7 @@ impl Default for Controls {
             display: "image".into(),
             orbit: [0.0, 0.0],
             zoom: 1.0,
+            pan: [0.0, 0.0],
             hide_emitters: false,
         }
     }
@@ -170,6 +174,19 @@ impl Controls {
                     next.orbit[0] = (next.orbit[0] + step[0] as f32).rem_euclid(360.0);
                     next.orbit[1] = (next.orbit[1] + step[1] as f32).clamp(-85.0, 85.0);
                 }
+                "pan" => {
+                    let step = value
+                        .as_array()
+                        .filter(|a| a.len() == 2)
+                        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
+                        .filter(|s| s.iter().all(|x| x.is_finite()))
+                        .ok_or_else(|| {
+                            format!("pan: expected [right, up] in view widths, got {value}")
+                        })?;
+                    for (p, d) in next.pan.iter_mut().zip(step) {
+                        *p = (*p + d as f32).clamp(-10.0, 10.0);
+                    }
+                }
                 "zoom" => {
                     let f = value
                         .as_f64()
@@ -212,16 +229,25 @@ impl Controls {
         }
     }
 
-    /// `camera` orbited about its target by [`Controls::orbit`] and moved by the zoom.
+    /// `camera` orbited about its target by [`Controls::orbit`], moved by the zoom and
+    /// panned.
     pub fn camera(&self, camera: &CameraDesc) -> CameraDesc {
         let up = camera.up.normalize_or(Vec3::Y);
         let offset = camera.origin - camera.target;
         let right = offset.cross(up).normalize_or(Vec3::X);
         let [yaw, pitch] = self.orbit.map(f32::to_radians);
         let turn = Mat3::from_axis_angle(up, yaw) * Mat3::from_axis_angle(right, pitch);
+        let origin = camera.target + turn * offset * self.zoom;
+        let up = turn * up;
+        // Panning moves the camera and its target together, across the view.
+        let forward = camera.target - origin;
+        let side = forward.cross(up).normalize_or_zero();
+        let lift = side.cross(forward).normalize_or_zero();
+        let shift = (self.pan[0] * side + self.pan[1] * lift) * forward.length();
         CameraDesc {
-            origin: camera.target + turn * offset * self.zoom,
-            up: turn * up,
+            origin: origin + shift,
+            target: camera.target + shift,
+            up,
             ..*camera
         }
     }
@@ -240,6 +266,7 @@ impl Controls {
             "display": self.display,
             "orbit": self.orbit,
             "zoom": self.zoom,
+            "pan": self.pan,
         })
     }
 }
@@ -335,5 +362,30 @@ mod tests {
         assert!(moved.origin.y > 1.0 + 1.0, "pitched up: {}", moved.origin);
         c.apply(r#"{"zoom": 0.5}"#).unwrap();
         assert!(((c.camera(&camera).origin - camera.target).length() - 2.5).abs() < 1e-4);
+    }
+
+    #[test]
+    fn panning_moves_the_camera_and_its_target_across_the_view() {
+        let camera = CameraDesc {
+            origin: Vec3::new(0.0, 1.0, 5.0),
+            target: Vec3::new(0.0, 1.0, 0.0),
+            up: Vec3::Y,
+            ..Default::default()
+        };
+        let mut c = Controls::default();
+        assert!(
+            c.apply(r#"{"pan": [0.1, 0.2]}"#).unwrap(),
+            "a pan restarts the image"
+        );
+        let moved = c.camera(&camera);
+        // Looking down -z with +y up, right is +x: 0.1 and 0.2 of the distance 5.
+        let shift = Vec3::new(0.5, 1.0, 0.0);
+        assert!(
+            (moved.target - (camera.target + shift)).length() < 1e-5,
+            "{moved:?}"
+        );
+        assert!((moved.origin - (camera.origin + shift)).length() < 1e-5);
+        assert!(c.apply(r#"{"pan": [1]}"#).is_err());
+        assert!(c.apply(r#"{"pan": [1, "up"]}"#).is_err());
     }
 }

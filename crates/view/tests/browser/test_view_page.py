@@ -28,6 +28,7 @@ from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import Select
 
 PATHLAB = os.environ.get("PATHLAB", "target/release/pathlab")
@@ -261,4 +262,22 @@ def test_samples_at_a_clicked_point_are_drawn_with_their_estimates(page, shots):
     (lit_h, e_h, se_h), (lit_l, e_l, se_l) = estimates["hemisphere"], estimates["light"]
     assert lit_l > 4 * lit_h, estimates
     assert abs(e_h - e_l) < 4 * math.hypot(se_h, se_l), estimates
+    assert not js_errors(page)
+
+
+def test_dragging_orbits_and_shift_dragging_pans_the_camera(page):
+    canvas = page.find_element(By.ID, "image")
+    before = page.execute_script("return [stats.controls.orbit, stats.controls.pan]")
+    ActionChains(page).move_to_element(canvas).click_and_hold().move_by_offset(40, 0) \
+        .release().perform()
+    ActionChains(page).key_down(Keys.SHIFT).move_to_element(canvas).click_and_hold() \
+        .move_by_offset(0, 30).release().key_up(Keys.SHIFT).perform()
+    end = time.time() + 30
+    while True:
+        orbit, pan = page.execute_script("return [stats.controls.orbit, stats.controls.pan]")
+        if orbit[0] != before[0][0] and pan[1] != before[1][1]:
+            break
+        assert time.time() < end, f"orbit {orbit}, pan {pan} (before {before})"
+        time.sleep(0.05)
+    assert pan[0] == before[1][0], "a vertical shift-drag pans up or down only"
     assert not js_errors(page)
