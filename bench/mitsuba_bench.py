@@ -13,23 +13,11 @@ else scalar_rgb, which the output says. Its first render of each configuration c
 and is not timed. Each Mitsuba measurement runs in a process of its own that has exited before
 pathlab starts: after a render, Mitsuba's worker threads keep a core busy (measured: a whole
 core for seconds), which would slow whatever runs next."""
-import argparse, json, os, subprocess, sys, tempfile, time
+import argparse, json, subprocess
 import numpy as np
 import mitsuba as mi
+import mitsuba_runs
 
-if len(sys.argv) > 1 and sys.argv[1] == "--mitsuba-child":
-    # One timed Mitsuba render: VARIANT SCENE MAX_DEPTH SPP OUT.npy; prints the seconds.
-    _, _, variant, scene_path, max_depth, spp, out = sys.argv
-    mi.set_variant(variant)
-    scene = mi.load_file(scene_path, spp=int(spp), max_depth=int(max_depth))
-    # Seeds far from the small ones the reference images' 16 runs may have used, so that the
-    # timed image is not one of the runs its error is measured against.
-    mi.render(scene, spp=int(spp), seed=1_000_001)  # compiles the kernels
-    start = time.perf_counter()
-    img = np.array(mi.render(scene, spp=int(spp), seed=1_000_002))
-    print(time.perf_counter() - start)
-    np.save(out, img)
-    sys.exit(0)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--pathlab", required=True)
@@ -40,28 +28,16 @@ ap.add_argument("--spp", type=int, default=64)
 ap.add_argument("--reps", type=int, default=3, help="speed runs per renderer, taken in turns")
 args = ap.parse_args()
 
-variant = "llvm_ad_rgb"
-try:
-    mi.set_variant(variant)
-except Exception as e:  # no LLVM: the scalar variant, much slower
-    variant = "scalar_rgb"
-    mi.set_variant(variant)
-    print(f"note: llvm_ad_rgb unavailable ({e}); using scalar_rgb", file=sys.stderr)
+variant = mitsuba_runs.pick_variant()
 
-def rmse(img, ref):
-    return float(np.sqrt(np.mean((np.asarray(img, dtype=np.float64)[..., :3] - ref) ** 2)))
+rmse = mitsuba_runs.rmse
 
 ref = np.asarray(mi.Bitmap(args.reference), dtype=np.float64)[..., :3]
 height, width = ref.shape[:2]
 pixels = width * height
 
 def mitsuba_render(max_depth, spp):
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "img.npy")
-        cmd = [sys.executable, __file__, "--mitsuba-child", variant, args.scene, str(max_depth),
-               str(spp), out]
-        seconds = float(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
-        return seconds, np.load(out)
+    return mitsuba_runs.render(variant, args.scene, max_depth, spp)
 
 def pathlab_render(depth, extra, name):
     out = f"{args.work}/{name}.exr"

@@ -13,23 +13,11 @@ Mitsuba's variant is llvm_ad_rgb (JIT-compiled, as wide as the CPU's vectors: 16
 AVX-512); its first render of each configuration compiles kernels and is not timed. Each
 Mitsuba measurement runs in a process of its own, gone before pathlab starts (after a render
 Mitsuba's worker threads keep a core busy for seconds)."""
-import argparse, json, os, platform, subprocess, sys, tempfile, time
+import argparse, json, os, platform, subprocess
 import numpy as np
 import mitsuba as mi
+import mitsuba_runs
 
-if len(sys.argv) > 1 and sys.argv[1] == "--mitsuba-child":
-    # One timed Mitsuba render: VARIANT SCENE MAX_DEPTH SPP OUT.npy; prints the seconds.
-    _, _, variant, scene_path, max_depth, spp, out = sys.argv
-    mi.set_variant(variant)
-    scene = mi.load_file(scene_path, spp=int(spp), max_depth=int(max_depth))
-    # Seeds far from the small ones the reference images' 16 runs may have used, so that the
-    # timed image is not one of the runs its error is measured against.
-    mi.render(scene, spp=int(spp), seed=1_000_001)  # compiles the kernels
-    start = time.perf_counter()
-    img = np.array(mi.render(scene, spp=int(spp), seed=1_000_002))
-    print(time.perf_counter() - start)
-    np.save(out, img)
-    sys.exit(0)
 
 # (name in the table, folder under crates/scene/tests/data, pathlab -m, reference's depth)
 CASES = [
@@ -50,13 +38,7 @@ ap.add_argument("--reps", type=int, default=3, help="speed runs per renderer, ta
 ap.add_argument("--only", nargs="*", help="names of the cases to run (default: all)")
 args = ap.parse_args()
 
-variant = "llvm_ad_rgb"
-try:
-    mi.set_variant(variant)
-except Exception as e:  # no LLVM: the scalar variant, much slower
-    variant = "scalar_rgb"
-    mi.set_variant(variant)
-    print(f"note: llvm_ad_rgb unavailable ({e}); using scalar_rgb", file=sys.stderr)
+variant = mitsuba_runs.pick_variant()
 
 
 def cpu_line():
@@ -70,16 +52,11 @@ def cpu_line():
     return f"{model}, {os.cpu_count()} threads, {isa}"
 
 
-def rmse(img, ref):
-    return float(np.sqrt(np.mean((np.asarray(img, dtype=np.float64)[..., :3] - ref) ** 2)))
+rmse = mitsuba_runs.rmse
 
 
 def mitsuba_render(scene, max_depth, spp):
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "img.npy")
-        cmd = [sys.executable, __file__, "--mitsuba-child", variant, scene, str(max_depth), str(spp), out]
-        seconds = float(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
-        return seconds, np.load(out)
+    return mitsuba_runs.render(variant, scene, max_depth, spp)
 
 
 def pathlab_render(scene, depth, extra, name):

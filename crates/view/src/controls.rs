@@ -163,26 +163,16 @@ impl Controls {
                     }
                 },
                 "orbit" => {
-                    let step = value
-                        .as_array()
-                        .filter(|a| a.len() == 2)
-                        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
-                        .filter(|s| s.iter().all(|x| x.is_finite()))
-                        .ok_or_else(|| {
-                            format!("orbit: expected [yaw, pitch] in degrees, got {value}")
-                        })?;
+                    let step = finite_pair(value).ok_or_else(|| {
+                        format!("orbit: expected [yaw, pitch] in degrees, got {value}")
+                    })?;
                     next.orbit[0] = (next.orbit[0] + step[0] as f32).rem_euclid(360.0);
                     next.orbit[1] = (next.orbit[1] + step[1] as f32).clamp(-85.0, 85.0);
                 }
                 "pan" => {
-                    let step = value
-                        .as_array()
-                        .filter(|a| a.len() == 2)
-                        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
-                        .filter(|s| s.iter().all(|x| x.is_finite()))
-                        .ok_or_else(|| {
-                            format!("pan: expected [right, up] in view widths, got {value}")
-                        })?;
+                    let step = finite_pair(value).ok_or_else(|| {
+                        format!("pan: expected [right, up] in view widths, got {value}")
+                    })?;
                     for (p, d) in next.pan.iter_mut().zip(step) {
                         *p = (*p + d as f32).clamp(-10.0, 10.0);
                     }
@@ -269,6 +259,15 @@ impl Controls {
             "pan": self.pan,
         })
     }
+}
+
+/// `[a, b]` of two finite numbers.
+fn finite_pair(value: &serde_json::Value) -> Option<[f64; 2]> {
+    value
+        .as_array()
+        .filter(|a| a.len() == 2)
+        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
+        .filter(|s| s.iter().all(|x| x.is_finite()))
 }
 
 #[cfg(test)]

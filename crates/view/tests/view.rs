@@ -74,6 +74,23 @@ fn get_page(addr: SocketAddr) -> String {
     out
 }
 
+/// Runs `talk` on a WebSocket connected to the server at `addr`.
+fn on_socket<F: std::future::Future<Output = ()>>(
+    addr: SocketAddr,
+    talk: impl FnOnce(Socket) -> F,
+) {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/ws"))
+            .await
+            .unwrap();
+        talk(ws).await
+    });
+}
+
 /// A server on the built-in Cornell box at `size`: its address, its stop flag and its thread.
 fn start(
     size: u32,
@@ -109,14 +126,7 @@ fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
     assert!(page.starts_with("HTTP/1.1 200"), "{page}");
     assert!(page.contains("<canvas") && page.contains("cornell &lt;box&gt;"));
 
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .unwrap();
-    runtime.block_on(async {
-        let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/ws"))
-            .await
-            .unwrap();
+    on_socket(addr, |mut ws| async move {
         // Passes arrive with growing sample counts; the box is not black.
         let first = frame_where(&mut ws, |_| true).await;
         assert_eq!(first.stats["width"], 48);
@@ -221,14 +231,7 @@ fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
 fn a_finished_image_is_sent_again_for_a_new_display_or_inspected_pixel() {
     // 2 x 2 pixels reach the last pass quickly; then the render waits for a change.
     let (addr, stop, server) = start(2);
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .unwrap();
-    runtime.block_on(async {
-        let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/ws"))
-            .await
-            .unwrap();
+    on_socket(addr, |mut ws| async move {
         let max = pathlab_view::renderer::MAX_SPP as u64;
         frame_where(&mut ws, |s| s["spp"].as_u64() == Some(max)).await;
         send(&mut ws, r#"{"inspect": [1, 1]}"#).await;

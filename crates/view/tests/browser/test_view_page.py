@@ -126,6 +126,23 @@ def render(args, out):
     return subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
 
 
+# A pixel of the floor, lit directly.
+FLOOR = (SIZE * 20 // 64, SIZE * 44 // 64)
+
+
+def click_pixel(driver, x, y):
+    """Clicks the image's pixel (x, y): its centre, from the element's centre (the offsets
+    Selenium takes), inside the canvas's border."""
+    canvas = driver.find_element(By.ID, "image")
+    box = driver.execute_script(
+        "const c = arguments[0], r = c.getBoundingClientRect();"
+        "return [r.width, r.height, c.clientLeft, c.clientTop, c.clientWidth, c.clientHeight];",
+        canvas)
+    dx = box[2] + (x + 0.5) * box[4] / SIZE - box[0] / 2
+    dy = box[3] + (y + 0.5) * box[5] / SIZE - box[1] / 2
+    ActionChains(driver).move_to_element_with_offset(canvas, round(dx), round(dy)).click().perform()
+
+
 def js_errors(driver):
     return [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
 
@@ -169,17 +186,8 @@ def test_a_clicked_pixels_interval_holds_its_value(page, shots, tmp_path):
     # Direct lighting by light sampling (left on by the test before, or set here).
     Select(page.find_element(By.ID, "integrator")).select_by_value("direct")
     Select(page.find_element(By.ID, "direct")).select_by_value("light")
-    canvas = page.find_element(By.ID, "image")
-    x, y = SIZE * 20 // 64, SIZE * 44 // 64  # a pixel of the floor, lit directly
-    # The pixel's centre, from the element's centre (the offsets Selenium takes), inside the
-    # canvas's border.
-    box = page.execute_script(
-        "const c = arguments[0], r = c.getBoundingClientRect();"
-        "return [r.width, r.height, c.clientLeft, c.clientTop, c.clientWidth, c.clientHeight];",
-        canvas)
-    dx = box[2] + (x + 0.5) * box[4] / SIZE - box[0] / 2
-    dy = box[3] + (y + 0.5) * box[5] / SIZE - box[1] / 2
-    ActionChains(page).move_to_element_with_offset(canvas, round(dx), round(dy)).click().perform()
+    x, y = FLOOR
+    click_pixel(page, x, y)
     end = time.time() + 60
     text = ""
     while time.time() < end:
@@ -225,21 +233,13 @@ def test_samples_at_a_clicked_point_are_drawn_with_their_estimates(page, shots):
     """The course's picture: N directions drawn at the point a pixel sees, by two strategies;
     light sampling brings light with more of them, and both estimates agree."""
     page.find_element(By.ID, "show_samples").click()
-    canvas = page.find_element(By.ID, "image")
     estimates = {}
     for strategy in ("hemisphere", "light"):
         Select(page.find_element(By.ID, "strategy")).select_by_value(strategy)
         count = page.find_element(By.ID, "sample_count")
         count.clear()
         count.send_keys("256\n")
-        x, y = SIZE * 20 // 64, SIZE * 44 // 64
-        box = page.execute_script(
-            "const c = arguments[0], r = c.getBoundingClientRect();"
-            "return [r.width, r.height, c.clientLeft, c.clientTop, c.clientWidth, c.clientHeight];",
-            canvas)
-        dx = box[2] + (x + 0.5) * box[4] / SIZE - box[0] / 2
-        dy = box[3] + (y + 0.5) * box[5] / SIZE - box[1] / 2
-        ActionChains(page).move_to_element_with_offset(canvas, round(dx), round(dy)).click().perform()
+        click_pixel(page, *FLOOR)
         end = time.time() + 60
         while True:
             text = page.find_element(By.ID, "samples_text").text
