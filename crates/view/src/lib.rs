@@ -196,6 +196,9 @@ fn sample_view_json(v: &samples::SampleView) -> serde_json::Value {
         "estimate": v.estimate,
         "luminance": v.luminance,
         "std_error": v.std_error,
+        "compared": v.compared.iter().map(|(strategy, mean, error, lit)| json!({
+            "strategy": strategy, "luminance": mean, "std_error": error, "lit": lit,
+        })).collect::<Vec<_>>(),
     })
 }
 

@@ -88,6 +88,17 @@ pub struct SampleView {
     pub estimate: [f64; 3],
     pub luminance: f64,
     pub std_error: f64,
+    /// Every strategy's estimate from as many samples at the same point: (strategy,
+    /// luminance, its standard error, how many samples brought light).
+    pub compared: Vec<(&'static str, f64, f64, u32)>,
+}
+
+/// The mean of `values` and its standard error.
+fn mean_and_error(values: &[f64]) -> (f64, f64) {
+    let n = values.len().max(1) as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    (mean, (var / n).sqrt())
 }
 
 /// The samples of `request` in `scene` (with its current camera).
@@ -102,6 +113,7 @@ pub fn sample_view(scene: &Scene, request: &Request) -> SampleView {
         estimate: [0.0; 3],
         luminance: 0.0,
         std_error: 0.0,
+        compared: Vec::new(),
     };
     let Some(si) = scene.intersect(&ray).0 else {
         return view;
@@ -135,10 +147,19 @@ pub fn sample_view(scene: &Scene, request: &Request) -> SampleView {
         });
     }
     view.estimate = sum.map(|v| v / n);
-    let mean = lum.iter().sum::<f64>() / n;
-    let var = lum.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-    view.luminance = mean;
-    view.std_error = (var / n).sqrt();
+    (view.luminance, view.std_error) = mean_and_error(&lum);
+    view.compared = SampleStrategy::ALL
+        .into_iter()
+        .map(|other| {
+            let lum: Vec<f64> = direct_samples(scene, &si, -ray.d, other, request.n, 1)
+                .iter()
+                .map(|s| luminance(s.contribution) as f64)
+                .collect();
+            let (mean, error) = mean_and_error(&lum);
+            let lit = lum.iter().filter(|&&l| l > 0.0).count() as u32;
+            (other.name(), mean, error, lit)
+        })
+        .collect();
     view
 }
 
@@ -202,6 +223,18 @@ mod tests {
         let se = (light.std_error.powi(2) + cosine.std_error.powi(2)).sqrt();
         assert!((l - c).abs() < 4.0 * se, "{l} against {c} (± {se})");
         assert!(cosine.std_error > light.std_error);
+        // Every strategy's estimate from as many samples, the drawn one's among them.
+        let names: Vec<_> = light.compared.iter().map(|c| c.0).collect();
+        assert_eq!(names, ["hemisphere", "cosine", "bsdf", "light"]);
+        assert_eq!(light.compared[3].1, light.luminance);
+        assert_eq!(cosine.compared[1].1, cosine.luminance);
+        for (name, mean, error, _) in &light.compared {
+            let se = (error * error + light.std_error.powi(2)).sqrt();
+            assert!(
+                (mean - l).abs() < 4.0 * se.max(1e-12),
+                "{name}: {mean} against {l}"
+            );
+        }
         // A pixel outside the box sees nothing.
         let none = sample_view(
             &scene,

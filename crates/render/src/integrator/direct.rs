@@ -249,18 +249,37 @@ pub enum SampleStrategy {
     Light,
 }
 
+impl SampleStrategy {
+    /// Every strategy, in the course's order.
+    pub const ALL: [SampleStrategy; 4] = [
+        SampleStrategy::Hemisphere,
+        SampleStrategy::Cosine,
+        SampleStrategy::Bsdf,
+        SampleStrategy::Light,
+    ];
+
+    /// The strategy's name in settings and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            SampleStrategy::Hemisphere => "hemisphere",
+            SampleStrategy::Cosine => "cosine",
+            SampleStrategy::Bsdf => "bsdf",
+            SampleStrategy::Light => "light",
+        }
+    }
+}
+
 impl std::str::FromStr for SampleStrategy {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "hemisphere" => Ok(SampleStrategy::Hemisphere),
-            "cosine" => Ok(SampleStrategy::Cosine),
-            "bsdf" => Ok(SampleStrategy::Bsdf),
-            "light" => Ok(SampleStrategy::Light),
-            _ => Err(format!(
-                "unknown sampling strategy '{s}' (expected hemisphere, cosine, bsdf or light)"
-            )),
-        }
+        SampleStrategy::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "unknown sampling strategy '{s}' (expected hemisphere, cosine, bsdf or light)"
+                )
+            })
     }
 }
 
