@@ -125,8 +125,8 @@ pub fn run(desc: &SceneDesc, mut scene: Scene, shared: &Shared) {
             return;
         };
         if let Some((g, spp, film, rate)) = &last_film {
-            // The image is done: only a new display (exposure, heat map) or a newly inspected
-            // pixel is worth a frame.
+            // The image is done: only a new display (exposure, heat map), a newly inspected
+            // pixel or a new request for samples at a point is worth a frame.
             if *g == generation {
                 let now = (controls, inspected_pixels(shared), requested(shared));
                 if shown.as_ref() != Some(&now) {
