@@ -360,16 +360,15 @@ fn the_course_strategies_samples_estimate_the_same_direct_light() {
     let estimate = |strategy| {
         let samples = direct_samples(&scene, &si, -ray.d, strategy, n, 9);
         assert_eq!(samples.len(), n as usize);
-        let y: Vec<f64> = samples.iter().map(|s| s.contribution.y as f64).collect();
-        let mean = y.iter().sum::<f64>() / n as f64;
-        let var = y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        let mut y = pathlab_mc::estimator::RunningStats::new();
+        samples.iter().for_each(|s| y.push(s.contribution.y as f64));
         let hits = samples
             .iter()
             .filter(|s| s.contribution.y > 0.0)
             .map(|s| s.end.expect("a lit sample ends somewhere"))
             .filter(|e| (e.y - 0.5).abs() < 1e-3)
             .count();
-        (mean, (var / n as f64).sqrt(), hits)
+        (y.mean(), y.std_error(), hits)
     };
     let (light, light_se, light_hits) = estimate(SampleStrategy::Light);
     assert!(light > 0.1, "{light}");

@@ -186,7 +186,7 @@ fn sample_view_json(v: &samples::SampleView) -> serde_json::Value {
     json!({
         "x": v.request.pixel[0],
         "y": v.request.pixel[1],
-        "strategy": v.request.strategy,
+        "strategy": v.request.strategy.name(),
         "n": v.request.n,
         "origin": v.origin,
         "ends": v.samples.iter().map(|s| s.end).collect::<Vec<_>>(),

@@ -3,6 +3,7 @@
 //! ends in the image, its weight f·cos/pdf, what it contributes, and the estimate the N give.
 
 use glam::Vec2;
+use pathlab_mc::estimator::RunningStats;
 use pathlab_render::color::luminance;
 use pathlab_render::integrator::{direct_samples, SampleStrategy};
 use pathlab_render::scene::Scene;
@@ -14,7 +15,7 @@ pub const MAX_SHOWN: u32 = 4096;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Request {
     pub pixel: [u32; 2],
-    pub strategy: String,
+    pub strategy: SampleStrategy,
     pub n: u32,
 }
 
@@ -44,8 +45,8 @@ impl Request {
         let strategy = fields
             .get("strategy")
             .map_or(Some("cosine"), |s| s.as_str())
-            .ok_or("samples_at: strategy must be a string")?;
-        strategy.parse::<SampleStrategy>()?;
+            .ok_or("samples_at: strategy must be a string")?
+            .parse::<SampleStrategy>()?;
         let n = match fields.get("n") {
             None => 64,
             Some(v) => v
@@ -56,7 +57,7 @@ impl Request {
         };
         Ok(Some(Request {
             pixel: [pixel[0] as u32, pixel[1] as u32],
-            strategy: strategy.to_string(),
+            strategy,
             n,
         }))
     }
@@ -95,10 +96,9 @@ pub struct SampleView {
 
 /// The mean of `values` and its standard error.
 fn mean_and_error(values: &[f64]) -> (f64, f64) {
-    let n = values.len().max(1) as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-    (mean, (var / n).sqrt())
+    let mut stats = RunningStats::new();
+    values.iter().for_each(|&v| stats.push(v));
+    (stats.mean(), stats.std_error())
 }
 
 /// The samples of `request` in `scene` (with its current camera).
@@ -118,11 +118,7 @@ pub fn sample_view(scene: &Scene, request: &Request) -> SampleView {
     let Some(si) = scene.intersect(&ray).0 else {
         return view;
     };
-    let strategy = request
-        .strategy
-        .parse::<SampleStrategy>()
-        .unwrap_or(SampleStrategy::Cosine);
-    let drawn = direct_samples(scene, &si, -ray.d, strategy, request.n, 1);
+    let drawn = direct_samples(scene, &si, -ray.d, request.strategy, request.n, 1);
     let far = (si.p - ray.o).length();
     let raster = |p: glam::Vec3| camera.raster_position(p).map(|f| f.to_array());
     view.origin = camera.raster_position(si.p).map(|f| f.to_array());
@@ -148,14 +144,21 @@ pub fn sample_view(scene: &Scene, request: &Request) -> SampleView {
     }
     view.estimate = sum.map(|v| v / n);
     (view.luminance, view.std_error) = mean_and_error(&lum);
+    // The other strategies from as many samples (the drawn one's are those above).
     view.compared = SampleStrategy::ALL
         .into_iter()
         .map(|other| {
-            let lum: Vec<f64> = direct_samples(scene, &si, -ray.d, other, request.n, 1)
-                .iter()
-                .map(|s| luminance(s.contribution) as f64)
-                .collect();
-            let (mean, error) = mean_and_error(&lum);
+            let others: Vec<f64>;
+            let lum = if other == request.strategy {
+                &lum
+            } else {
+                others = direct_samples(scene, &si, -ray.d, other, request.n, 1)
+                    .iter()
+                    .map(|s| luminance(s.contribution) as f64)
+                    .collect();
+                &others
+            };
+            let (mean, error) = mean_and_error(lum);
             let lit = lum.iter().filter(|&&l| l > 0.0).count() as u32;
             (other.name(), mean, error, lit)
         })
@@ -178,7 +181,7 @@ mod tests {
             parse(r#"{"samples_at": [3, 4], "strategy": "light", "n": 16}"#),
             Ok(Some(Request {
                 pixel: [3, 4],
-                strategy: "light".into(),
+                strategy: SampleStrategy::Light,
                 n: 16
             }))
         );
@@ -198,17 +201,17 @@ mod tests {
         let mut desc = pathlab_scene::builtin::load("cornell-box").unwrap();
         desc.resolution = [32, 32];
         let scene = Scene::build(&desc).unwrap();
-        let at = |strategy: &str| {
+        let at = |strategy: SampleStrategy| {
             sample_view(
                 &scene,
                 &Request {
                     pixel: [10, 28],
-                    strategy: strategy.into(),
+                    strategy,
                     n: 4096,
                 },
             )
         };
-        let (light, cosine) = (at("light"), at("cosine"));
+        let (light, cosine) = (at(SampleStrategy::Light), at(SampleStrategy::Cosine));
         let origin = light.origin.expect("the floor");
         // The floor is below the middle of the image, the light at its top.
         assert!(origin[1] > 16.0, "{origin:?}");
@@ -240,7 +243,7 @@ mod tests {
             &scene,
             &Request {
                 pixel: [0, 0],
-                strategy: "light".into(),
+                strategy: SampleStrategy::Light,
                 n: 4,
             },
         );
