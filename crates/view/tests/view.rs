@@ -204,8 +204,15 @@ fn the_viewer_streams_passes_and_restarts_on_a_change_of_settings() {
         assert!(generation >= 1);
         send(&mut ws, r#"{"direct": "light"}"#).await;
         let restarted = frame_where(&mut ws, |s| s["controls"]["direct"] == "light").await;
-        assert_eq!(restarted.stats["spp"], 1, "a change starts the image again");
+        // A new image (the next generation) from its first passes: a page gets only the
+        // latest frame, so under load it may see the 8-spp pass rather than the 1-spp one, but
+        // never the hemisphere image's count or more.
         assert_eq!(restarted.stats["generation"], generation + 1);
+        let first = restarted.stats["spp"].as_u64().unwrap();
+        assert!(
+            first < hemisphere.stats["spp"].as_u64().unwrap(),
+            "a change starts the image again: {first} spp"
+        );
         // The first light-sampling frame with at least as many samples (a page gets only the
         // latest frame, so one with exactly as many may be skipped); the errors compared at
         // one sample per pixel (they fall as 1/√spp).
