@@ -7,20 +7,7 @@ use pathlab_render::integrator::DirectStrategy;
 use pathlab_render::render::{Adaptive, AdaptiveRule};
 use std::path::PathBuf;
 
-/// Which integrator renders the image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum IntegratorName {
-    /// Path tracing with next-event estimation, MIS and Russian roulette.
-    Path,
-    /// Direct lighting only, by the strategy chosen with --direct.
-    Direct,
-    /// Debug view: shading normals.
-    Normals,
-    /// Debug view: distance to the first surface.
-    Depth,
-    /// Debug view: BVH nodes visited per camera ray.
-    Bvh,
-}
+pub use pathlab_render::integrator::IntegratorName;
 
 /// Adaptive stopping rules.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -152,8 +139,11 @@ pub struct RenderArgs {
     /// (-o a.exr -o a.png). Default: SCENE.png.
     #[arg(short = 'o', long, visible_short_alias = 'f', value_name = "FILE")]
     pub output: Vec<PathBuf>,
-    /// The integrator (default: the one the scene file names, else path).
-    #[arg(long, value_enum)]
+    /// The integrator: path (path tracing with next-event estimation, MIS and Russian
+    /// roulette), direct (direct lighting only, by the strategy --direct names), or the debug
+    /// views normals (shading normals), depth (distance to the first surface) and bvh (BVH
+    /// nodes visited per camera ray). Default: the one the scene file names, else path.
+    #[arg(long)]
     pub integrator: Option<IntegratorName>,
     /// A scene parameter, NAME=VALUE, for the `$NAME` references of a Mitsuba scene (its
     /// `<default>`s give the others). Repeat for several.

@@ -4,12 +4,8 @@
 use super::args::{Checked, FresnelName, IntegratorName, LightingName, RenderArgs, RuleName};
 use anyhow::{bail, Result};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::desc::{
-    FovAxis, FresnelModel, IntegratorHint, MaterialDesc, Projection, SceneDesc,
-};
-use pathlab_render::integrator::{
-    DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator, PathLighting,
-};
+use pathlab_render::desc::{FovAxis, FresnelModel, MaterialDesc, Projection, SceneDesc};
+use pathlab_render::integrator::{IntegratorChoice, IntegratorKind, PathLighting};
 use pathlab_render::render::{AdaptiveRule, RenderSettings};
 use pathlab_render::scene::Scene;
 use std::sync::atomic::AtomicBool;
@@ -66,38 +62,20 @@ pub(super) fn integrator(
     desc: &SceneDesc,
     max_depth: u32,
 ) -> (IntegratorName, IntegratorKind) {
-    let rr_depth = args.rr_depth.or(desc.hints.rr_depth).unwrap_or(5);
-    let integrator_name = args.integrator.unwrap_or(match desc.hints.integrator {
-        Some(IntegratorHint::Direct { .. }) => IntegratorName::Direct,
-        _ => IntegratorName::Path,
-    });
-    let integrator = match integrator_name {
-        IntegratorName::Direct if args.integrator.is_none() => {
-            IntegratorKind::from_hints(&desc.hints)
-        }
-        IntegratorName::Path => IntegratorKind::Path(PathIntegrator {
-            max_depth,
-            rr_depth,
-            hide_emitters: desc.hints.hide_emitters,
-            only_bounce: args.only_bounce,
-            light_samples: args.light_samples,
-            lighting: match args.lighting.unwrap_or(LightingName::Mis) {
-                LightingName::Mis => PathLighting::Mis,
-                LightingName::Bsdf => PathLighting::Bsdf,
-                LightingName::Light => PathLighting::Light,
-            },
-        }),
-        IntegratorName::Direct => IntegratorKind::Direct(DirectIntegrator {
-            strategy: args.direct.unwrap_or(DirectStrategy::Mis),
-            samples: args.light_samples,
-            hide_emitters: desc.hints.hide_emitters,
-            ..Default::default()
-        }),
-        IntegratorName::Normals => IntegratorKind::Debug(DebugView::Normals),
-        IntegratorName::Depth => IntegratorKind::Debug(DebugView::Depth),
-        IntegratorName::Bvh => IntegratorKind::Debug(DebugView::BvhHeat),
+    let choice = IntegratorChoice {
+        name: args.integrator,
+        max_depth: Some(max_depth),
+        rr_depth: args.rr_depth,
+        only_bounce: args.only_bounce,
+        light_samples: args.light_samples,
+        lighting: match args.lighting.unwrap_or(LightingName::Mis) {
+            LightingName::Mis => PathLighting::Mis,
+            LightingName::Bsdf => PathLighting::Bsdf,
+            LightingName::Light => PathLighting::Light,
+        },
+        direct: args.direct,
     };
-    (integrator_name, integrator)
+    choice.integrator(&desc.hints)
 }
 
 /// The render settings: samples, seed, sampler (the scene's or the mode's default), adaptive

@@ -7,11 +7,13 @@
 //!   cosine-weighted hemisphere, light sampling, MIS), the course's comparison;
 //! - debug views: shading normals, distance, BVH nodes visited.
 
+mod choice;
 mod debug;
 mod direct;
 mod packet;
 mod path;
 
+pub use choice::{IntegratorChoice, IntegratorName};
 pub use debug::DebugView;
 pub use direct::{direct_samples, DirectIntegrator, DirectSample, DirectStrategy, SampleStrategy};
 pub use path::{PathIntegrator, PathLighting};
