@@ -40,15 +40,9 @@ impl Proposal {
         match self {
             Proposal::Uniform { lo, size, pdf } => {
                 let d = lo.len();
-                let mut i = 0;
-                while i + 1 < d {
-                    let u = s.next_2d();
-                    x[i] = lo[i] + size[i] * u.x as f64;
-                    x[i + 1] = lo[i + 1] + size[i + 1] * u.y as f64;
-                    i += 2;
-                }
-                if i < d {
-                    x[i] = lo[i] + size[i] * s.next_1d() as f64;
+                s.next_point(&mut x[..d]);
+                for ((xi, lo), size) in x.iter_mut().zip(lo).zip(size) {
+                    *xi = lo + size * *xi;
                 }
                 *pdf
             }

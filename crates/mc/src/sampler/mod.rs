@@ -51,6 +51,21 @@ pub trait Sampler {
     fn next_pixel_2d(&mut self) -> Vec2 {
         self.next_2d()
     }
+
+    /// The next `x.len()` dimensions as a point of [0, 1)^d: two at a time from
+    /// [`Sampler::next_2d`] (stratified jointly), the last alone from [`Sampler::next_1d`] when
+    /// `d` is odd.
+    fn next_point(&mut self, x: &mut [f64]) {
+        let mut pairs = x.chunks_exact_mut(2);
+        for pair in &mut pairs {
+            let u = self.next_2d();
+            pair[0] = u.x as f64;
+            pair[1] = u.y as f64;
+        }
+        if let [last] = pairs.into_remainder() {
+            *last = self.next_1d() as f64;
+        }
+    }
 }
 
 /// Which sampler to use, by name (for command lines and configuration).
