@@ -87,35 +87,14 @@ pub fn chi2_test_2d_with_quadrature(
     res: [usize; 2],
     subdivisions: usize,
 ) -> ChiSquareTest {
-    let [nx, ny] = [res[0].max(1), res[1].max(1)];
-    let [[x0, x1], [y0, y1]] = domain;
-    let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
-    let mut observed = vec![0.0f64; nx * ny + 1];
-    let mut n = 0u64;
-    for [x, y] in samples {
-        n += 1;
-        let inside = x >= x0 && x < x1 && y >= y0 && y < y1;
-        let cell = if inside {
-            let ix = (((x - x0) / dx) as usize).min(nx - 1);
-            let iy = (((y - y0) / dy) as usize).min(ny - 1);
-            iy * nx + ix
-        } else {
-            nx * ny
-        };
-        observed[cell] += 1.0;
-    }
-    let mut expected = vec![0.0f64; nx * ny + 1];
-    let mut total = 0.0;
-    for iy in 0..ny {
-        for ix in 0..nx {
-            let (bx, by) = (x0 + ix as f64 * dx, y0 + iy as f64 * dy);
-            let mass = quadrature_2d(&pdf, [bx, bx + dx], [by, by + dy], subdivisions);
-            expected[iy * nx + ix] = mass * n as f64;
-            total += mass;
-        }
-    }
-    expected[nx * ny] = (1.0 - total).max(0.0) * n as f64;
-    chi2_from_cells(&observed, &expected, n)
+    let grid = Chi2Grid {
+        subdivisions,
+        ..Chi2Grid::new(domain, res)
+    };
+    let masses = grid
+        .bins()
+        .map(|(xr, yr)| quadrature_2d(&pdf, xr, yr, subdivisions));
+    grid.test_masses(samples, masses)
 }
 
 /// Chi-square test of 1D samples against the density `pdf(x)` over `[x0, x1]` in `bins` bins.
@@ -235,9 +214,21 @@ fn quadrature_2d(
     yr: [f64; 2],
     subdivisions: usize,
 ) -> f64 {
+    let mut sum = 0.0;
+    let scale = quadrature_nodes(xr, yr, subdivisions, |x, y, w| sum += w * f(x, y));
+    sum * scale
+}
+
+/// Visits the nodes of [`quadrature_2d`]'s rule over a rectangle, in its order, as
+/// `node(x, y, weight)`; returns the factor the weighted sum is multiplied by.
+fn quadrature_nodes(
+    xr: [f64; 2],
+    yr: [f64; 2],
+    subdivisions: usize,
+    mut node: impl FnMut(f64, f64, f64),
+) -> f64 {
     let m = subdivisions.max(1);
     let (hx, hy) = ((xr[1] - xr[0]) / m as f64, (yr[1] - yr[0]) / m as f64);
-    let mut sum = 0.0;
     for j in 0..m {
         let cy = yr[0] + (j as f64 + 0.5) * hy;
         for (ny, wy) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
@@ -245,12 +236,119 @@ fn quadrature_2d(
             for i in 0..m {
                 let cx = xr[0] + (i as f64 + 0.5) * hx;
                 for (nx, wx) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
-                    sum += wx * wy * f(cx + 0.5 * hx * nx, y);
+                    node(cx + 0.5 * hx * nx, y, wx * wy);
                 }
             }
         }
     }
-    sum * 0.25 * hx * hy
+    0.25 * hx * hy
+}
+
+/// [`chi2_test_2d`] for a density evaluated many points at a time (a vectorised function in
+/// another language, a GPU kernel): [`Chi2Grid::nodes`] lists the points where the density is
+/// needed, and [`Chi2Grid::test`] takes its values there. The result is the same as
+/// [`chi2_test_2d_with_quadrature`]'s for the same density.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Chi2Grid {
+    /// `[[x0, x1], [y0, y1]]`.
+    pub domain: [[f64; 2]; 2],
+    /// Bins per axis.
+    pub res: [usize; 2],
+    /// Quadrature pieces per axis and bin.
+    pub subdivisions: usize,
+}
+
+impl Chi2Grid {
+    /// The grid [`chi2_test_2d`] uses for `domain` and `res`.
+    pub fn new(domain: [[f64; 2]; 2], res: [usize; 2]) -> Self {
+        Chi2Grid {
+            domain,
+            res: [res[0].max(1), res[1].max(1)],
+            subdivisions: QUADRATURE_SUBDIVISIONS,
+        }
+    }
+
+    /// Each bin's rectangle, row by row.
+    fn bins(&self) -> impl Iterator<Item = ([f64; 2], [f64; 2])> {
+        let [nx, ny] = self.res;
+        let [[x0, x1], [y0, y1]] = self.domain;
+        let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
+        (0..ny).flat_map(move |iy| {
+            (0..nx).map(move |ix| {
+                let (bx, by) = (x0 + ix as f64 * dx, y0 + iy as f64 * dy);
+                ([bx, bx + dx], [by, by + dy])
+            })
+        })
+    }
+
+    /// The points where the density is needed, bin by bin.
+    pub fn nodes(&self) -> Vec<[f64; 2]> {
+        let mut out = Vec::new();
+        for (xr, yr) in self.bins() {
+            quadrature_nodes(xr, yr, self.subdivisions, |x, y, _| out.push([x, y]));
+        }
+        out
+    }
+
+    /// The test of `samples` against the density whose values at [`Chi2Grid::nodes`] are
+    /// `pdf_at_nodes` (`None` if their number is not the nodes').
+    pub fn test(
+        &self,
+        samples: impl IntoIterator<Item = [f64; 2]>,
+        pdf_at_nodes: &[f64],
+    ) -> Option<ChiSquareTest> {
+        let per_bin = (4 * self.subdivisions.max(1)).pow(2);
+        let bins = self.res[0] * self.res[1];
+        if pdf_at_nodes.len() != bins * per_bin {
+            return None;
+        }
+        let masses = self
+            .bins()
+            .zip(pdf_at_nodes.chunks(per_bin))
+            .map(|((xr, yr), values)| {
+                let mut k = 0;
+                let mut sum = 0.0;
+                let scale = quadrature_nodes(xr, yr, self.subdivisions, |_, _, w| {
+                    sum += w * values[k];
+                    k += 1;
+                });
+                sum * scale
+            });
+        Some(self.test_masses(samples, masses))
+    }
+
+    /// The test of `samples` against the bins' probabilities `masses` (row by row).
+    fn test_masses(
+        &self,
+        samples: impl IntoIterator<Item = [f64; 2]>,
+        masses: impl Iterator<Item = f64>,
+    ) -> ChiSquareTest {
+        let [nx, ny] = self.res;
+        let [[x0, x1], [y0, y1]] = self.domain;
+        let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
+        let mut observed = vec![0.0f64; nx * ny + 1];
+        let mut n = 0u64;
+        for [x, y] in samples {
+            n += 1;
+            let inside = x >= x0 && x < x1 && y >= y0 && y < y1;
+            let cell = if inside {
+                let ix = (((x - x0) / dx) as usize).min(nx - 1);
+                let iy = (((y - y0) / dy) as usize).min(ny - 1);
+                iy * nx + ix
+            } else {
+                nx * ny
+            };
+            observed[cell] += 1.0;
+        }
+        let mut expected = vec![0.0f64; nx * ny + 1];
+        let mut total = 0.0;
+        for (e, mass) in expected.iter_mut().zip(masses) {
+            *e = mass * n as f64;
+            total += mass;
+        }
+        expected[nx * ny] = (1.0 - total).max(0.0) * n as f64;
+        chi2_from_cells(&observed, &expected, n)
+    }
 }
 
 /// The azimuth atan2(y, x), in [0, 2π).
@@ -341,6 +439,31 @@ mod tests {
         // ∫0^2∫1^3 (x⁷ + y² + 1) dy dx = 2·2⁸/8 + 2·26/3 + 4
         let exact = 64.0 + 52.0 / 3.0 + 4.0;
         assert!((v - exact).abs() < 1e-10);
+    }
+
+    #[test]
+    fn a_tabulated_density_gives_the_streamed_test_to_the_bit() {
+        let mut rng = crate::rng::Pcg32::new(7, 3);
+        let pts: Vec<[f64; 2]> = (0..5_000)
+            .map(|_| {
+                let x = rng.uniform_f64().sqrt();
+                [x * 2.0 - 0.5, rng.uniform_f64() * 3.0]
+            })
+            .collect();
+        let pdf = |x: f64, y: f64| if y < 3.0 { (x + 0.5) / 6.0 } else { 0.0 };
+        let domain = [[-0.5, 1.5], [0.0, 3.0]];
+        let streamed = chi2_test_2d(pts.iter().copied(), pdf, domain, [12, 7]);
+        let grid = Chi2Grid::new(domain, [12, 7]);
+        let values: Vec<f64> = grid.nodes().iter().map(|p| pdf(p[0], p[1])).collect();
+        assert_eq!(
+            grid.test(pts.iter().copied(), &values),
+            Some(streamed.clone())
+        );
+        assert!(streamed.p_value > 1e-4, "{streamed:?}");
+        // A density of the wrong shape is told apart, and too few values are refused.
+        let wrong: Vec<f64> = grid.nodes().iter().map(|_| 1.0 / 6.0).collect();
+        assert!(grid.test(pts.iter().copied(), &wrong).unwrap().p_value < 1e-6);
+        assert_eq!(grid.test(pts.iter().copied(), &values[1..]), None);
     }
 
     #[test]
