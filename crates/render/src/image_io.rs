@@ -227,6 +227,16 @@ pub fn write_rgb8(
     })
 }
 
+/// 8-bit values (3 bytes a pixel) of linear `rgb` after scaling by 2^`exposure` and the tone
+/// map `tone`.
+pub fn encode_rgb8(rgb: &[Rgb], exposure: f32, tone: ToneMap) -> Vec<u8> {
+    let scale = exposure.exp2();
+    rgb.iter()
+        .flat_map(|c| c.to_array())
+        .map(|v| (tone.encode(v, scale) * 255.0 + 0.5) as u8)
+        .collect()
+}
+
 /// Writes `rgb` as an 8-bit PNG after scaling by 2^`exposure`, with the sRGB transfer function.
 pub fn write_png(
     path: &Path,
@@ -247,12 +257,7 @@ pub fn write_png_with(
     exposure: f32,
     tone: ToneMap,
 ) -> std::result::Result<(), ImageError> {
-    let scale = exposure.exp2();
-    let bytes: Vec<u8> = rgb
-        .iter()
-        .flat_map(|c| c.to_array())
-        .map(|v| (tone.encode(v, scale) * 255.0 + 0.5) as u8)
-        .collect();
+    let bytes = encode_rgb8(rgb, exposure, tone);
     image::save_buffer(path, &bytes, width, height, image::ExtendedColorType::Rgb8).map_err(|e| {
         ImageError::Png {
             path: path.display().to_string(),
