@@ -8,6 +8,7 @@
 #   bench/run.sh rays       # Embree only
 #   bench/run.sh render     # Mitsuba, the Cornell box in detail
 #   bench/run.sh scenes     # Mitsuba, every reference scene (speed and equal-time error)
+#   bench/run.sh python     # the Python module against the command line, same render
 #
 # Results go to target/bench/ (JSON per measurement) and a table on stdout.
 set -euo pipefail
@@ -79,4 +80,14 @@ if [ "$what" = all ] || [ "$what" = scenes ]; then
     DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/scenes.py" \
         --pathlab "$pathlab" --data "$root/crates/scene/tests/data" --work "$work" \
         --spp "${PATHLAB_BENCH_SPP:-256}" --reps "${PATHLAB_BENCH_REPS:-3}"
+fi
+
+if [ "$what" = all ] || [ "$what" = python ]; then
+    pyvenv="$work/pyvenv"
+    [ -x "$pyvenv/bin/python" ] || python3 -m venv "$pyvenv"
+    "$pyvenv/bin/pip" install --quiet maturin numpy
+    rm -rf "$work/wheels"
+    "$pyvenv/bin/maturin" build --quiet --release -m "$root/crates/python/Cargo.toml" -o "$work/wheels"
+    "$pyvenv/bin/pip" install --quiet --force-reinstall --no-deps "$work"/wheels/pathlab-*.whl
+    "$pyvenv/bin/python" "$root/bench/python_vs_cli.py" "$pathlab" --reps "${PATHLAB_BENCH_REPS:-9}"
 fi

@@ -1,0 +1,132 @@
+//! `pathlab.read` and `pathlab.write`: images as float32 arrays of linear values, in OpenEXR
+//! (exact) or 8-bit PNG (sRGB), and `png_bytes` for a notebook to show an array.
+
+use crate::arrays::f64_array;
+use numpy::ndarray::Array3;
+use numpy::IntoPyArray;
+use pathlab_render::color::Rgb;
+use pathlab_render::image_io::{encode_rgb8, read_rgb, write_exr, ToneMap};
+use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use std::path::Path;
+
+/// `read(path)`: an image as an `(H, W, 3)` float32 array of linear values (8-bit formats are
+/// decoded from sRGB).
+#[pyfunction]
+fn read<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    let (w, h, pixels) = py
+        .detach(|| read_rgb(&path, true))
+        .map_err(|e| PyOSError::new_err(e.to_string()))?;
+    let data: Vec<f32> = pixels.iter().flat_map(|p| p.to_array()).collect();
+    Ok(Array3::from_shape_vec((h as usize, w as usize, 3), data)
+        .expect("one RGB triple per pixel")
+        .into_pyarray(py)
+        .into_any())
+}
+
+/// An `(H, W, 3)` or `(H, W)` array (grey) as RGB pixels, with its width and height.
+fn pixels(array: &Bound<'_, PyAny>) -> PyResult<(u32, u32, Vec<Rgb>)> {
+    let a = f64_array(array, "image")?;
+    let v = a.as_array();
+    let shape = v.shape().to_vec();
+    let (h, w, channels) = match shape.as_slice() {
+        [h, w, 3] => (*h, *w, 3),
+        [h, w] => (*h, *w, 1),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "image: expected an array of shape (height, width, 3) or (height, width), got {shape:?}"
+            )))
+        }
+    };
+    if h == 0 || w == 0 || h > 65536 || w > 65536 {
+        return Err(PyValueError::new_err(format!(
+            "image: {w}x{h} pixels; width and height must be between 1 and 65536"
+        )));
+    }
+    let flat: Vec<f32> = v.iter().map(|&x| x as f32).collect();
+    let px = if channels == 3 {
+        flat.chunks_exact(3)
+            .map(|c| Rgb::new(c[0], c[1], c[2]))
+            .collect()
+    } else {
+        flat.iter().map(|&g| Rgb::splat(g)).collect()
+    };
+    Ok((w as u32, h as u32, px))
+}
+
+/// 8-bit sRGB bytes of linear pixels scaled by 2^`exposure`.
+fn srgb_bytes(px: &[Rgb], exposure: f32) -> Vec<u8> {
+    encode_rgb8(px, exposure, ToneMap::Srgb)
+}
+
+/// `write(path, image, exposure=0.0)`: OpenEXR (float32, exact) for `.exr`, else an 8-bit
+/// sRGB PNG after scaling by 2^exposure.
+#[pyfunction]
+#[pyo3(signature = (path, image, exposure=0.0))]
+fn write(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    image: &Bound<'_, PyAny>,
+    exposure: f32,
+) -> PyResult<()> {
+    if !exposure.is_finite() {
+        return Err(PyValueError::new_err(format!(
+            "exposure {exposure}: must be a finite number of stops"
+        )));
+    }
+    let (w, h, px) = pixels(image)?;
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    let result = py.detach(|| match ext.as_deref() {
+        Some("exr") => write_exr(&path, w, h, &px, &[]).map_err(|e| e.to_string()),
+        Some("png") => {
+            pathlab_render::image_io::write_rgb8(&path, w, h, &srgb_bytes(&px, exposure))
+                .map_err(|e| e.to_string())
+        }
+        _ => Err(format!(
+            "{}: unknown image format (expected .exr or .png)",
+            Path::new(&path).display()
+        )),
+    });
+    result.map_err(|e| {
+        if e.contains("unknown image format") {
+            PyValueError::new_err(e)
+        } else {
+            PyOSError::new_err(e)
+        }
+    })
+}
+
+/// `png_bytes(image, exposure=0.0)`: the image as the bytes of an sRGB PNG file (what a
+/// notebook shows).
+#[pyfunction]
+#[pyo3(signature = (image, exposure=0.0))]
+fn png_bytes<'py>(
+    py: Python<'py>,
+    image: &Bound<'py, PyAny>,
+    exposure: f32,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let (w, h, px) = pixels(image)?;
+    let bytes = srgb_bytes(&px, exposure);
+    let mut out = std::io::Cursor::new(Vec::new());
+    image::write_buffer_with_format(
+        &mut out,
+        &bytes,
+        w,
+        h,
+        image::ExtendedColorType::Rgb8,
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| PyValueError::new_err(format!("cannot encode the PNG: {e}")))?;
+    Ok(PyBytes::new(py, out.get_ref()))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(write, m)?)?;
+    m.add_function(wrap_pyfunction!(png_bytes, m)?)?;
+    Ok(())
+}

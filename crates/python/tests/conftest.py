@@ -1,0 +1,12 @@
+"""Shared paths of the Python tests: the repository's test data."""
+
+from pathlib import Path
+
+import pytest
+
+DATA = Path(__file__).resolve().parents[2] / "scene" / "tests" / "data"
+
+
+@pytest.fixture
+def data():
+    return DATA
