@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # pathlab against Embree (BVH build and ray throughput on the same rays) and Mitsuba 3 (render
-# speed and equal-time error on the Cornell box), as ratios measured in one run on one machine.
+# speed and equal-time error on the Cornell box), and the Python module against the command line,
+# as ratios measured in one run on one machine.
 # A benchmark, not a test. Needs the project's shared tools (../shared, or PATHLAB_SHARED),
 # network access to Debian's packages and PyPI the first time, and root (or sudo) for apt.
 #
