@@ -145,7 +145,15 @@ fn weighted_terms(
     Ok(terms)
 }
 
-/// `integrate(f, domain, n, sampler="independent", seed=0, replicates=16)`.
+/// Estimate the integral of f over a box by F_N = 1/N Σ f(X_i)/p(X_i), X_i uniform in the box
+/// (p = 1/volume).
+///
+/// `f` takes an (n, d) array of points and returns n values; `domain` is `(lo, hi)` or a list
+/// of `(lo, hi)`, one per dimension. Independent samples give the standard error from their
+/// sample variance; "stratified" and "sobol" points, which are not independent, from
+/// `replicates` independent randomisations of n / replicates points each. Returns an Estimate
+/// (mean, std_error, ci95, ...); warns when one sample carries much of the variance (a
+/// heavy-tailed f/p, whose error is not to be trusted).
 #[pyfunction]
 #[pyo3(signature = (f, domain, n, sampler="independent", seed=0, replicates=16))]
 fn integrate(
@@ -319,7 +327,19 @@ enum Kind {
     Directions,
 }
 
-/// `chi2_test(samples, pdf, domain=None, bins=None)`.
+/// Pearson's chi-square goodness-of-fit test of samples against a density.
+///
+/// - numbers, shape (n,): `pdf(x)` on `domain=(lo, hi)`, `bins` (64) bins;
+/// - points, shape (n, 2): `pdf(p)` per unit area on `domain=((x0, x1), (y0, y1))`, `bins`
+///   ((32, 32));
+/// - directions, shape (n, 3): `pdf(w)` per unit solid angle, binned in (cos θ, φ) over the
+///   sphere, `bins` ((32, 64));
+/// - integer outcomes, shape (n,), with `pdf` an array of their probabilities.
+///
+/// The pdf is called once, on an array of every quadrature node (4x4 Gauss–Legendre pieces of
+/// 4 nodes per bin); a pdf that jumps inside a bin is integrated only approximately, so put its
+/// jumps on bin edges. Mass outside the domain is one more cell, so a pdf that does not
+/// integrate to one is rejected. Returns a ChiSquareTest (statistic, p_value, dof, ...).
 #[pyfunction]
 #[pyo3(signature = (samples, pdf, domain=None, bins=None))]
 fn chi2_test(

@@ -11,8 +11,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::path::Path;
 
-/// `read(path)`: an image as an `(H, W, 3)` float32 array of linear values (8-bit formats are
-/// decoded from sRGB).
+/// Read an image (OpenEXR, PNG, JPEG, Radiance HDR, BMP) as a float32 array (H, W, 3) of
+/// linear values; 8-bit formats are decoded from sRGB. Raises OSError naming the file.
 #[pyfunction]
 fn read<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResult<Bound<'py, PyAny>> {
     let (w, h, pixels) = py
@@ -60,8 +60,8 @@ fn srgb_bytes(px: &[Rgb], exposure: f32) -> Vec<u8> {
     encode_rgb8(px, exposure, ToneMap::Srgb)
 }
 
-/// `write(path, image, exposure=0.0)`: OpenEXR (float32, exact) for `.exr`, else an 8-bit
-/// sRGB PNG after scaling by 2^exposure.
+/// Write an image of linear values, shape (H, W, 3) or (H, W): OpenEXR (float32, exact) for a
+/// `.exr` path, an 8-bit sRGB PNG after scaling by 2^exposure for `.png`.
 #[pyfunction]
 #[pyo3(signature = (path, image, exposure=0.0))]
 fn write(
@@ -100,8 +100,8 @@ fn write(
     })
 }
 
-/// `png_bytes(image, exposure=0.0)`: the image as the bytes of an sRGB PNG file (what a
-/// notebook shows).
+/// The image (linear values, (H, W, 3) or (H, W)) as the bytes of an 8-bit sRGB PNG file,
+/// after scaling by 2^exposure: what a notebook shows.
 #[pyfunction]
 #[pyo3(signature = (image, exposure=0.0))]
 fn png_bytes<'py>(

@@ -148,8 +148,8 @@ fn request(
     })
 }
 
-/// `render(scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None,
-/// sampler=None, resolution=None, threads=0, aovs=())`.
+/// Render a scene to a float32 array (H, W, 3) of linear radiance, or with `aovs` a dict of
+/// arrays; see `pathlab.render` for the arguments.
 #[pyfunction]
 #[pyo3(signature = (scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, sampler=None, resolution=None, threads=0, aovs=Vec::new()))]
 #[allow(clippy::too_many_arguments)]

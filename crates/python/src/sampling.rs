@@ -13,9 +13,9 @@ use pyo3::prelude::*;
 /// Most dimensions of `uniform_points`.
 const MAX_POINT_DIMS: i64 = 1024;
 
-/// `uniform_points(n, dims, sampler="independent", seed=0)`: `n` points of the unit cube
-/// `[0, 1)^dims`, point `i` being the sampler's sample `i` (dimensions taken two at a time,
-/// as the renderer and `integrate` take them).
+/// n points of the unit cube [0, 1)^dims as an (n, dims) float64 array, point i being sample i
+/// of the sampler: "independent", "stratified" (jittered) or "sobol" (Owen-scrambled), with
+/// `seed`. Dimensions are drawn two at a time, as the renderer and `integrate` draw them.
 #[pyfunction]
 #[pyo3(signature = (n, dims, sampler="independent", seed=0))]
 fn uniform_points<'py>(

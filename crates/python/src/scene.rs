@@ -22,10 +22,21 @@ pub struct Scene {
     built: Option<Arc<BuiltScene>>,
 }
 
-/// `load(source, **params)`.
+/// Load a scene: a built-in name ("cornell-box", ...) or a file pathlab reads (Mitsuba 3 XML,
+/// pbrt-v4 .pbrt/.pbrt.gz, the course's COLLADA .dae, OBJ, PLY, glTF .gltf/.glb).
+///
+/// Keyword arguments fill a Mitsuba file's `$name` defaults, as `pathlab render -D name=value`
+/// does: `load("scene.xml", spp=16, resx=128)`. The loader's warnings are given as Python
+/// warnings (UserWarning). Raises SceneError naming the file, line and what was expected.
 #[pyfunction]
 #[pyo3(signature = (source, **params))]
-fn load(py: Python<'_>, source: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<Scene> {
+fn load(
+    py: Python<'_>,
+    source: std::path::PathBuf,
+    params: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Scene> {
+    let source = source.to_string_lossy().into_owned();
+    let source = source.as_str();
     let mut defines = Vec::new();
     if let Some(params) = params {
         for (name, value) in params.iter() {

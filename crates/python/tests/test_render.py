@@ -217,3 +217,15 @@ def test_the_readme_example_runs(tmp_path, monkeypatch, capsys):
     exec(compile(code, "README.md", "exec"), {})
     assert (tmp_path / "box.png").exists()
     assert "ChiSquareTest(" in capsys.readouterr().out
+
+
+def test_an_image_is_an_array_that_reduces_to_numbers_and_shows_itself(data):
+    image = pathlab.render(pathlab.load(data / "cornell-box" / "scene.xml", resx=8, resy=8), spp=1)
+    assert isinstance(image, np.ndarray)
+    mean = image.mean()
+    assert not isinstance(mean, np.ndarray) and float(mean) > 0
+    assert isinstance(image * 2, pathlab.Image)
+    assert image._repr_png_()[:4] == b"\x89PNG"
+    assert image[..., 0]._repr_png_()[:4] == b"\x89PNG"
+    assert image[0, 0]._repr_png_() is None
+    assert pathlab.load.__doc__.startswith("Load a scene")

@@ -65,6 +65,12 @@ class Image(_np.ndarray):
 
     exposure = 0.0
 
+    def __array_wrap__(self, obj, *args, **kwargs):
+        # A reduction to one number (image.mean()) gives a number, not a 0-d Image.
+        if obj.ndim == 0:
+            return obj[()]
+        return super().__array_wrap__(obj, *args, **kwargs)
+
     def _repr_png_(self):
         if self.ndim not in (2, 3) or (self.ndim == 3 and self.shape[2] != 3) or self.size == 0:
             return None
