@@ -12,7 +12,6 @@ copy-free hand-over of the image to numpy.
 
 import argparse
 import json
-import platform
 import statistics
 import subprocess
 import tempfile
@@ -20,17 +19,7 @@ import time
 from pathlib import Path
 
 import pathlab
-
-
-def cpu():
-    try:
-        text = Path("/proc/cpuinfo").read_text()
-    except OSError:
-        return platform.processor()
-    model = next((l.split(":", 1)[1].strip() for l in text.splitlines() if l.startswith("model name")), "?")
-    flags = next((l.split(":", 1)[1].split() for l in text.splitlines() if l.startswith("flags")), [])
-    isa = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
-    return f"{model}, {isa}"
+from machine import cpu_line
 
 
 def main():
@@ -56,7 +45,7 @@ def main():
                 check=True, capture_output=True, text=True)
             cli_rates.append(json.loads(run.stdout)["samples_per_second"])
     py, cli = statistics.median(py_rates), statistics.median(cli_rates)
-    print(f"CPU: {cpu()}, {len(__import__('os').sched_getaffinity(0))} threads")
+    print(f"CPU: {cpu_line()}")
     print(f"{args.scene}, {args.spp} spp, medians of {args.reps} runs in turns")
     print(f"| | samples/s |\n|---|---|\n| pathlab.render (Python) | {py:.3e} |\n| pathlab render (CLI) | {cli:.3e} |")
     print(f"Python / CLI: {py / cli:.3f}")

@@ -13,10 +13,11 @@ Mitsuba's variant is llvm_ad_rgb (JIT-compiled, as wide as the CPU's vectors: 16
 AVX-512); its first render of each configuration compiles kernels and is not timed. Each
 Mitsuba measurement runs in a process of its own, gone before pathlab starts (after a render
 Mitsuba's worker threads keep a core busy for seconds)."""
-import argparse, json, os, platform, subprocess
+import argparse, json, os, subprocess
 import numpy as np
 import mitsuba as mi
 import mitsuba_runs
+from machine import cpu_line
 
 
 # (name in the table, folder under crates/scene/tests/data, pathlab -m, reference's depth)
@@ -39,17 +40,6 @@ ap.add_argument("--only", nargs="*", help="names of the cases to run (default: a
 args = ap.parse_args()
 
 variant = mitsuba_runs.pick_variant()
-
-
-def cpu_line():
-    try:
-        info = open("/proc/cpuinfo").read()
-    except OSError:
-        return platform.processor()
-    model = next((l.split(":", 1)[1].strip() for l in info.splitlines() if l.startswith("model name")), "?")
-    flags = next((l.split(":", 1)[1].split() for l in info.splitlines() if l.startswith("flags")), [])
-    isa = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
-    return f"{model}, {os.cpu_count()} threads, {isa}"
 
 
 rmse = mitsuba_runs.rmse

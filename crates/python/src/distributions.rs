@@ -19,6 +19,28 @@ fn unit_values(u: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     Ok(v)
 }
 
+/// `f` of each value of `x` (a number or an `(n,)` array), as an array.
+fn map_values<'py, T: numpy::Element>(
+    py: Python<'py>,
+    x: &Bound<'py, PyAny>,
+    what: &str,
+    f: impl Fn(f64) -> T,
+) -> PyResult<Bound<'py, PyArray1<T>>> {
+    Ok(values_out(
+        py,
+        values(x, what)?.into_iter().map(f).collect(),
+    ))
+}
+
+/// `f` of each uniform number of `u` (checked to lie in [0, 1)), as an array.
+fn map_uniform<'py, T: numpy::Element>(
+    py: Python<'py>,
+    u: &Bound<'py, PyAny>,
+    f: impl Fn(f64) -> T,
+) -> PyResult<Bound<'py, PyArray1<T>>> {
+    Ok(values_out(py, unit_values(u)?.into_iter().map(f).collect()))
+}
+
 /// Weights: finite, non-negative, with a positive sum.
 fn weights(w: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     let a = crate::arrays::f64_array(w, "weights")?;
@@ -69,11 +91,7 @@ impl Exponential {
         py: Python<'py>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let x = unit_values(u)?
-            .into_iter()
-            .map(|u| self.0.sample(u))
-            .collect();
-        Ok(values_out(py, x))
+        map_uniform(py, u, |u| self.0.sample(u))
     }
 
     /// The density λ e^(-λx) (0 for x < 0).
@@ -82,8 +100,7 @@ impl Exponential {
         py: Python<'py>,
         x: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let p = values(x, "x")?.into_iter().map(|x| self.0.pdf(x)).collect();
-        Ok(values_out(py, p))
+        map_values(py, x, "x", |x| self.0.pdf(x))
     }
 
     /// The distribution function 1 - e^(-λx).
@@ -92,8 +109,7 @@ impl Exponential {
         py: Python<'py>,
         x: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let p = values(x, "x")?.into_iter().map(|x| self.0.cdf(x)).collect();
-        Ok(values_out(py, p))
+        map_values(py, x, "x", |x| self.0.cdf(x))
     }
 
     fn __repr__(&self) -> String {
@@ -135,11 +151,7 @@ impl Piecewise1D {
         py: Python<'py>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let x = unit_values(u)?
-            .into_iter()
-            .map(|u| self.0.sample(u as f32).x as f64)
-            .collect();
-        Ok(values_out(py, x))
+        map_uniform(py, u, |u| self.0.sample(u as f32).x as f64)
     }
 
     /// The density at each point (0 outside the domain).
@@ -148,11 +160,7 @@ impl Piecewise1D {
         py: Python<'py>,
         x: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let p = values(x, "x")?
-            .into_iter()
-            .map(|x| self.0.pdf(x as f32) as f64)
-            .collect();
-        Ok(values_out(py, p))
+        map_values(py, x, "x", |x| self.0.pdf(x as f32) as f64)
     }
 
     fn __repr__(&self) -> String {
@@ -265,11 +273,7 @@ impl AliasTable {
         py: Python<'py>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let i = unit_values(u)?
-            .into_iter()
-            .map(|u| self.0.sample(u as f32).index as i64)
-            .collect();
-        Ok(values_out(py, i))
+        map_uniform(py, u, |u| self.0.sample(u as f32).index as i64)
     }
 
     /// The probability of each outcome `i` (0 for any outside `0..n`).
@@ -278,17 +282,13 @@ impl AliasTable {
         py: Python<'py>,
         i: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let p = values(i, "i")?
-            .into_iter()
-            .map(|i| {
-                if i >= 0.0 && i.fract() == 0.0 && (i as usize) < self.0.len() {
-                    self.0.pmf(i as usize)
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        Ok(values_out(py, p))
+        map_values(py, i, "i", |i| {
+            if i >= 0.0 && i.fract() == 0.0 && (i as usize) < self.0.len() {
+                self.0.pmf(i as usize)
+            } else {
+                0.0
+            }
+        })
     }
 
     fn __repr__(&self) -> String {
