@@ -1,7 +1,6 @@
 //! The benchmark harness run as bench/run.sh runs it: ray files checked hit by hit, and the OBJ
 //! export of a scene's triangles.
 
-use serde_json::Value;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -12,30 +11,10 @@ fn bench(args: &[&str]) -> Output {
         .expect("the pathlab-bench binary runs")
 }
 
-fn json_of(out: &Output) -> Value {
-    assert!(
-        out.status.success(),
-        "pathlab-bench failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("--json prints valid JSON")
-}
-
-fn assert_one_line_error(out: &Output, expected: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "expected a failure, got success");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "stderr: {stderr}");
-    assert!(stderr.starts_with("error: "), "stderr: {stderr}");
-    assert!(
-        stderr.contains(expected),
-        "stderr lacks '{expected}': {stderr}"
-    );
-}
+use pathlab_testkit::process::{assert_one_line_error, json_of};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bench-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    pathlab_testkit::process::scratch(env!("CARGO_TARGET_TMPDIR"), "bench-tests", name)
 }
 
 #[test]

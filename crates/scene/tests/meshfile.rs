@@ -10,9 +10,7 @@ use pathlab_scene::{info, load, Error};
 use std::path::PathBuf;
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("meshfile-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    pathlab_testkit::process::scratch(env!("CARGO_TARGET_TMPDIR"), "meshfile-tests", name)
 }
 
 /// A box [-1, 2] x [0, 1] x [-3, 0.5] as 8 vertices and 6 quads.

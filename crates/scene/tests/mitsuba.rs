@@ -69,18 +69,7 @@ fn scene_xml_renders_the_built_in_image() {
         outliers <= 3,
         "{outliers} block channels beyond 4 sigma of 3072"
     );
-    let (ma, mb) = (xml.image_mean(), built.image_mean());
-    let (sa, sb) = (xml.image_mean_std_error(), built.image_mean_std_error());
-    for c in 0..3 {
-        let z = z_test_two_sample(ma[c], sa[c], mb[c], sb[c]);
-        assert!(
-            z.within(3.0),
-            "channel {c}: {} vs {} (z {})",
-            ma[c],
-            mb[c],
-            z.z
-        );
-    }
+    pathlab_testkit::render::assert_same_mean("the XML box against the built-in box", &xml, &built);
 }
 
 fn write(name: &str, text: &str) -> PathBuf {

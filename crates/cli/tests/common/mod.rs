@@ -2,7 +2,6 @@
 //! files, and scratch paths. (Each test file uses a part of it.)
 #![allow(dead_code)]
 
-use serde_json::Value;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -21,34 +20,11 @@ pub fn pathlab_with_threads(args: &[&str], threads: usize) -> Output {
         .expect("the pathlab binary runs")
 }
 
-pub fn json_of(out: &Output) -> Value {
-    assert!(
-        out.status.success(),
-        "pathlab failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("--json prints valid JSON")
-}
-
-/// Asserts a failed run with exactly one line on stderr, an error and no panic.
-pub fn assert_one_line_error(out: &Output, expected: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "expected a failure, got success");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "stderr: {stderr}");
-    assert!(stderr.starts_with("error: "), "stderr: {stderr}");
-    assert!(
-        stderr.contains(expected),
-        "stderr lacks '{expected}': {stderr}"
-    );
-    assert!(!stderr.contains("panicked"), "stderr: {stderr}");
-}
+#[allow(unused_imports)] // each test file uses a part
+pub use pathlab_testkit::process::{assert_one_line_error, json_of};
 
 pub fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    let _ = std::fs::remove_file(&path);
-    path
+    pathlab_testkit::process::scratch(env!("CARGO_TARGET_TMPDIR"), "cli-tests", name)
 }
 
 pub fn assert_image(path: &PathBuf, png: bool) {

@@ -2,45 +2,19 @@
 //! the assertions that compare them with their standard errors.
 #![allow(dead_code)]
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use pathlab_mc::sampler::{AnySampler, SamplerKind};
-use pathlab_mc::stats::z_test_two_sample;
 use pathlab_render::desc::*;
 use pathlab_render::film::Film;
 use pathlab_render::geometry::Ray;
 use pathlab_render::integrator::*;
-use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::{diffuse, Scene};
 
-pub const MAX_Z: f64 = 4.0;
+#[allow(unused_imports)] // each test file uses a part
+pub use pathlab_testkit::render::{assert_mean, assert_same_image, path, MAX_Z};
 
 pub fn run(desc: &SceneDesc, integrator: IntegratorKind, spp: u32, seed: u64) -> Film {
-    let scene = Scene::build(desc).unwrap();
-    let settings = RenderSettings::new(spp, seed, SamplerKind::Independent);
-    render(&scene, &integrator, &settings, &|_| {}, &Default::default()).0
-}
-
-pub fn path(max_depth: u32) -> IntegratorKind {
-    IntegratorKind::Path(PathIntegrator {
-        max_depth,
-        ..Default::default()
-    })
-}
-
-/// Asserts that every channel of the image mean is within 4 standard errors of `truth`.
-pub fn assert_mean(name: &str, film: &Film, truth: DVec3) {
-    let (m, se) = (film.image_mean(), film.image_mean_std_error());
-    eprintln!("{name}: mean {m:.5?} ± {se:.5?}, expected {truth:?}");
-    for c in 0..3 {
-        assert!(
-            // The second term is the single-precision rounding of the radiance computation.
-            (m[c] - truth[c]).abs() <= MAX_Z * se[c] + 1e-6 * truth[c].abs(),
-            "{name}: channel {c}: {} vs {} (se {})",
-            m[c],
-            truth[c],
-            se[c]
-        );
-    }
+    pathlab_testkit::render::render_desc(desc, integrator, spp, seed)
 }
 
 /// The camera at the centre of a closed sphere that emits 1 everywhere and reflects albedo a.
@@ -144,36 +118,6 @@ pub fn big_light() -> SceneDesc {
         },
         resolution: [24, 24],
         ..Default::default()
-    }
-}
-
-/// Per-pixel two-sample z-tests: at most 0.1% of pixel channels beyond 4σ (rounded up to 1),
-/// and image means within 3 combined standard errors.
-pub fn assert_same_image(name: &str, a: &Film, b: &Film) {
-    let mut outliers = 0;
-    for (p, q) in a.pixels().iter().zip(b.pixels()) {
-        let (va, vb) = (p.variance_of_mean(), q.variance_of_mean());
-        for c in 0..3 {
-            let z = z_test_two_sample(p.mean()[c], va[c].sqrt(), q.mean()[c], vb[c].sqrt());
-            outliers += (!z.within(MAX_Z)) as usize;
-        }
-    }
-    let allowed = (a.pixels().len() * 3) / 1000 + 1;
-    assert!(
-        outliers <= allowed,
-        "{name}: {outliers} pixel channels beyond {MAX_Z} sigma"
-    );
-    let (ma, mb) = (a.image_mean(), b.image_mean());
-    let (sa, sb) = (a.image_mean_std_error(), b.image_mean_std_error());
-    for c in 0..3 {
-        let z = z_test_two_sample(ma[c], sa[c], mb[c], sb[c]);
-        assert!(
-            z.within(3.0),
-            "{name}: image mean channel {c}: {} vs {} (z {})",
-            ma[c],
-            mb[c],
-            z.z
-        );
     }
 }
 
