@@ -329,13 +329,15 @@ enum Kind {
 
 /// Pearson's chi-square goodness-of-fit test of samples against a density.
 ///
-/// - numbers, shape (n,): `pdf(x)` on `domain=(lo, hi)`, `bins` (64) bins;
-/// - points, shape (n, 2): `pdf(p)` per unit area on `domain=((x0, x1), (y0, y1))`, `bins`
-///   ((32, 32));
+/// - numbers, shape (n,): `pdf(x)` on `domain=(lo, hi)`, in `bins` bins;
+/// - points, shape (n, 2): `pdf(p)` per unit area on `domain=((x0, x1), (y0, y1))`, in
+///   `bins=(nx, ny)`;
 /// - directions, shape (n, 3): `pdf(w)` per unit solid angle, binned in (cos θ, φ) over the
-///   sphere, `bins` ((32, 64));
+///   sphere, in `bins=(n_cos_theta, n_phi)`;
 /// - integer outcomes, shape (n,), with `pdf` an array of their probabilities.
 ///
+/// Without `bins`, about 20 samples per bin (at most 64 bins in 1D, 32 x 32 in 2D, 32 x 64
+/// for directions).
 /// The pdf is called once, on an array of every quadrature node (4x4 Gauss–Legendre pieces of
 /// 4 nodes per bin); a pdf that jumps inside a bin is integrated only approximately, so put its
 /// jumps on bin edges. Mass outside the domain is one more cell, so a pdf that does not
@@ -411,9 +413,18 @@ fn chi2_test(
                 positive_u32(y, "bins")? as usize,
             ]
         }
-        (None, Kind::Line) => [64, 1],
-        (None, Kind::Plane) => [32, 32],
-        (None, Kind::Directions) => [32, 64],
+        // By default about 20 samples per bin (were they spread evenly), so that cells are
+        // not pooled away: at most 64 bins, 32 x 32 or 32 x 64, at least 4 per axis.
+        (None, kind) => {
+            // An even count per axis keeps the middle (the horizon z = 0) on a bin edge.
+            let k = |cells: f64| (cells.sqrt() as usize / 2 * 2).clamp(4, 32);
+            let per_bin = pts.len() as f64 / 20.0;
+            match kind {
+                Kind::Line => [(per_bin as usize / 2 * 2).clamp(4, 64), 1],
+                Kind::Plane => [k(per_bin), k(per_bin)],
+                Kind::Directions => [k(per_bin / 2.0), 2 * k(per_bin / 2.0)],
+            }
+        }
     };
     if res[0] * res[1] > 1 << 20 {
         return Err(PyValueError::new_err(format!(
@@ -423,9 +434,19 @@ fn chi2_test(
     }
     let grid = Chi2Grid::new(dom, res);
     let values = pdf_at(pdf, &grid.nodes(), kind)?;
+    let n = pts.len();
     let test = grid
         .test(pts, &values)
         .expect("one pdf value per quadrature node, checked above");
+    if test.dof == 0 && test.impossible_samples == 0 {
+        crate::scene::warn(
+            samples.py(),
+            &format!(
+                "chi2_test: {n} samples in {} x {} bins leave no cell with 5 expected samples to test: the p-value of 1 says nothing; use more samples or fewer bins",
+                res[0], res[1]
+            ),
+        )?;
+    }
     Ok(test.into())
 }
 

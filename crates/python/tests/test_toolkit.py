@@ -178,3 +178,14 @@ def test_chi2_test_rejects_bad_input():
         pathlab.chi2_test(w, lambda d: -pathlab.uniform_sphere_pdf(d))
     with pytest.raises(ValueError, match="not one of"):
         pathlab.chi2_test([0, 1, 7], [0.5, 0.5])
+
+
+def test_chi2_test_bins_suit_the_sample_count():
+    # 2,000 uniform directions: the default bins leave cells to test, so a wrong pdf is caught.
+    w = pathlab.sample_uniform_sphere(u2(seed=9, n=2000))
+    t = pathlab.chi2_test(w, pathlab.uniform_sphere_pdf)
+    assert t.dof > 10 and t.passes(ALPHA), t
+    assert pathlab.chi2_test(w, lambda d: 3 * d[:, 2] ** 2 / (4 * np.pi)).p_value < 1e-6
+    # Asked-for bins too fine for the samples: a warning, not a silent p-value of 1.
+    with pytest.warns(UserWarning, match="says nothing"):
+        pathlab.chi2_test(w[:50], pathlab.uniform_sphere_pdf, bins=(32, 64))
