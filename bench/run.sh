@@ -41,7 +41,7 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
         meshes+=("$name")
     done
     for scene in maxplanck CBbunny; do
-        [ -e "$work/$scene.obj" ] || "$bench" obj "$root/crates/scene/tests/data/cs184/$scene.dae" "$work/$scene.obj" >/dev/null
+        [ -e "$work/$scene.obj" ] || "$bench" obj "$root/tests/data/cs184/$scene.dae" "$work/$scene.obj" >/dev/null
         meshes+=("$scene")
     done
     threads="$(nproc)"
@@ -71,15 +71,15 @@ mitsuba_venv() {
 if [ "$what" = all ] || [ "$what" = render ]; then
     mitsuba_venv
     DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/mitsuba_bench.py" \
-        --pathlab "$pathlab" --scene "$root/crates/scene/tests/data/cornell-box/scene.xml" \
-        --reference "$root/crates/scene/tests/data/cornell-box/mean-maxdepth-inf.exr" \
+        --pathlab "$pathlab" --scene "$root/tests/data/cornell-box/scene.xml" \
+        --reference "$root/tests/data/cornell-box/mean-maxdepth-inf.exr" \
         --work "$work"
 fi
 
 if [ "$what" = all ] || [ "$what" = scenes ]; then
     mitsuba_venv
     DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/scenes.py" \
-        --pathlab "$pathlab" --data "$root/crates/scene/tests/data" --work "$work" \
+        --pathlab "$pathlab" --data "$root/tests/data" --work "$work" \
         --spp "${PATHLAB_BENCH_SPP:-256}" --reps "${PATHLAB_BENCH_REPS:-3}"
 fi
 

@@ -7,7 +7,7 @@
 set -euo pipefail
 old="$1"; new="$2"
 root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/crates/scene/tests/data"
+data="$root/tests/data"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 cases=(

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""pathlab against Mitsuba 3 on every reference scene of crates/scene/tests/data, in one run on
+"""pathlab against Mitsuba 3 on every reference scene of tests/data, in one run on
 one machine (bench/run.sh scenes starts it with a venv holding `mitsuba`):
 
 1. speed: samples per second of both renderers on the same scene file at the same resolution,
@@ -20,7 +20,7 @@ import mitsuba_runs
 from machine import cpu_line
 
 
-# (name in the table, folder under crates/scene/tests/data, pathlab -m, reference's depth)
+# (name in the table, folder under tests/data, pathlab -m, reference's depth)
 CASES = [
     ("cornell-box", "cornell-box", "inf", "inf"),
     ("cornell-box -m 1", "cornell-box", "1", "2"),
@@ -32,7 +32,7 @@ CASES = [
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--pathlab", required=True)
-ap.add_argument("--data", required=True, help="crates/scene/tests/data")
+ap.add_argument("--data", required=True, help="tests/data")
 ap.add_argument("--work", required=True)
 ap.add_argument("--spp", type=int, default=256)
 ap.add_argument("--reps", type=int, default=3, help="speed runs per renderer, taken in turns")

@@ -418,11 +418,11 @@ fn target_error_and_time_budget() {
 #[test]
 fn envmap_lighting_and_fresnel_flags() {
     let sky = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scene/tests/data/sky-spheres/sky.exr")
+        .join("../../tests/data/sky-spheres/sky.exr")
         .display()
         .to_string();
     let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scene/tests/data/cornell-spheres/scene.xml")
+        .join("../../tests/data/cornell-spheres/scene.xml")
         .display()
         .to_string();
     let mean = |extra: &[&str]| -> Vec<f64> {

@@ -76,7 +76,7 @@ fn a_stopped_render_writes_whole_passes_and_exits_with_the_signals_status() {
     // Stopped at a moment the test does not choose precisely: every pixel holds whole passes
     // (or one pass more), the image is an unbiased estimate, the exit status 130.
     let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scene/tests/data/cornell-box/mean-maxdepth-2.exr");
+        .join("../../tests/data/cornell-box/mean-maxdepth-2.exr");
     let out = scratch("stopped.exr");
     let ck = scratch("stopped.plf");
     let o = interrupt(

@@ -372,7 +372,7 @@ fn convergence_plot_and_data() {
 fn compare_ranks_the_strategies() {
     let out = scratch("compare.png");
     let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scene/tests/data/cornell-box/mean-maxdepth-2.exr");
+        .join("../../tests/data/cornell-box/mean-maxdepth-2.exr");
     let v = json_of(&pathlab(&[
         "compare",
         "-s",
@@ -420,7 +420,7 @@ fn compare_ranks_the_strategies() {
 fn converge_plots_error_curves() {
     let out = scratch("converge.png");
     let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scene/tests/data/cornell-box/mean-maxdepth-2.exr");
+        .join("../../tests/data/cornell-box/mean-maxdepth-2.exr");
     let v = json_of(&pathlab(&[
         "converge",
         "--ref",
@@ -491,7 +491,7 @@ fn converge_plots_error_curves() {
 
 #[test]
 fn compare_warns_when_the_reference_is_of_another_depth() {
-    let data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scene/tests/data/cornell-box");
+    let data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/cornell-box");
     let run = |reference: &str, strategies: &str| {
         let out = scratch("compare_warn.png");
         pathlab(&[

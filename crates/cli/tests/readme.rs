@@ -84,7 +84,7 @@ fn every_command_of_the_readme_tour_runs_as_written() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("readme-tour");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    for folder in ["crates", "examples"] {
+    for folder in ["crates", "examples", "tests"] {
         std::os::unix::fs::symlink(root.join(folder).canonicalize().unwrap(), dir.join(folder))
             .unwrap();
     }

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/cs184")
+        .join("../../tests/data/cs184")
         .join(name)
 }
 

@@ -69,7 +69,7 @@ fn the_allocator_counts() {
 
 fn sample(name: &str) -> String {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/cs184")
+        .join("../../tests/data/cs184")
         .join(name);
     std::fs::read_to_string(path).unwrap()
 }
@@ -220,7 +220,7 @@ proptest! {
 
     #[test]
     fn mitsuba_xml_truncated_or_flipped(cut in 0.0f64..1.0, flips in prop::collection::vec((0.0f64..1.0, 0u8..8), 0..6)) {
-        let xml = std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-box/scene.xml")).unwrap();
+        let xml = std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/cornell-box/scene.xml")).unwrap();
         exercise_file("case.xml", &corrupt(xml, cut, &flips));
     }
 }
@@ -242,8 +242,9 @@ fn scene_around(plugin: &str, file: &str) -> String {
 /// Mitsuba's `.serialized` rectangle from its test suite.
 fn serialized_rectangle() -> Vec<u8> {
     std::fs::read(
-        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/mitsuba-suite/tests/serialized/rectangle_normals_uv.serialized"),
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(
+            "../../tests/data/mitsuba-suite/tests/serialized/rectangle_normals_uv.serialized",
+        ),
     )
     .unwrap()
 }

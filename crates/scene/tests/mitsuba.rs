@@ -13,7 +13,7 @@ use pathlab_scene::{builtin, info, mitsuba, Error};
 use std::path::{Path, PathBuf};
 
 fn scene_xml() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-box/scene.xml")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/cornell-box/scene.xml")
 }
 
 fn run(desc: &SceneDesc, seed: u64) -> Film {
@@ -170,7 +170,7 @@ fn malformed_xml_gives_located_errors() {
 fn conductor_table_matches_mitsubas_spectral_files() {
     use pathlab_scene::mitsuba::ior::{named_conductor, CONDUCTORS};
     use pathlab_scene::spectrum::{parse_spd, sampled_to_rgb, SpectrumKind};
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/mitsuba-suite/ior");
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/mitsuba-suite/ior");
     let rgb = |file: &str| {
         let text = std::fs::read_to_string(dir.join(file)).unwrap();
         sampled_to_rgb(&parse_spd(&text).unwrap(), SpectrumKind::Unbounded)

@@ -96,7 +96,7 @@ fn mitsuba_bitmap_on_a_rectangle() {
 #[test]
 fn collada_texture_resolves_sampler_surface_and_image() {
     let dir = fixture("collada");
-    let plane = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cs184/plane.dae");
+    let plane = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/cs184/plane.dae");
     let text = std::fs::read_to_string(plane).unwrap();
     // The plane with an image, a surface and a sampler, its diffuse colour replaced by the
     // texture, and every corner's texture coordinate at the top-left texel's centre.

@@ -54,7 +54,7 @@ pub fn scratch_exists(name: &str) -> bool {
 
 pub fn course_scene(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scene/tests/data/cs184")
+        .join("../../tests/data/cs184")
         .join(name)
         .to_str()
         .unwrap()

@@ -15,7 +15,7 @@ pub use pathlab_testkit::reference::*;
 pub use pathlab_testkit::render::{path, MAX_Z};
 
 pub fn reference(mitsuba_depth: &str) -> Reference {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-box");
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/cornell-box");
     let r = Reference::read(&dir, mitsuba_depth);
     assert_eq!(r.mean.len(), 256 * 256);
     r
@@ -53,7 +53,7 @@ pub fn render_independent(
 /// Renders a reference folder's scene.xml at -m inf and loads its reference.
 pub fn render_reference_scene(folder: &str, spp: u32, seed: u64) -> (Film, Reference) {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
+        .join("../../tests/data")
         .join(folder);
     let desc = pathlab_scene::mitsuba::load(&dir.join("scene.xml")).unwrap();
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);

@@ -23,7 +23,7 @@ const SIGNIFICANCE: f64 = 0.01;
 const REQUIRED: f64 = 0.9975;
 
 fn suite() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/mitsuba-suite/tests/scenes")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/mitsuba-suite/tests/scenes")
 }
 
 fn read(path: &std::path::Path) -> (u32, u32, Vec<DVec3>) {

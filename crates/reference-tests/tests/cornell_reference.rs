@@ -127,7 +127,7 @@ fn direct_strategies_rank_by_variance() {
 fn mitsuba_xml_scene_matches_mitsuba_pixel_by_pixel() {
     // The reference's own scene.xml, read by the Mitsuba loader, at -m 1.
     let desc = pathlab_scene::mitsuba::load(
-        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/cornell-box/scene.xml"),
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/cornell-box/scene.xml"),
     )
     .unwrap();
     let scene = Scene::build(&desc).unwrap();
