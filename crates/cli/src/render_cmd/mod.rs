@@ -80,17 +80,15 @@ impl Plan {
         let (outputs, formats) = outputs::checked_outputs(args)?;
         let mut desc = setup::scene_desc(args, &checked.params)?;
         let spp = args.spp.or(desc.hints.spp).unwrap_or(64);
-        let max_depth = checked
-            .cli_depth
-            .or(desc.hints.max_depth)
-            .unwrap_or(u32::MAX);
+        let choice = setup::integrator_choice(args, &checked);
+        let max_depth = choice.max_depth(&desc.hints);
         if let Some(k) = args.only_bounce.filter(|&k| k > max_depth) {
             anyhow::bail!("--only-bounce {k} is beyond the scene's largest bounce {max_depth}: the image would be black");
         }
         setup::apply_resolution(&mut desc, args.resolution.as_deref())?;
         setup::apply_view(&mut desc, args.scale, args.fov)?;
         let scene = Scene::build(&desc).context("cannot build the scene")?;
-        let (integrator_name, integrator) = setup::integrator(args, &desc, max_depth);
+        let (integrator_name, integrator) = choice.integrator(&desc.hints);
         let settings = setup::settings(args, &checked, &desc, &scene, &integrator, spp, cancel)?;
         let progressive = checked.progressive;
         let stop_cap = if progressive {

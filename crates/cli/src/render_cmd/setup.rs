@@ -1,7 +1,7 @@
 //! From flags to what the renderer gets: the scene description with the flags' changes, the
 //! integrator and the render settings.
 
-use super::args::{Checked, FresnelName, IntegratorName, LightingName, RenderArgs, RuleName};
+use super::args::{Checked, FresnelName, LightingName, RenderArgs, RuleName};
 use anyhow::{bail, Result};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::desc::{FovAxis, FresnelModel, MaterialDesc, Projection, SceneDesc};
@@ -56,15 +56,12 @@ pub(super) fn scene_desc(args: &RenderArgs, params: &[(String, String)]) -> Resu
     Ok(desc)
 }
 
-/// The integrator the flags and the scene's hints choose, and its name.
-pub(super) fn integrator(
-    args: &RenderArgs,
-    desc: &SceneDesc,
-    max_depth: u32,
-) -> (IntegratorName, IntegratorKind) {
-    let choice = IntegratorChoice {
+/// The integrator the flags ask for; the scene's hints fill what they leave open
+/// ([`IntegratorChoice::integrator`]).
+pub(super) fn integrator_choice(args: &RenderArgs, checked: &Checked) -> IntegratorChoice {
+    IntegratorChoice {
         name: args.integrator,
-        max_depth: Some(max_depth),
+        max_depth: checked.cli_depth,
         rr_depth: args.rr_depth,
         only_bounce: args.only_bounce,
         light_samples: args.light_samples,
@@ -74,8 +71,7 @@ pub(super) fn integrator(
             LightingName::Light => PathLighting::Light,
         },
         direct: args.direct,
-    };
-    choice.integrator(&desc.hints)
+    }
 }
 
 /// The render settings: samples, seed, sampler (the scene's or the mode's default), adaptive
