@@ -5,6 +5,7 @@
 
 use crate::arrays::{f64_array, positive_u32, value_error, values};
 use crate::sampling::points;
+use numpy::PyArrayMethods;
 use pathlab_mc::estimator::{looks_heavy_tailed, replicate_estimate, RunningStats};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_mc::stats::{chi2_test_discrete, cos_theta_phi, Chi2Grid};
@@ -104,22 +105,23 @@ fn weighted_terms(
     let py = f.py();
     let d = box_.len();
     let volume: f64 = box_.iter().map(|(lo, hi)| hi - lo).product();
-    let all = py.detach(|| {
-        let mut x = points(kind, n, d, seed);
-        for p in x.chunks_exact_mut(d) {
-            for (xi, (lo, hi)) in p.iter_mut().zip(box_) {
-                *xi = lo + (hi - lo) * *xi;
-            }
-        }
-        x
-    });
     let mut terms = Vec::with_capacity(n as usize);
-    for chunk in all.chunks(CHUNK as usize * d) {
-        let m = chunk.len() / d;
-        let array = numpy::ndarray::Array2::from_shape_vec((m, d), chunk.to_vec())
+    for start in (0..n).step_by(CHUNK as usize) {
+        let indices = start..start.saturating_add(CHUNK).min(n);
+        let m = indices.len();
+        let chunk = py.detach(|| {
+            let mut x = points(kind, n, d, seed, indices);
+            for p in x.chunks_exact_mut(d) {
+                for (xi, (lo, hi)) in p.iter_mut().zip(box_) {
+                    *xi = lo + (hi - lo) * *xi;
+                }
+            }
+            x
+        });
+        let array = numpy::ndarray::Array2::from_shape_vec((m, d), chunk)
             .expect("m points of d coordinates");
         let arg = numpy::IntoPyArray::into_pyarray(array, py);
-        let out = f.call1((arg,))?;
+        let out = f.call1((arg.clone(),))?;
         let a = f64_array(&out, "the integrand's values")?;
         let v = a.as_array();
         if v.len() != m || v.ndim() > 2 {
@@ -130,7 +132,10 @@ fn weighted_terms(
         }
         for (k, &fx) in v.iter().enumerate() {
             if !fx.is_finite() {
-                let at: Vec<String> = chunk[k * d..(k + 1) * d]
+                let point = arg.readonly();
+                let at: Vec<String> = point
+                    .as_array()
+                    .row(k)
                     .iter()
                     .map(|x| format!("{x}"))
                     .collect();

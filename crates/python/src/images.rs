@@ -5,11 +5,10 @@ use crate::arrays::f64_array;
 use numpy::ndarray::Array3;
 use numpy::IntoPyArray;
 use pathlab_render::color::Rgb;
-use pathlab_render::image_io::{encode_rgb8, read_rgb, write_exr, ToneMap};
+use pathlab_render::image_io::{encode_rgb8, read_rgb, write_exr, write_rgb8, ToneMap};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use std::path::Path;
 
 /// Read an image (OpenEXR, PNG, JPEG, Radiance HDR, BMP) as a float32 array (H, W, 3) of
 /// linear values; 8-bit formats are decoded from sRGB. Raises OSError naming the file.
@@ -75,29 +74,29 @@ fn write(
             "exposure {exposure}: must be a finite number of stops"
         )));
     }
-    let (w, h, px) = pixels(image)?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase());
-    let result = py.detach(|| match ext.as_deref() {
-        Some("exr") => write_exr(&path, w, h, &px, &[]).map_err(|e| e.to_string()),
-        Some("png") => {
-            pathlab_render::image_io::write_rgb8(&path, w, h, &srgb_bytes(&px, exposure))
-                .map_err(|e| e.to_string())
+    let exr = match ext.as_deref() {
+        Some("exr") => true,
+        Some("png") => false,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "{}: unknown image format (expected .exr or .png)",
+                path.display()
+            )))
         }
-        _ => Err(format!(
-            "{}: unknown image format (expected .exr or .png)",
-            Path::new(&path).display()
-        )),
-    });
-    result.map_err(|e| {
-        if e.contains("unknown image format") {
-            PyValueError::new_err(e)
+    };
+    let (w, h, px) = pixels(image)?;
+    py.detach(|| {
+        if exr {
+            write_exr(&path, w, h, &px, &[])
         } else {
-            PyOSError::new_err(e)
+            write_rgb8(&path, w, h, &srgb_bytes(&px, exposure))
         }
     })
+    .map_err(|e| PyOSError::new_err(e.to_string()))
 }
 
 /// The image (linear values, (H, W, 3) or (H, W)) as the bytes of an 8-bit sRGB PNG file,

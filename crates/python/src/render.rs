@@ -11,6 +11,7 @@ use crate::scene::{checked_resolution, Scene};
 use numpy::ndarray::{Array2, Array3};
 use numpy::IntoPyArray;
 use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::desc::RenderHints;
 use pathlab_render::film::{Film, PixelStats};
 use pathlab_render::integrator::{
     DirectStrategy, IntegratorChoice, IntegratorKind, IntegratorName,
@@ -55,6 +56,9 @@ impl Aov {
 /// The arguments of `render`, checked.
 struct Request {
     settings: RenderSettings,
+    /// What was asked of the integrator, with the file's hints it is completed by.
+    choice: IntegratorChoice,
+    hints: RenderHints,
     integrator: IntegratorKind,
     resolution: [u32; 2],
     threads: usize,
@@ -141,6 +145,8 @@ fn request(
     }
     Ok(Request {
         settings: RenderSettings::new(spp, seed, sampler),
+        choice,
+        hints: *hints,
         integrator,
         resolution,
         threads: threads as usize,
@@ -189,13 +195,11 @@ fn render<'py>(
             Aov::Variance => out.set_item(key, variance_image(py, &film))?,
             Aov::Samples => out.set_item(key, sample_counts(py, &film))?,
             Aov::Bounce(k) => {
-                let IntegratorKind::Path(path) = req.integrator else {
-                    unreachable!("bounce outputs were checked to need the path tracer")
-                };
-                let only = IntegratorKind::Path(pathlab_render::integrator::PathIntegrator {
+                let only = IntegratorChoice {
                     only_bounce: Some(k),
-                    ..path
-                });
+                    ..req.choice
+                };
+                let (_, only) = only.integrator(&req.hints);
                 let (bounce, _) = interruptible(py, &pool, &built, &only, &req.settings)?;
                 out.set_item(key, mean_image(py, &bounce))?;
             }

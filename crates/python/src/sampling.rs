@@ -33,18 +33,25 @@ fn uniform_points<'py>(
     }
     let kind: SamplerKind = sampler.parse().map_err(value_error)?;
     let d = dims as usize;
-    let flat = py.detach(|| points(kind, n, d, seed));
+    let flat = py.detach(|| points(kind, n, d, seed, 0..n));
     let array = numpy::ndarray::Array2::from_shape_vec((n as usize, d), flat)
         .expect("n points of d coordinates");
     Ok(numpy::IntoPyArray::into_pyarray(array, py))
 }
 
-/// Sample `i` of the sampler for `i` in `0..n`, `d` coordinates each, row-major.
-pub fn points(kind: SamplerKind, n: u32, d: usize, seed: u64) -> Vec<f64> {
+/// Samples `indices` of the sampler of `kind` set up for `n` samples, `d` coordinates each,
+/// row-major.
+pub fn points(
+    kind: SamplerKind,
+    n: u32,
+    d: usize,
+    seed: u64,
+    indices: std::ops::Range<u32>,
+) -> Vec<f64> {
     let mut s = kind.build(n, seed);
-    let mut out = vec![0.0; n as usize * d];
-    for (i, x) in out.chunks_exact_mut(d).enumerate() {
-        s.start_pixel_sample([0, 0], i as u32, 0);
+    let mut out = vec![0.0; indices.len() * d];
+    for (i, x) in indices.zip(out.chunks_exact_mut(d)) {
+        s.start_pixel_sample([0, 0], i, 0);
         s.next_point(x);
     }
     out

@@ -30,6 +30,8 @@ def test_the_built_in_box_matches_the_reference_within_4_standard_errors(data):
     assert image.shape == (256, 256, 3) and image.dtype == np.float32
     assert out["variance"].shape == (256, 256, 3)
     assert out["samples"].shape == (256, 256) and np.all(out["samples"] == 64)
+    # One output may be named alone.
+    assert set(pathlab.render(scene, spp=1, resolution=(4, 4), aovs="samples")) == {"image", "samples"}
     n = 256 * 256
     ours = image.astype(np.float64).mean(axis=(0, 1))
     ours_se = np.sqrt(out["variance"].astype(np.float64).sum(axis=(0, 1))) / n

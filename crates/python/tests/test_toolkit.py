@@ -146,6 +146,11 @@ def test_integrate_is_the_plain_estimator_on_the_sampler_points():
     e = pathlab.integrate(gauss, [(-2, 2), (-2, 2)], 5000, seed=3)
     assert e.mean == pytest.approx(16 * gauss(x).mean(), rel=1e-12)
     assert e.std_error == pytest.approx(16 * gauss(x).std(ddof=1) / math.sqrt(5000), rel=1e-9)
+    # Past one call's 2^20 points, the points are still the sampler's, in order.
+    n = (1 << 20) + 5000
+    x = pathlab.uniform_points(n, 1, sampler="sobol", seed=4)[:, 0]
+    e = pathlab.integrate(lambda p: p[:, 0] ** 2, (0, 1), n, sampler="sobol", seed=4, replicates=1)
+    assert e.mean == pytest.approx((x**2).mean(), rel=1e-12)
     # One interval for one dimension.
     assert float(pathlab.integrate(lambda p: p[:, 0], (0, 1), 1000)) == pytest.approx(0.5, abs=0.05)
 

@@ -110,7 +110,7 @@ def render(scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None
     """
     out = _pathlab.render(scene, spp=spp, seed=seed, max_depth=max_depth, integrator=integrator,
                           direct=direct, sampler=sampler, resolution=resolution, threads=threads,
-                          aovs=list(aovs))
+                          aovs=[aovs] if isinstance(aovs, str) else list(aovs))
     if isinstance(out, dict):
         return {k: (_image(v) if k == "image" or k.startswith("bounce:") else v)
                 for k, v in out.items()}
