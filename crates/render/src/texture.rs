@@ -154,6 +154,12 @@ pub enum Tex {
     },
     /// Attribute table `index` of the scene (zero where the point is not on a triangle).
     Attribute(u32),
+    /// The product of two textures.
+    Product(Box<[Tex; 2]>),
+    /// `(1 - a) first + a second`, `a` the first read as a number.
+    Mix(Box<[Tex; 3]>),
+    /// max(0, 1 - t) per channel.
+    Invert(Box<Tex>),
 }
 
 impl Tex {
@@ -182,6 +188,16 @@ impl Tex {
                 to_uv: *to_uv,
             },
             TextureDesc::MeshAttribute { name } => Tex::Attribute(attribute(name)),
+            TextureDesc::Product(ab) => Tex::Product(Box::new([
+                Tex::new(&ab[0], attribute),
+                Tex::new(&ab[1], attribute),
+            ])),
+            TextureDesc::Mix(m) => Tex::Mix(Box::new([
+                Tex::new(&m[0], attribute),
+                Tex::new(&m[1], attribute),
+                Tex::new(&m[2], attribute),
+            ])),
+            TextureDesc::Invert(t) => Tex::Invert(Box::new(Tex::new(t, attribute))),
         }
     }
 
@@ -232,6 +248,13 @@ impl Tex {
                 };
                 (1.0 - b.x - b.y) * c[0] + b.x * c[1] + b.y * c[2]
             }
+            Tex::Product(ab) => ab[0].eval(p) * ab[1].eval(p),
+            Tex::Mix(m) => {
+                // The amount's luminance (its value where grey), the checkerboard unswapped.
+                let a = crate::color::mitsuba_luminance(m[0].eval(p));
+                (1.0 - a) * m[1].eval(p) + a * m[2].eval(p)
+            }
+            Tex::Invert(t) => (Rgb::ONE - t.eval(p)).max(Rgb::ZERO),
         }
     }
 

@@ -116,6 +116,15 @@ fn diffuse() -> Bxdf {
     })
 }
 
+/// Diffuse reflection and transmission of different colours (reflection chosen with
+/// probability 0.6 / (0.6 + 0.5)).
+fn diffuse_transmission() -> Bxdf {
+    Bxdf::DiffuseTransmission(DiffuseTransmission {
+        reflectance: Vec3::new(0.6, 0.3, 0.1),
+        transmittance: Vec3::new(0.2, 0.5, 0.4),
+    })
+}
+
 /// A direction at polar angle `theta_deg` in the xz-plane (φ = 0), above or below.
 fn wo_at(theta_deg: f32, below: bool) -> Vec3 {
     let t = theta_deg.to_radians();
@@ -199,6 +208,13 @@ fn cases() -> Vec<Case> {
             format!("diffuse θo {theta}"),
             diffuse(),
             wo_at(theta, false),
+        );
+    }
+    for (theta, below) in [(30.0, false), (70.0, true)] {
+        add(
+            format!("diffuse transmission θo {theta} below {below}"),
+            diffuse_transmission(),
+            wo_at(theta, below),
         );
     }
     for (kind, label) in [
@@ -422,13 +438,20 @@ fn sampled_weights_agree_with_uniform_integration_and_albedo_is_at_most_one() {
         ),
         ("principled roughness 0.5", principled(false, 0.5)),
         ("principled thin roughness 0.5", principled(true, 0.5)),
+        ("diffuse transmission", diffuse_transmission()),
     ]
     .into_iter()
     .flat_map(|(name, b)| {
         [(10.0, false), (70.0, false), (30.0, true)]
             .into_iter()
             .filter(move |&(_, below)| {
-                !below || matches!(b, Bxdf::RoughDielectric(_) | Bxdf::Principled(_))
+                !below
+                    || matches!(
+                        b,
+                        Bxdf::RoughDielectric(_)
+                            | Bxdf::Principled(_)
+                            | Bxdf::DiffuseTransmission(_)
+                    )
             })
             .map(move |(theta, below)| {
                 (
@@ -555,6 +578,45 @@ fn smooth_glass_conserves_energy_exactly() {
 }
 
 #[test]
+fn diffuse_transmission_carries_reflectance_plus_transmittance_in_every_sample() {
+    // Grey R = 0.3 and T = 0.5: reflection is chosen with probability 0.3 / 0.8, and each
+    // sample's weight f |cos| / pdf is R / p_r = T / (1 - p_r) = R + T, on either side; a
+    // sample on wo's side is a reflection, one on the other side a transmission.
+    let b = Bxdf::DiffuseTransmission(DiffuseTransmission {
+        reflectance: Vec3::splat(0.3),
+        transmittance: Vec3::splat(0.5),
+    });
+    for (theta, below) in [(0.0, false), (60.0, false), (40.0, true)] {
+        let wo = wo_at(theta, below);
+        let mut reflected = 0;
+        let n = 10_000;
+        for i in 0..n {
+            let uc = (i as f32 + 0.5) / n as f32;
+            let u = Vec2::new((((i * 7919) % n) as f32 + 0.5) / n as f32, 0.37);
+            let s = b.sample(wo, uc, u).unwrap();
+            let w = s.f * s.wi.z.abs() / s.pdf;
+            assert!(
+                (w - Vec3::splat(0.8)).abs().max_element() < 1e-5,
+                "weight {w}"
+            );
+            assert!((s.pdf - b.pdf(wo, s.wi)).abs() <= 1e-5 * s.pdf);
+            reflected += (s.wi.z * wo.z > 0.0) as u32;
+        }
+        assert_eq!(reflected, 3750, "θo {theta}: reflections of {n}");
+    }
+    // Black on both sides: nothing but zero-valued samples, never a NaN.
+    let black = Bxdf::DiffuseTransmission(DiffuseTransmission {
+        reflectance: Vec3::ZERO,
+        transmittance: Vec3::ZERO,
+    });
+    let s = black
+        .sample(wo_at(30.0, false), 0.7, Vec2::new(0.2, 0.4))
+        .unwrap();
+    assert_eq!(s.f, Vec3::ZERO);
+    assert!(s.pdf > 0.0);
+}
+
+#[test]
 fn thin_glass_reflects_what_its_internal_bounces_add_up_to_and_conserves_energy() {
     // A sheet's two interfaces each reflect R = F(θ) and transmit T = 1 - R; light bounces
     // between them until it leaves. Simulating that walk estimates the sheet's reflectance,
@@ -624,6 +686,7 @@ fn reflection_is_reciprocal() {
         rough_glass(NormalDistribution::Ggx, 0.3),
         plastic(0.6, false),
         plastic(0.6, true),
+        diffuse_transmission(),
     ];
     for bxdf in &bxdfs {
         let mut checked = 0;

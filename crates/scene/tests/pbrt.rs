@@ -332,3 +332,110 @@ Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indi
     let l = render_film(&desc, 256, 3).image_mean();
     assert!((l.x - 0.5).abs() < 0.02, "floor radiance {l}");
 }
+
+#[test]
+fn textures_scale_mix_invert_and_checker_as_pbrt_defines_them() {
+    use glam::{Vec2, Vec3};
+    use pathlab_render::desc::{MaterialDesc, TextureDesc};
+    use pathlab_render::texture::{Tex, TexPoint};
+    // A 2 x 1 image: 0.2 on its left half, 0.6 on its right.
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-textures");
+    std::fs::create_dir_all(&dir).unwrap();
+    let texels = [Vec3::splat(0.2), Vec3::splat(0.6)];
+    pathlab_render::image_io::write_exr(&dir.join("two.exr"), 2, 1, &texels, &[]).unwrap();
+    let scene = r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 4 "integer yresolution" 4
+WorldBegin
+Texture "img" "spectrum" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear"
+Texture "amount" "float" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear"
+Texture "doubled" "spectrum" "scale" "texture tex" "img" "float scale" 2
+Texture "inverted" "spectrum" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear" "float scale" 2 "bool invert" true
+Texture "mixed" "spectrum" "mix" "rgb tex1" [ 1 0 0 ] "rgb tex2" [ 0 0 1 ] "texture amount" "amount"
+Texture "checks" "spectrum" "checkerboard" "float uscale" 4 "float vscale" 4 "rgb tex1" [ 1 0 0 ]
+Texture "checked" "spectrum" "checkerboard" "float uscale" 4 "float vscale" 4 "texture tex2" "img"
+MakeNamedMaterial "m0" "string type" "diffuse" "texture reflectance" "doubled"
+MakeNamedMaterial "m1" "string type" "diffuse" "texture reflectance" "inverted"
+MakeNamedMaterial "m2" "string type" "diffuse" "texture reflectance" "mixed"
+MakeNamedMaterial "m3" "string type" "diffuse" "texture reflectance" "checks"
+MakeNamedMaterial "m4" "string type" "diffuse" "texture reflectance" "checked"
+MakeNamedMaterial "m5" "string type" "diffusetransmission" "rgb reflectance" [ 0.8 0.6 0.4 ] "texture transmittance" "img" "float scale" 0.5
+NamedMaterial "m5"
+Shape "sphere"
+"#;
+    std::fs::write(dir.join("textures.pbrt"), scene).unwrap();
+    let desc = pathlab_scene::load(dir.join("textures.pbrt").to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let texture = |m: &MaterialDesc| match m {
+        MaterialDesc::TexturedDiffuse { texture, .. } => Tex::from_desc(texture),
+        other => panic!("not a textured diffuse material: {other:?}"),
+    };
+    let at = |t: &Tex, u: f32, v: f32| t.eval(&TexPoint::uv(Vec2::new(u, v)));
+    let close = |a: Vec3, b: Vec3| (a - b).abs().max_element() < 1e-5;
+    let m = &desc.materials;
+    // scale: the image times 2.
+    let t = texture(&m[0]);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::splat(0.4)));
+    assert!(close(at(&t, 0.75, 0.5), Vec3::splat(1.2)));
+    // An image's scale, then invert, clamped at zero: max(0, 1 - 2 x).
+    let t = texture(&m[1]);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::splat(0.6)));
+    assert!(close(at(&t, 0.75, 0.5), Vec3::ZERO));
+    // mix: (1 - a) red + a blue, a read from the image.
+    let t = texture(&m[2]);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::new(0.8, 0.0, 0.2)));
+    assert!(close(at(&t, 0.75, 0.5), Vec3::new(0.4, 0.0, 0.6)));
+    // checkerboard: tex1 where ⌊4u⌋ + ⌊4v⌋ is even, tex2 (default 0) elsewhere.
+    let t = texture(&m[3]);
+    assert!(close(at(&t, 0.1, 0.1), Vec3::X));
+    assert!(close(at(&t, 0.3, 0.1), Vec3::ZERO));
+    assert!(close(at(&t, 0.3, 0.3), Vec3::X));
+    assert!(close(at(&t, 0.6, 0.1), Vec3::X));
+    // A textured square: tex2 is the image, read at the point's own (u, v).
+    let t = texture(&m[4]);
+    assert!(close(at(&t, 0.1, 0.1), Vec3::ONE));
+    assert!(close(at(&t, 0.3, 0.1), Vec3::splat(0.2)));
+    assert!(close(at(&t, 0.8, 0.1), Vec3::splat(0.6)));
+    // diffusetransmission: both albedos times scale.
+    let MaterialDesc::DiffuseTransmission {
+        reflectance,
+        transmittance,
+    } = &m[5]
+    else {
+        panic!("{:?}", m[5]);
+    };
+    assert!(close(
+        reflectance.as_constant().unwrap(),
+        Vec3::new(0.4, 0.3, 0.2)
+    ));
+    assert!(matches!(transmittance, TextureDesc::Product(_)));
+    let t = Tex::from_desc(transmittance);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::splat(0.1)));
+    render_film(&desc, 1, 0);
+}
+
+#[test]
+fn a_sphere_that_reflects_and_transmits_everything_vanishes_in_a_furnace() {
+    // Under a uniform sky of radiance 1, a closed sphere whose diffuse reflectance and
+    // transmittance add up to one returns all the light it receives, on both its sides: the
+    // expected radiance of every pixel is 1 (light sampling and MIS leave some noise).
+    let scene = r#"LookAt 0 0 4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+Integrator "path" "integer maxdepth" [ 1000 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+Material "diffusetransmission" "rgb reflectance" [ 0.3 0.3 0.3 ] "rgb transmittance" [ 0.7 0.7 0.7 ]
+Shape "sphere" "float radius" 1
+"#;
+    let desc = load_text("furnace", &[("furnace.pbrt", scene)]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let film = render_film(&desc, 64, 5);
+    let means: Vec<f64> = film.pixels().iter().map(|p| p.mean().x).collect();
+    let n = means.len() as f64;
+    let mean = means.iter().sum::<f64>() / n;
+    let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (n - 1.0);
+    let se = (var / n).sqrt();
+    assert!(se > 0.0 && se < 0.01, "standard error {se}");
+    assert!((mean - 1.0).abs() < 4.0 * se, "image mean {mean} ± {se}");
+}

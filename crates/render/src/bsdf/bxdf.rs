@@ -37,6 +37,8 @@ impl LocalSample {
 pub enum Bxdf {
     /// Lambertian.
     Diffuse(Diffuse),
+    /// Lambertian reflection and transmission.
+    DiffuseTransmission(DiffuseTransmission),
     /// Perfect specular reflection.
     Mirror(Mirror),
     /// Smooth glass.
@@ -60,6 +62,7 @@ impl Bxdf {
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
         match self {
             Bxdf::Diffuse(b) => b.f(wo, wi),
+            Bxdf::DiffuseTransmission(b) => b.f(wo, wi),
             Bxdf::Conductor(b) => b.f(wo, wi),
             Bxdf::RoughDielectric(b) => b.f(wo, wi),
             Bxdf::Plastic(b) => b.f(wo, wi),
@@ -73,6 +76,7 @@ impl Bxdf {
     pub fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<LocalSample> {
         match self {
             Bxdf::Diffuse(b) => b.sample(wo, u),
+            Bxdf::DiffuseTransmission(b) => b.sample(wo, uc, u),
             Bxdf::Mirror(b) => b.sample(wo),
             Bxdf::Dielectric(b) => b.sample(wo, uc),
             Bxdf::ThinDielectric(b) => b.sample(wo, uc),
@@ -88,6 +92,7 @@ impl Bxdf {
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Bxdf::Diffuse(b) => b.pdf(wo, wi),
+            Bxdf::DiffuseTransmission(b) => b.pdf(wo, wi),
             Bxdf::Conductor(b) => b.pdf(wo, wi),
             Bxdf::RoughDielectric(b) => b.pdf(wo, wi),
             Bxdf::Plastic(b) => b.pdf(wo, wi),
@@ -103,6 +108,7 @@ impl Bxdf {
             Bxdf::Mirror(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => true,
             Bxdf::Conductor(c) => c.distribution.is_none(),
             Bxdf::Diffuse(_)
+            | Bxdf::DiffuseTransmission(_)
             | Bxdf::RoughDielectric(_)
             | Bxdf::Plastic(_)
             | Bxdf::RoughPlastic(_)

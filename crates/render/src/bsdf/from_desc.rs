@@ -40,6 +40,25 @@ impl Material {
                 }),
                 true,
             ),
+            MaterialDesc::DiffuseTransmission {
+                reflectance,
+                transmittance,
+            } => match (reflectance.as_constant(), transmittance.as_constant()) {
+                (Some(r), Some(t)) => Material::new(
+                    Bxdf::DiffuseTransmission(DiffuseTransmission {
+                        reflectance: r.clamp(Vec3::ZERO, Vec3::ONE),
+                        transmittance: t.clamp(Vec3::ZERO, Vec3::ONE),
+                    }),
+                    false,
+                ),
+                _ => Material::Leaf(Leaf {
+                    model: Model::DiffuseTransmission {
+                        reflectance: tex(reflectance),
+                        transmittance: tex(transmittance),
+                    },
+                    two_sided: false,
+                }),
+            },
             MaterialDesc::Glass { .. } | MaterialDesc::ThinGlass { .. } => glass(d),
             &MaterialDesc::Conductor {
                 alpha,

@@ -53,6 +53,13 @@ pub enum Model {
         /// Its scale.
         scale: Rgb,
     },
+    /// Diffuse reflection and transmission with textured albedos.
+    DiffuseTransmission {
+        /// Albedo of the reflection.
+        reflectance: Tex,
+        /// Albedo of the transmission.
+        transmittance: Tex,
+    },
     /// A rough conductor with textured, possibly anisotropic roughness.
     Conductor {
         /// Roughness along the u tangent.
@@ -387,6 +394,16 @@ impl Model {
             Model::Diffuse { texture, scale } => (
                 Bxdf::Diffuse(Diffuse {
                     reflectance: (*scale * texture.eval(p)).clamp(Vec3::ZERO, Vec3::ONE),
+                }),
+                false,
+            ),
+            Model::DiffuseTransmission {
+                reflectance,
+                transmittance,
+            } => (
+                Bxdf::DiffuseTransmission(DiffuseTransmission {
+                    reflectance: reflectance.eval(p).clamp(Vec3::ZERO, Vec3::ONE),
+                    transmittance: transmittance.eval(p).clamp(Vec3::ZERO, Vec3::ONE),
                 }),
                 false,
             ),

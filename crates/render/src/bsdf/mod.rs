@@ -2,7 +2,7 @@
 //! the integrator multiplies by |cos θi|. Both directions point away from the surface.
 //!
 //! One file per model, each with `f`, `sample` and `pdf` in the local frame: [`diffuse`],
-//! [`mirror`], [`dielectric`] (smooth glass), [`conductor`] (smooth or microfacet),
+//! [`diffuse_transmission`], [`mirror`], [`dielectric`] (smooth glass), [`conductor`] (smooth or microfacet),
 //! [`rough_dielectric`], [`plastic`], [`rough_plastic`]; [`microfacet`] holds the
 //! distributions, [`fresnel`] the reflectance formulas and [`scattering`] the reflected and
 //! refracted directions; [`bxdf`] dispatches among the models.
@@ -16,6 +16,7 @@ pub mod bxdf;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
+pub mod diffuse_transmission;
 pub mod fresnel;
 pub mod from_desc;
 pub mod material;
@@ -33,6 +34,7 @@ pub use bxdf::{Bxdf, LocalSample};
 pub use conductor::Conductor;
 pub use dielectric::{FresnelModel, SmoothDielectric};
 pub use diffuse::Diffuse;
+pub use diffuse_transmission::DiffuseTransmission;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 pub use material::{Leaf, Material, Model, ShadingPoint};
 pub use microfacet::{Microfacet, NormalDistribution};

@@ -60,6 +60,12 @@ pub enum TextureDesc {
         /// The attribute's name (e.g. `vertex_color`, `face_weight`).
         name: String,
     },
+    /// The product of two textures (pbrt-v4's `scale`).
+    Product(Box<[TextureDesc; 2]>),
+    /// `(1 - a) first + a second`, `a` the first texture read as a number (pbrt-v4's `mix`).
+    Mix(Box<[TextureDesc; 3]>),
+    /// max(0, 1 - t) per channel (pbrt-v4's image textures' `invert`).
+    Invert(Box<TextureDesc>),
 }
 
 impl TextureDesc {
@@ -86,13 +92,58 @@ impl TextureDesc {
         }
     }
 
-    /// A summary value: the constant, the image's mean, the checkerboard's average colour.
+    /// `self` × `other` (a constant where both are).
+    pub fn product(self, other: TextureDesc) -> Self {
+        match (self.as_constant(), other.as_constant()) {
+            (Some(a), Some(b)) => TextureDesc::Constant(a * b),
+            (Some(a), None) if a == Rgb::ONE => other,
+            (None, Some(b)) if b == Rgb::ONE => self,
+            _ => TextureDesc::Product(Box::new([self, other])),
+        }
+    }
+
+    /// `self` × `s`.
+    pub fn scaled(self, s: f32) -> Self {
+        self.product(TextureDesc::value(s))
+    }
+
+    /// `(1 - amount) first + amount second` (a constant where all three are).
+    pub fn mix(amount: TextureDesc, first: TextureDesc, second: TextureDesc) -> Self {
+        match (
+            amount.as_constant(),
+            first.as_constant(),
+            second.as_constant(),
+        ) {
+            (Some(a), Some(f), Some(s)) => {
+                let a = crate::color::mitsuba_luminance(a);
+                TextureDesc::Constant((1.0 - a) * f + a * s)
+            }
+            _ => TextureDesc::Mix(Box::new([amount, first, second])),
+        }
+    }
+
+    /// max(0, 1 - self) per channel.
+    pub fn inverted(self) -> Self {
+        match self.as_constant() {
+            Some(c) => TextureDesc::Constant((Rgb::ONE - c).max(Rgb::ZERO)),
+            None => TextureDesc::Invert(Box::new(self)),
+        }
+    }
+
+    /// A summary value: the constant, the image's mean, the checkerboard's average colour,
+    /// and the combinations' values of those.
     pub fn mean(&self) -> Rgb {
         match self {
             TextureDesc::Constant(c) => *c,
             TextureDesc::Image { image, .. } => image.mean(),
             TextureDesc::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
             TextureDesc::MeshAttribute { .. } => Rgb::splat(0.5),
+            TextureDesc::Product(ab) => ab[0].mean() * ab[1].mean(),
+            TextureDesc::Mix(m) => {
+                let a = crate::color::mitsuba_luminance(m[0].mean());
+                (1.0 - a) * m[1].mean() + a * m[2].mean()
+            }
+            TextureDesc::Invert(t) => (Rgb::ONE - t.mean()).max(Rgb::ZERO),
         }
     }
 }
@@ -120,6 +171,14 @@ pub enum MaterialDesc {
     Mirror {
         /// Reflectance per channel.
         reflectance: Rgb,
+    },
+    /// Lambertian reflection on the side light comes from and Lambertian transmission to the
+    /// other (pbrt-v4's `diffusetransmission`); both sides alike.
+    DiffuseTransmission {
+        /// Albedo of the reflection.
+        reflectance: TextureDesc,
+        /// Albedo of the transmission.
+        transmittance: TextureDesc,
     },
     /// A smooth or rough dielectric.
     Glass {
@@ -253,6 +312,7 @@ impl MaterialDesc {
             MaterialDesc::Diffuse { .. } => "diffuse",
             MaterialDesc::TexturedDiffuse { .. } => "textured diffuse",
             MaterialDesc::Mirror { .. } => "mirror",
+            MaterialDesc::DiffuseTransmission { .. } => "diffuse transmission",
             MaterialDesc::Glass { .. } => "glass",
             MaterialDesc::ThinGlass { .. } => "thin glass",
             MaterialDesc::Conductor { .. } => "conductor",

@@ -373,11 +373,7 @@ impl Builder {
             },
             "coateddiffuse" => self.coated_diffuse(params)?,
             "coatedconductor" => self.coated_conductor(params)?,
-            "diffusetransmission" => {
-                params.get("transmittance");
-                self.warn("diffusetransmission: its transmission is not supported; rendered as its diffuse reflection");
-                self.diffuse(params, "reflectance", 0.25)?
-            }
+            "diffusetransmission" => self.diffuse_transmission(params)?,
             "mix" => self.mix(params)?,
             "interface" | "" | "none" => MaterialDesc::Mask {
                 opacity: TextureDesc::value(0.0),
@@ -442,6 +438,18 @@ impl Builder {
             }
         };
         Ok(two_sided(m))
+    }
+
+    /// pbrt-v4's `diffusetransmission`: reflectance and transmittance (0.25 each by default),
+    /// both times `scale`.
+    fn diffuse_transmission(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
+        let scale = self.float(params, "scale", 1.0)? as f32;
+        let reflectance = self.color_texture(params, "reflectance", Rgb::splat(0.25))?;
+        let transmittance = self.color_texture(params, "transmittance", Rgb::splat(0.25))?;
+        Ok(MaterialDesc::DiffuseTransmission {
+            reflectance: reflectance.scaled(scale),
+            transmittance: transmittance.scaled(scale),
+        })
     }
 
     /// pbrt-v4's `coateddiffuse`, approximated (with a warning) by Mitsuba's plastic: a diffuse base under a dielectric coat, with no scattering inside the layer.

@@ -1,5 +1,6 @@
-//! pbrt-v4's `Texture` directive: `constant`, `imagemap` (with its encoding, filter, wrap and
-//! uv mapping), `scale` and `mix` textures, each kept by name for the materials that use it.
+//! pbrt-v4's `Texture` directive: `constant`, `imagemap` (with its encoding, filter, wrap, uv
+//! mapping, scale and invert), `scale`, `mix` and 2D `checkerboard` textures, each kept by name
+//! for the materials that use it.
 
 use super::materials::Use;
 use super::params::ParamList;
@@ -30,38 +31,18 @@ impl Builder {
             }),
             "imagemap" => self.image_texture(&name, ty, &params)?,
             "scale" => {
-                let tex = self.texture_or_value(&params, "tex", ty)?;
-                let scale = self.texture_or_value(&params, "scale", ty)?;
-                match (tex.as_constant(), scale.as_constant()) {
-                    (Some(a), Some(b)) => TextureDesc::Constant(a * b),
-                    (None, Some(b)) if b == Rgb::ONE => tex,
-                    (Some(a), None) if a == Rgb::ONE => scale,
-                    _ => {
-                        self.warn(format!("Texture \"{name}\": a scaled image is not supported; the image alone is used"));
-                        if tex.as_constant().is_none() {
-                            tex
-                        } else {
-                            scale
-                        }
-                    }
-                }
+                let tex = self.texture_or_value(&params, "tex", ty, 1.0)?;
+                // pbrt-v4: the scale is a float texture for either type.
+                let scale = self.texture_or_value(&params, "scale", "float", 1.0)?;
+                tex.product(scale)
             }
             "mix" => {
-                let a = self.texture_or_value(&params, "tex1", ty)?;
-                let b = self.texture_or_value(&params, "tex2", ty)?;
-                let amount = self.float(&params, "amount", 0.5)? as f32;
-                if a.as_constant().is_none()
-                    || b.as_constant().is_none()
-                    || params.has("amount")
-                        && params
-                            .params
-                            .iter()
-                            .any(|p| p.name == "amount" && p.ty == "texture")
-                {
-                    self.warn(format!("Texture \"{name}\": a mix of textures is not supported; their mean is used"));
-                }
-                TextureDesc::Constant(a.mean() * (1.0 - amount) + b.mean() * amount)
+                let first = self.texture_or_value(&params, "tex1", ty, 0.0)?;
+                let second = self.texture_or_value(&params, "tex2", ty, 1.0)?;
+                let amount = self.texture_or_value(&params, "amount", "float", 0.5)?;
+                TextureDesc::mix(amount, first, second)
             }
+            "checkerboard" => self.checkerboard(&name, ty, &params)?,
             other => {
                 self.warn(format!(
                     "Texture \"{name}\": \"{other}\" textures are not supported; a constant 0.5 is used"
@@ -113,6 +94,92 @@ impl Builder {
             }
             _ => WrapMode::Repeat,
         };
+        let to_uv = self.uv_mapping(name, params)?;
+        Ok(match crate::texture::load(&path, raw) {
+            Ok(image) => {
+                // pbrt-v4: the texel times scale, then inverted.
+                let t = TextureDesc::Image {
+                    image,
+                    filter,
+                    wrap,
+                    to_uv,
+                }
+                .scaled(scale);
+                if invert {
+                    t.inverted()
+                } else {
+                    t
+                }
+            }
+            Err(e) => {
+                self.warn(format!("Texture \"{name}\": {e}; a constant 0.5 is used"));
+                TextureDesc::value(0.5)
+            }
+        })
+    }
+
+    /// A texture parameter or a value of the texture's type (`default` where absent).
+    fn texture_or_value(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        ty: &str,
+        default: f32,
+    ) -> Result<TextureDesc, Error> {
+        if params
+            .params
+            .iter()
+            .any(|p| p.name == name && p.ty == "texture")
+        {
+            return self.color_texture(params, name, Rgb::splat(default));
+        }
+        Ok(TextureDesc::Constant(if ty == "float" {
+            Rgb::splat(self.float(params, name, default as f64)? as f32)
+        } else {
+            self.spectrum(params, name, Use::Albedo)?
+                .unwrap_or(Rgb::splat(default))
+        }))
+    }
+
+    /// pbrt-v4's 2D `checkerboard`: `tex1` (default 1) where ⌊s⌋ + ⌊t⌋ is even, `tex2` (default
+    /// 0) elsewhere, (s, t) being the uv mapping's coordinates.
+    fn checkerboard(
+        &mut self,
+        name: &str,
+        ty: &str,
+        params: &ParamList,
+    ) -> Result<TextureDesc, Error> {
+        let dimension = self.float(params, "dimension", 2.0)?;
+        if dimension != 2.0 {
+            self.warn(format!("Texture \"{name}\": a {dimension}D checkerboard is not supported; the 2D one is used"));
+        }
+        let first = self.texture_or_value(params, "tex1", ty, 1.0)?;
+        let second = self.texture_or_value(params, "tex2", ty, 0.0)?;
+        let to_st = self.uv_mapping(name, params)?;
+        // The checkerboard's colour0 lies where the fractional parts of both coordinates are
+        // on the same side of ½: at half the (s, t) scale, where ⌊s⌋ + ⌊t⌋ is even.
+        let to_uv = glam::Affine2::from_scale(glam::Vec2::splat(0.5)) * to_st;
+        Ok(match (first.as_constant(), second.as_constant()) {
+            (Some(color0), Some(color1)) => TextureDesc::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            },
+            _ => TextureDesc::mix(
+                TextureDesc::Checkerboard {
+                    color0: Rgb::ZERO,
+                    color1: Rgb::ONE,
+                    to_uv,
+                },
+                first,
+                second,
+            ),
+        })
+    }
+
+    /// pbrt-v4's `uv` texture mapping: (s, t) = (uscale u + udelta, vscale v + vdelta); other
+    /// mappings are warned about and read as it.
+    fn uv_mapping(&mut self, name: &str, params: &ParamList) -> Result<glam::Affine2, Error> {
         let su = self.float(params, "uscale", 1.0)? as f32;
         let sv = self.float(params, "vscale", 1.0)? as f32;
         let du = self.float(params, "udelta", 0.0)? as f32;
@@ -124,48 +191,10 @@ impl Builder {
                 ));
             }
         }
-        Ok(match crate::texture::load(&path, raw) {
-            Ok(image) => {
-                if invert || scale != 1.0 {
-                    self.warn(format!("Texture \"{name}\": scale and invert of image textures are not supported; ignored"));
-                }
-                TextureDesc::Image {
-                    image,
-                    filter,
-                    wrap,
-                    to_uv: glam::Affine2::from_scale_angle_translation(
-                        glam::Vec2::new(su, sv),
-                        0.0,
-                        glam::Vec2::new(du, dv),
-                    ),
-                }
-            }
-            Err(e) => {
-                self.warn(format!("Texture \"{name}\": {e}; a constant 0.5 is used"));
-                TextureDesc::value(0.5)
-            }
-        })
-    }
-
-    /// A texture parameter or a value of the texture's type (default 1).
-    fn texture_or_value(
-        &mut self,
-        params: &ParamList,
-        name: &str,
-        ty: &str,
-    ) -> Result<TextureDesc, Error> {
-        if params
-            .params
-            .iter()
-            .any(|p| p.name == name && p.ty == "texture")
-        {
-            return self.color_texture(params, name, Rgb::ONE);
-        }
-        Ok(TextureDesc::Constant(if ty == "float" {
-            Rgb::splat(self.float(params, name, 1.0)? as f32)
-        } else {
-            self.spectrum(params, name, Use::Albedo)?
-                .unwrap_or(Rgb::ONE)
-        }))
+        Ok(glam::Affine2::from_scale_angle_translation(
+            glam::Vec2::new(su, sv),
+            0.0,
+            glam::Vec2::new(du, dv),
+        ))
     }
 }
