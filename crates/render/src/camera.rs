@@ -206,9 +206,9 @@ impl FilterSampler {
                     Box::new(move |x: f32| (1.0 - (x / r).abs()).max(0.0) as f64),
                 )
             }
-            PixelFilter::Gaussian { stddev } => {
+            PixelFilter::Gaussian { stddev, radius } => {
                 let s = stddev.max(1e-3) as f64;
-                let r = 4.0 * s;
+                let r = radius.max(1e-3) as f64;
                 let cut = (-r * r / (2.0 * s * s)).exp();
                 (
                     r as f32,
@@ -276,6 +276,65 @@ impl FilterSampler {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn filter_offsets_fit_the_filter_profile_over_any_interval() {
+        use pathlab_mc::rng::Pcg32;
+        use pathlab_mc::stats::{bonferroni, chi2_test_1d};
+        // Each filter's profile, for the test to normalise over the interval it samples.
+        let gaussian = |s: f64, r: f64| {
+            move |x: f64| {
+                let g = |x: f64| (-x * x / (2.0 * s * s)).exp();
+                if x.abs() < r {
+                    (g(x) - g(r)).max(0.0)
+                } else {
+                    0.0
+                }
+            }
+        };
+        type Profile = Box<dyn Fn(f64) -> f64>;
+        let filters: [(PixelFilter, Profile); 3] = [
+            (
+                PixelFilter::Tent { radius: 1.0 },
+                Box::new(|x: f64| (1.0 - x.abs()).max(0.0)),
+            ),
+            (PixelFilter::gaussian(0.5), Box::new(gaussian(0.5, 2.0))),
+            (
+                PixelFilter::Gaussian {
+                    stddev: 0.5,
+                    radius: 1.5,
+                },
+                Box::new(gaussian(0.5, 1.5)),
+            ),
+        ];
+        let intervals = [(-10.0f32, 10.0f32), (-0.3, 10.0), (-10.0, 0.6)];
+        let alpha = bonferroni(0.01, filters.len() * intervals.len());
+        let mut rng = Pcg32::new(11, 4);
+        for (filter, profile) in &filters {
+            let sampler = FilterSampler::new(*filter).unwrap();
+            let r = sampler.radius();
+            for &(lo, hi) in &intervals {
+                let (a, b) = (lo.max(-r) as f64, hi.min(r) as f64);
+                // The profile's integral over [a, b] by the midpoint rule.
+                let n = 100_000;
+                let h = (b - a) / n as f64;
+                let mass: f64 = (0..n)
+                    .map(|i| profile(a + (i as f64 + 0.5) * h))
+                    .sum::<f64>()
+                    * h;
+                let samples: Vec<f64> = (0..200_000)
+                    .map(|_| sampler.sample(rng.uniform_f32(), lo, hi) as f64)
+                    .collect();
+                assert!(samples.iter().all(|&x| x >= a && x <= b));
+                let t = chi2_test_1d(samples, |x| profile(x) / mass, [a, b], 40);
+                assert!(
+                    t.passes(alpha),
+                    "{filter:?} over [{lo}, {hi}]: p = {:.2e}",
+                    t.p_value
+                );
+            }
+        }
+    }
 
     #[test]
     fn raster_positions_invert_camera_rays() {

@@ -138,12 +138,25 @@ pub enum PixelFilter {
         /// Radius in pixels.
         radius: f32,
     },
-    /// A Gaussian of standard deviation `stddev` pixels, cut at 4 standard deviations and
-    /// shifted down to zero there (Mitsuba's `gaussian`).
+    /// A Gaussian of standard deviation `stddev` pixels, cut at `radius` and shifted down to
+    /// zero there: Mitsuba's `gaussian` has radius 4σ ([`PixelFilter::gaussian`]), pbrt-v4's
+    /// 1.5 pixels unless its file says otherwise.
     Gaussian {
         /// Standard deviation in pixels.
         stddev: f32,
+        /// Where the filter ends, in pixels.
+        radius: f32,
     },
+}
+
+impl PixelFilter {
+    /// Mitsuba's Gaussian of standard deviation `stddev`, cut at 4 standard deviations.
+    pub fn gaussian(stddev: f32) -> Self {
+        PixelFilter::Gaussian {
+            stddev,
+            radius: 4.0 * stddev,
+        }
+    }
 }
 
 /// A named attribute of a mesh's vertices or faces (Mitsuba's `vertex_*` / `face_*` PLY

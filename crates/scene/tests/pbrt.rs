@@ -188,6 +188,14 @@ MakeNamedMaterial "gold" "string type" [ "conductor" ]
     assert_eq!(desc.hints.spp, Some(8));
     assert_eq!(desc.hints.max_depth, Some(3));
     assert_eq!(desc.resolution, [16, 16]);
+    // No PixelFilter: pbrt-v4's default Gaussian, σ = 0.5 cut at 1.5 pixels.
+    assert_eq!(
+        desc.filter,
+        pathlab_render::desc::PixelFilter::Gaussian {
+            stddev: 0.5,
+            radius: 1.5
+        }
+    );
     // A blackbody light has luminance 1 before its power: 100 W over 4π sr.
     let i = desc.point_lights[0].intensity;
     let y = 0.2126 * i.x + 0.7152 * i.y + 0.0722 * i.z;

@@ -46,7 +46,7 @@ pub fn load_with(path: &Path, params: &[(String, String)]) -> Result<SceneDesc, 
         tree: &tree,
         desc: SceneDesc {
             resolution: [768, 576],
-            filter: PixelFilter::Gaussian { stddev: 0.5 },
+            filter: PixelFilter::gaussian(0.5),
             ..Default::default()
         },
         materials: HashMap::new(),

@@ -219,15 +219,13 @@ fn film_settings(ctx: &mut Ctx, film: Obj) -> Result<(), Error> {
     }
     let filters = ctx.children(film, "rfilter")?;
     ctx.desc.filter = match filters.first() {
-        None => PixelFilter::Gaussian { stddev: 0.5 },
+        None => PixelFilter::gaussian(0.5),
         Some((_, f)) => match f.plugin {
             "box" => PixelFilter::Box,
             "tent" => PixelFilter::Tent {
                 radius: ctx.positive(*f, "radius", 1.0)? as f32,
             },
-            "gaussian" => PixelFilter::Gaussian {
-                stddev: ctx.positive(*f, "stddev", 0.5)? as f32,
-            },
+            "gaussian" => PixelFilter::gaussian(ctx.positive(*f, "stddev", 0.5)? as f32),
             _ => {
                 let what = ctx.what(*f);
                 ctx.warn(

@@ -38,7 +38,7 @@ const MAX_INCLUDE_DEPTH: usize = 32;
 pub fn load(path: &Path) -> Result<SceneDesc, Error> {
     let mut b = Builder::new(path);
     // pbrt-v4's default pixel filter: a Gaussian of σ = 0.5 pixels.
-    b.desc.filter = pathlab_render::desc::PixelFilter::Gaussian { stddev: 0.5 };
+    b.desc.filter = world::PBRT_DEFAULT_FILTER;
     b.parse_file(path, 0)?;
     b.finish()
 }

@@ -9,6 +9,12 @@ use glam::{DMat4, DVec3, Mat3, Vec2, Vec3};
 use pathlab_render::desc::*;
 use pathlab_render::mc::sampler::SamplerKind;
 
+/// pbrt-v4's pixel filter where a file names none: a Gaussian of σ = 0.5 pixels and radius 1.5.
+pub(crate) const PBRT_DEFAULT_FILTER: PixelFilter = PixelFilter::Gaussian {
+    stddev: 0.5,
+    radius: 1.5,
+};
+
 /// What comes before `WorldBegin`.
 #[derive(Default)]
 pub(crate) struct Options {
@@ -91,18 +97,22 @@ impl Builder {
                     }
                     "gaussian" => {
                         let sigma = self.float(&params, "sigma", 0.5)?;
-                        self.float(&params, "xradius", 1.5)?;
-                        self.float(&params, "yradius", 1.5)?;
+                        let r = self.float(&params, "xradius", 1.5)?;
+                        let ry = self.float(&params, "yradius", r)?;
+                        if (r - ry).abs() > 1e-6 {
+                            self.warn("PixelFilter \"gaussian\": different x and y radii; the x radius is used");
+                        }
                         PixelFilter::Gaussian {
                             stddev: sigma as f32,
+                            radius: r as f32,
                         }
                     }
                     other => {
-                        self.warn(format!("PixelFilter \"{other}\": not supported; pbrt-v4's default Gaussian (σ = 0.5) is used"));
+                        self.warn(format!("PixelFilter \"{other}\": not supported; pbrt-v4's default Gaussian (σ = 0.5, radius 1.5) is used"));
                         for p in &params.params {
                             p.used.set(true);
                         }
-                        PixelFilter::Gaussian { stddev: 0.5 }
+                        PBRT_DEFAULT_FILTER
                     }
                 };
                 self.desc.filter = filter;
