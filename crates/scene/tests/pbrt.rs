@@ -447,3 +447,71 @@ Shape "sphere" "float radius" 1
     assert!(se > 0.0 && se < 0.01, "standard error {se}");
     assert!((mean - 1.0).abs() < 4.0 * se, "image mean {mean} ± {se}");
 }
+
+#[test]
+fn area_light_power_is_per_pbrt_shape_as_in_pbrt_v4() {
+    // pbrt-v4 makes one light of each triangle of a mesh, a sphere or a disk, and scales each
+    // to emit `power` watts: radiance Φ / (π A × sides) for white L.
+    use std::f64::consts::PI;
+    let scene = r#"LookAt 0 0 10  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 6 ]
+  # Two triangles of areas 2 and 1.
+  Shape "trianglemesh" "point3 P" [ 0 0 0  2 0 0  0 2 0   5 0 0  6 0 0  5 2 0 ] "integer indices" [ 0 1 2  3 4 5 ]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 8 ] "bool twosided" true "rgb L" [ 1 0.5 0.25 ]
+  # A unit square: two triangles of area 1/2, each its own light.
+  Shape "bilinearmesh" "point3 P" [ 0 0 3  1 0 3  0 1 3  1 1 3 ] "integer indices" [ 0 1 2 3 ]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 100 ]
+  Shape "sphere" "float radius" 2
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 10 ] "float scale" 2
+  Translate 0 0 -3
+  Shape "disk" "float radius" 1
+AttributeEnd
+"#;
+    let desc = load_text("power", &[("power.pbrt", scene)]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let radiance = |i: usize| desc.meshes[i].emission.unwrap().radiance.as_dvec3();
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-5 * b;
+    // The triangle mesh: two lights, one per triangle (smaller area first).
+    assert_eq!(
+        desc.meshes.len(),
+        4,
+        "{:?}",
+        desc.meshes.iter().map(|m| &m.name).collect::<Vec<_>>()
+    );
+    assert_eq!(desc.meshes[0].indices.len(), 3);
+    assert_eq!(desc.meshes[0].positions.len(), 3);
+    assert!(close(radiance(0).x, 6.0 / (PI * 1.0)), "{}", radiance(0));
+    assert!(close(radiance(1).x, 6.0 / (PI * 2.0)), "{}", radiance(1));
+    // The patch: one light of area 1, two-sided, its colour kept.
+    let l = radiance(2);
+    assert!(close(l.x, 8.0 / (PI * 1.0 * 2.0)), "{l}");
+    assert!(close(l.y, 0.5 * l.x) && close(l.z, 0.25 * l.x), "{l}");
+    // The disk: one light over its whole (tessellated) area, times scale.
+    let disk = &desc.meshes[3];
+    let area: f64 = disk
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            let p = |k: usize| disk.positions[t[k] as usize].as_dvec3();
+            0.5 * (p(1) - p(0)).cross(p(2) - p(0)).length()
+        })
+        .sum();
+    assert!((area - PI).abs() < 1e-3 * PI);
+    assert!(
+        close(radiance(3).x, 2.0 * 10.0 / (PI * area)),
+        "{}",
+        radiance(3)
+    );
+    // The sphere: 4π r².
+    let s = desc.spheres[0].emission.unwrap().radiance.x as f64;
+    assert!(close(s, 100.0 / (PI * 4.0 * PI * 4.0)), "{s}");
+}

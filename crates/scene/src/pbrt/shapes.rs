@@ -39,10 +39,13 @@ impl Builder {
             return Err(self.error(format!("Shape \"{kind}\": its transform is singular")));
         }
         let material = self.shape_material(&params, state)?;
-        let emission = self.area_emission(state)?;
+        let (emission, power) = match self.area_emission(state)? {
+            Some((e, p)) => (Some(e), p),
+            None => (None, None),
+        };
         let mesh = match kind {
             "sphere" => {
-                self.sphere(&params, m, material, emission, state)?;
+                self.sphere(&params, m, material, emission, power, state)?;
                 self.warn_unused(&format!("Shape \"{kind}\""), &params);
                 return Ok(());
             }
@@ -69,7 +72,21 @@ impl Builder {
         out.name = format!("{}:{} {kind}", self.file.display(), self.line);
         out.material = material;
         out.emission = emission;
-        self.desc.meshes.push(out);
+        match (emission, power) {
+            (Some(e), Some(watts)) => {
+                // pbrt-v4 makes a light of each triangle of a mesh (each patch of a bilinear
+                // mesh), each emitting `power`; a disk or cylinder is one light.
+                let per_unit = match kind {
+                    "disk" | "cylinder" => out.indices.len() / 3,
+                    "bilinearmesh" => 2,
+                    _ => 1,
+                };
+                self.desc
+                    .meshes
+                    .extend(split_by_power(out, e, watts, per_unit));
+            }
+            _ => self.desc.meshes.push(out),
+        }
         Ok(())
     }
 
@@ -116,8 +133,11 @@ impl Builder {
         m
     }
 
-    /// The emission of the current area light, if any.
-    fn area_emission(&mut self, state: &GraphicsState) -> Result<Option<Emission>, Error> {
+    /// The emission of the current area light, if any, and its `power` (watts per pbrt shape).
+    fn area_emission(
+        &mut self,
+        state: &GraphicsState,
+    ) -> Result<Option<(Emission, Option<f64>)>, Error> {
         let Some((kind, params, line)) = &state.area_light else {
             return Ok(None);
         };
@@ -136,10 +156,8 @@ impl Builder {
             .unwrap_or(Vec3::ONE);
         let scale = self.float(&params, "scale", 1.0)? as f32;
         let two_sided = self.bool(&params, "twosided", false)?;
-        if params.has("power") {
-            params.get("power");
-            self.warn("AreaLightSource: \"power\" is not supported; L and scale are used");
-        }
+        // pbrt-v4: a power of 0 or less is no power at all.
+        let power = Some(self.float(&params, "power", -1.0)?).filter(|&p| p > 0.0);
         if let Some(file) = self.string(&params, "filename")? {
             self.warn(format!(
                 "AreaLightSource: image emission (\"{file}\") is not supported; L is used"
@@ -147,10 +165,13 @@ impl Builder {
         }
         self.warn_unused("AreaLightSource \"diffuse\"", &params);
         self.line = here;
-        Ok(Some(Emission {
-            radiance: l * scale,
-            two_sided,
-        }))
+        Ok(Some((
+            Emission {
+                radiance: l * scale,
+                two_sided,
+            },
+            power,
+        )))
     }
 
     fn param_numbers<'p>(
@@ -393,6 +414,7 @@ impl Builder {
         m: DMat4,
         material: usize,
         emission: Option<Emission>,
+        power: Option<f64>,
         state: &GraphicsState,
     ) -> Result<(), Error> {
         let radius = self.float(params, "radius", 1.0)?;
@@ -430,9 +452,18 @@ impl Builder {
             axes.y_axis / scales[1],
             axes.z_axis / scales[2],
         );
+        let world_radius = radius * scales[0];
+        let emission = match (emission, power) {
+            (Some(e), Some(watts)) => Some(with_power(
+                e,
+                watts,
+                4.0 * std::f64::consts::PI * world_radius * world_radius,
+            )),
+            _ => emission,
+        };
         self.desc.spheres.push(SphereDesc {
             center: m.transform_point3(DVec3::ZERO).as_vec3(),
-            radius: (radius * scales[0]) as f32,
+            radius: world_radius as f32,
             material,
             emission,
             to_object: rot.transpose().as_mat3(),
@@ -481,5 +512,103 @@ fn place(o: ObjectMesh, m: DMat4, reverse: bool) -> MeshDesc {
         normals,
         uvs: o.uvs,
         ..Default::default()
+    }
+}
+
+/// `e` scaled as pbrt-v4 scales an area light of `area` given its `power` Φ: the radiance
+/// L × Φ / (π A × sides), so that the light emits Φ where L is white of luminance one.
+fn with_power(e: Emission, watts: f64, area: f64) -> Emission {
+    let sides = if e.two_sided { 2.0 } else { 1.0 };
+    let k = watts / (std::f64::consts::PI * area * sides);
+    Emission {
+        radiance: e.radiance * k as f32,
+        ..e
+    }
+}
+
+/// The emitting mesh `mesh` as pbrt-v4 lights it when its area light has a `power`: each run
+/// of `per_unit` triangles (one pbrt shape) emits `watts`, so shapes of different areas have
+/// different radiance. Shapes of equal area (to 1e-6) share one mesh; each mesh keeps only
+/// the vertices its triangles use.
+fn split_by_power(mesh: MeshDesc, e: Emission, watts: f64, per_unit: usize) -> Vec<MeshDesc> {
+    let per_unit = per_unit.max(1);
+    let corner = |i: u32| mesh.positions[i as usize].as_dvec3();
+    let triangle_area = |t: &[u32]| {
+        0.5 * (corner(t[1]) - corner(t[0]))
+            .cross(corner(t[2]) - corner(t[0]))
+            .length()
+    };
+    let tris: Vec<&[u32]> = mesh.indices.chunks_exact(3).collect();
+    let mut units: Vec<(f64, usize)> = tris
+        .chunks(per_unit)
+        .enumerate()
+        .map(|(u, ts)| (ts.iter().map(|t| triangle_area(t)).sum::<f64>(), u))
+        .filter(|(a, _)| *a > 0.0 && a.is_finite())
+        .collect();
+    units.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut groups: Vec<(f64, Vec<usize>)> = Vec::new();
+    for (area, u) in units {
+        match groups.last_mut() {
+            Some((first, members)) if area - *first <= 1e-6 * *first => members.push(u),
+            _ => groups.push((area, vec![u])),
+        }
+    }
+    groups
+        .into_iter()
+        .enumerate()
+        .map(|(g, (area, members))| {
+            let triangles: Vec<usize> = members
+                .iter()
+                .flat_map(|&u| u * per_unit..((u + 1) * per_unit).min(tris.len()))
+                .collect();
+            let mut part = submesh(&mesh, &triangles);
+            part.emission = Some(with_power(e, watts, area));
+            if g > 0 {
+                part.name = format!("{} (shapes of area {area:.4e})", mesh.name);
+            }
+            part
+        })
+        .collect()
+}
+
+/// The triangles `triangles` of `mesh` as a mesh of their own, with only their vertices (its
+/// named attributes, which pbrt-v4 meshes do not have, are left out).
+fn submesh(mesh: &MeshDesc, triangles: &[usize]) -> MeshDesc {
+    let mut remap = std::collections::HashMap::new();
+    let mut used: Vec<u32> = Vec::new();
+    let mut indices = Vec::with_capacity(3 * triangles.len());
+    for &t in triangles {
+        for &i in &mesh.indices[3 * t..3 * t + 3] {
+            let j = *remap.entry(i).or_insert_with(|| {
+                used.push(i);
+                used.len() as u32 - 1
+            });
+            indices.push(j);
+        }
+    }
+    let pick = |v: &Vec<Vec3>| -> Vec<Vec3> {
+        if v.is_empty() {
+            Vec::new()
+        } else {
+            used.iter().map(|&i| v[i as usize]).collect()
+        }
+    };
+    MeshDesc {
+        positions: pick(&mesh.positions),
+        normals: pick(&mesh.normals),
+        tangents: pick(&mesh.tangents),
+        uvs: if mesh.uvs.is_empty() {
+            Vec::new()
+        } else {
+            used.iter().map(|&i| mesh.uvs[i as usize]).collect()
+        },
+        indices,
+        name: mesh.name.clone(),
+        material: mesh.material,
+        emission: mesh.emission,
+        visibility: mesh.visibility,
+        emission_texture: mesh.emission_texture.clone(),
+        // pbrt-v4 meshes carry no named attributes.
+        attributes: Vec::new(),
     }
 }
