@@ -75,6 +75,8 @@ pub enum ProjectorKind {
         cutoff: f32,
         /// Half-angle of the full-intensity beam (radians).
         beam_width: f32,
+        /// How the intensity falls from the beam to the cutoff.
+        falloff: SpotFalloff,
     },
     /// Mitsuba's `projector`: the image on the plane z = 1 spans a horizontal field of view
     /// (u = ½ - ½ x / (z t), Mitsuba's v = ½ - ½ aspect y / (z t), t = tan(fov_x / 2)); the
@@ -88,4 +90,14 @@ pub enum ProjectorKind {
         /// The image's width / height.
         aspect: f32,
     },
+}
+
+/// How a spot light's intensity falls from full at its beam's edge to zero at its cutoff.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpotFalloff {
+    /// Linearly in the angle from the axis (Mitsuba's `spot`).
+    LinearInAngle,
+    /// By the smoothstep t² (3 - 2t) of t = (cos θ - cos cutoff) / (cos beam - cos cutoff)
+    /// (pbrt-v4's `spot`).
+    SmoothStepInCosine,
 }

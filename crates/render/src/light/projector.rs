@@ -1,7 +1,7 @@
 //! Projectors: Mitsuba's textured spot light and projector, a texture seen through a pinhole.
 
 use crate::color::luminance;
-use crate::desc::{ProjectorKind, Rgb};
+use crate::desc::{ProjectorKind, Rgb, SpotFalloff};
 use crate::texture::{Tex, TexPoint};
 use glam::{Mat3, Vec2, Vec3};
 use std::f32::consts::PI;
@@ -30,15 +30,26 @@ impl Projector {
                 intensity,
                 cutoff,
                 beam_width,
+                falloff,
             } => {
                 let cos = d.z;
-                if cos <= cutoff.cos() {
+                let cos_cutoff = cutoff.cos();
+                if cos <= cos_cutoff {
                     return Rgb::ZERO;
                 }
-                let falloff = if cos >= beam_width.cos() {
+                let cos_beam = beam_width.cos();
+                let falloff = if cos >= cos_beam {
                     1.0
                 } else {
-                    (cutoff - cos.clamp(-1.0, 1.0).acos()) / (cutoff - beam_width)
+                    match falloff {
+                        SpotFalloff::LinearInAngle => {
+                            (cutoff - cos.clamp(-1.0, 1.0).acos()) / (cutoff - beam_width)
+                        }
+                        SpotFalloff::SmoothStepInCosine => {
+                            let t = ((cos - cos_cutoff) / (cos_beam - cos_cutoff)).clamp(0.0, 1.0);
+                            t * t * (3.0 - 2.0 * t)
+                        }
+                    }
                 };
                 let k = 0.5 / (d.z * cutoff.tan());
                 let uv = Vec2::new(0.5 + d.x * k, 0.5 - d.y * k);
@@ -77,5 +88,67 @@ impl Projector {
             }
         }
         (sum * std::f64::consts::TAU / (n * n) as f64) as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spot(falloff: SpotFalloff) -> Projector {
+        Projector {
+            position: Vec3::ZERO,
+            to_local: Mat3::IDENTITY,
+            texture: Tex::Constant(Rgb::ONE),
+            kind: ProjectorKind::Spot {
+                intensity: Rgb::splat(2.0),
+                cutoff: 30f32.to_radians(),
+                beam_width: 20f32.to_radians(),
+                falloff,
+            },
+        }
+    }
+
+    fn at_angle(deg: f32) -> Vec3 {
+        let t = deg.to_radians();
+        Vec3::new(t.sin(), 0.0, t.cos())
+    }
+
+    #[test]
+    fn spot_falloffs_follow_their_definitions() {
+        let (cos_cut, cos_beam) = (30f32.to_radians().cos(), 20f32.to_radians().cos());
+        for deg in [
+            0.0f32, 10.0, 20.0, 22.0, 25.0, 28.0, 29.9, 30.0, 45.0, 100.0,
+        ] {
+            let linear = spot(SpotFalloff::LinearInAngle).intensity(at_angle(deg)).x;
+            let smooth = spot(SpotFalloff::SmoothStepInCosine)
+                .intensity(at_angle(deg))
+                .x;
+            let t = ((at_angle(deg).z - cos_cut) / (cos_beam - cos_cut)).clamp(0.0, 1.0);
+            let expected_smooth = if deg >= 30.0 {
+                0.0
+            } else {
+                2.0 * t * t * (3.0 - 2.0 * t)
+            };
+            let expected_linear = 2.0 * ((30.0 - deg) / 10.0).clamp(0.0, 1.0);
+            assert!((smooth - expected_smooth).abs() < 1e-5, "{deg}°: {smooth}");
+            assert!((linear - expected_linear).abs() < 1e-4, "{deg}°: {linear}");
+        }
+        // pbrt-v4's power normalisation: ∫ I dω = 2π I ((1 - cos beam) + (cos beam - cos cutoff) / 2),
+        // the smoothstep averaging ½ over the falloff band in cos θ.
+        let exact = std::f32::consts::TAU * 2.0 * ((1.0 - cos_beam) + 0.5 * (cos_beam - cos_cut));
+        let n = 200_000;
+        let sum: f64 = (0..n)
+            .map(|i| {
+                let z = 1.0 - (1.0 - cos_cut) * (i as f32 + 0.5) / n as f32;
+                let d = Vec3::new((1.0 - z * z).sqrt(), 0.0, z);
+                spot(SpotFalloff::SmoothStepInCosine).intensity(d).x as f64
+            })
+            .sum();
+        let integral = sum * std::f64::consts::TAU * (1.0 - cos_cut as f64) / n as f64;
+        assert!(
+            (integral - exact as f64).abs() < 1e-4 * exact as f64,
+            "{integral} vs {exact}"
+        );
     }
 }

@@ -70,6 +70,7 @@ pub(super) fn emitter(ctx: &mut Ctx, e: Obj) -> Result<(), Error> {
                     intensity,
                     cutoff: (cutoff as f32).to_radians(),
                     beam_width: (beam as f32).to_radians(),
+                    falloff: SpotFalloff::LinearInAngle,
                 },
             });
         }

@@ -409,7 +409,6 @@ impl Builder {
                     .as_vec3()
                     .normalize_or(Vec3::Z);
                 let (x, y) = z.any_orthonormal_pair();
-                self.warn("spot: pbrt-v4's smoothstep falloff over the cone's last conedelta degrees is approximated by a linear falloff in angle");
                 self.desc.projectors.push(ProjectorDesc {
                     position: m.transform_point3(from).as_vec3(),
                     frame: Mat3::from_cols(x, y, z),
@@ -418,6 +417,7 @@ impl Builder {
                         intensity: i * scale,
                         cutoff: cone.to_radians() as f32,
                         beam_width: (cone - delta).max(0.0).to_radians() as f32,
+                        falloff: SpotFalloff::SmoothStepInCosine,
                     },
                 });
             }
