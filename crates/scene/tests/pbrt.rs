@@ -515,3 +515,63 @@ AttributeEnd
     let s = desc.spheres[0].emission.unwrap().radiance.x as f64;
     assert!(close(s, 100.0 / (PI * 4.0 * PI * 4.0)), "{s}");
 }
+
+#[test]
+fn coated_materials_read_their_layers_and_a_lossless_coat_vanishes_in_a_furnace() {
+    use pathlab_render::desc::{CoatedBase, MaterialDesc};
+    let scene = r#"LookAt 0 0 4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+Integrator "path" "integer maxdepth" [ 1000 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+MakeNamedMaterial "plastic" "string type" "coateddiffuse" "rgb reflectance" [ 0.2 0.4 0.6 ]
+  "float roughness" 0.04 "float thickness" 0.2 "rgb albedo" [ 0.5 0.5 0.5 ] "float g" 0.3
+  "integer maxdepth" 20 "integer nsamples" 2 "float eta" 1.4
+MakeNamedMaterial "gold" "string type" "coatedconductor" "float interface.roughness" 0.01
+  "spectrum conductor.eta" "metal-Au-eta" "spectrum conductor.k" "metal-Au-k"
+  "float conductor.uroughness" 0.09 "float conductor.vroughness" 0.16 "bool remaproughness" false
+Material "coateddiffuse" "rgb reflectance" [ 1 1 1 ] "integer maxdepth" 1000 "float thickness" 1e-30
+Shape "sphere" "float radius" 1
+"#;
+    let desc = load_text("coated", &[("coated.pbrt", scene)]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let MaterialDesc::Coated(plastic) = &desc.materials[0] else {
+        panic!("{:?}", desc.materials[0]);
+    };
+    assert_eq!(plastic.coat_alpha, [0.2, 0.2]);
+    assert_eq!(
+        (plastic.coat_eta, plastic.thickness, plastic.g),
+        (1.4, 0.2, 0.3)
+    );
+    assert_eq!((plastic.max_depth, plastic.samples), (20, 2));
+    assert_eq!(plastic.albedo, glam::Vec3::splat(0.5));
+    assert!(
+        matches!(&plastic.base, CoatedBase::Diffuse(t) if t.as_constant() == Some(glam::Vec3::new(0.2, 0.4, 0.6)))
+    );
+    let MaterialDesc::Coated(gold) = &desc.materials[1] else {
+        panic!("{:?}", desc.materials[1]);
+    };
+    // remaproughness false: the coat's roughness is its α.
+    assert_eq!(gold.coat_alpha, [0.01, 0.01]);
+    assert_eq!(
+        (gold.coat_eta, gold.thickness, gold.max_depth, gold.samples),
+        (1.5, 0.01, 10, 1)
+    );
+    let CoatedBase::Conductor { eta, alpha, .. } = &gold.base else {
+        panic!("{:?}", gold.base);
+    };
+    assert_eq!(*alpha, [0.09, 0.16]);
+    assert!(eta.x < 0.5 && eta.z > 1.0, "gold's η {eta}");
+    // A white Lambertian under a smooth coat, with no medium and no thickness to absorb in,
+    // returns all the light it receives: under a uniform sky the sphere's radiance is the
+    // sky's, 1. (pbrt-v4's default thickness 0.01 absorbs a little at each crossing.)
+    let film = render_film(&desc, 64, 5);
+    let means: Vec<f64> = film.pixels().iter().map(|p| p.mean().y).collect();
+    let n = means.len() as f64;
+    let mean = means.iter().sum::<f64>() / n;
+    let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (n - 1.0);
+    let se = (var / n).sqrt();
+    assert!(se > 0.0 && se < 0.01, "standard error {se}");
+    assert!((mean - 1.0).abs() < 4.0 * se, "image mean {mean} ± {se}");
+}

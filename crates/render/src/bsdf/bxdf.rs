@@ -32,6 +32,32 @@ impl LocalSample {
     }
 }
 
+/// Which of a BSDF's lobes a sample may come from (pbrt-v4's `BxDFReflTransFlags`): layered
+/// models walk inside their layers by sampling reflection or transmission alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lobes {
+    /// Reflection and transmission, each with its own probability.
+    All,
+    /// Reflection only.
+    Reflection,
+    /// Transmission only.
+    Transmission,
+}
+
+impl Lobes {
+    /// The probabilities of choosing reflection and transmission whose unrestricted values are
+    /// `r` and `t = 1 - r`: the restricted lobe's share set to zero, the rest renormalised
+    /// (exactly `(r, t)` for [`Lobes::All`]). `None` when nothing is left.
+    pub(crate) fn choose(self, r: f32, t: f32) -> Option<(f32, f32)> {
+        let (r, t) = match self {
+            Lobes::All => return Some((r, t)),
+            Lobes::Reflection => (r, 0.0),
+            Lobes::Transmission => (0.0, t),
+        };
+        (r + t > 0.0).then(|| (r / (r + t), t / (r + t)))
+    }
+}
+
 /// The reflectance model of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Bxdf {
@@ -39,6 +65,8 @@ pub enum Bxdf {
     Diffuse(Diffuse),
     /// Lambertian reflection and transmission.
     DiffuseTransmission(DiffuseTransmission),
+    /// A dielectric coat over a diffuse or conductor base (pbrt-v4's layered BSDFs).
+    Layered(Layered),
     /// Perfect specular reflection.
     Mirror(Mirror),
     /// Smooth glass.
@@ -63,6 +91,7 @@ impl Bxdf {
         match self {
             Bxdf::Diffuse(b) => b.f(wo, wi),
             Bxdf::DiffuseTransmission(b) => b.f(wo, wi),
+            Bxdf::Layered(b) => b.f(wo, wi),
             Bxdf::Conductor(b) => b.f(wo, wi),
             Bxdf::RoughDielectric(b) => b.f(wo, wi),
             Bxdf::Plastic(b) => b.f(wo, wi),
@@ -77,6 +106,7 @@ impl Bxdf {
         match self {
             Bxdf::Diffuse(b) => b.sample(wo, u),
             Bxdf::DiffuseTransmission(b) => b.sample(wo, uc, u),
+            Bxdf::Layered(b) => b.sample(wo, uc, u),
             Bxdf::Mirror(b) => b.sample(wo),
             Bxdf::Dielectric(b) => b.sample(wo, uc),
             Bxdf::ThinDielectric(b) => b.sample(wo, uc),
@@ -93,6 +123,7 @@ impl Bxdf {
         match self {
             Bxdf::Diffuse(b) => b.pdf(wo, wi),
             Bxdf::DiffuseTransmission(b) => b.pdf(wo, wi),
+            Bxdf::Layered(b) => b.pdf(wo, wi),
             Bxdf::Conductor(b) => b.pdf(wo, wi),
             Bxdf::RoughDielectric(b) => b.pdf(wo, wi),
             Bxdf::Plastic(b) => b.pdf(wo, wi),
@@ -102,6 +133,12 @@ impl Bxdf {
         }
     }
 
+    /// Whether `sample` returns an estimate (f / pdf unbiased, pdf for MIS only) rather than
+    /// exact values: the layered models.
+    pub fn is_stochastic(&self) -> bool {
+        matches!(self, Bxdf::Layered(_))
+    }
+
     /// Whether every lobe is a delta distribution (light sampling can never help).
     pub fn is_delta(&self) -> bool {
         match self {
@@ -109,6 +146,7 @@ impl Bxdf {
             Bxdf::Conductor(c) => c.distribution.is_none(),
             Bxdf::Diffuse(_)
             | Bxdf::DiffuseTransmission(_)
+            | Bxdf::Layered(_)
             | Bxdf::RoughDielectric(_)
             | Bxdf::Plastic(_)
             | Bxdf::RoughPlastic(_)

@@ -3,7 +3,7 @@
 use super::fresnel::{fresnel_dielectric, fresnel_schlick};
 use super::mirror::specular_reflection;
 use super::scattering::refract;
-use super::LocalSample;
+use super::{Lobes, LocalSample};
 use crate::desc::Rgb;
 use glam::Vec3;
 
@@ -47,19 +47,26 @@ pub struct SmoothDielectric {
 impl SmoothDielectric {
     /// Reflection with probability F, refraction otherwise (`uc` chooses).
     pub fn sample(&self, wo: Vec3, uc: f32) -> Option<LocalSample> {
+        self.sample_lobes(wo, uc, Lobes::All)
+    }
+
+    /// [`SmoothDielectric::sample`] restricted to `lobes` (the other's probability given to
+    /// the one left).
+    pub fn sample_lobes(&self, wo: Vec3, uc: f32, lobes: Lobes) -> Option<LocalSample> {
         if wo.z == 0.0 {
             return None;
         }
         let f = self.fresnel.reflectance(wo.z, self.eta);
-        if uc < f {
-            return specular_reflection(wo, self.reflectance * f, f);
+        let (pr, pt) = lobes.choose(f, 1.0 - f)?;
+        if uc < pr {
+            return specular_reflection(wo, self.reflectance * f, pr);
         }
         let (wi, etap) = refract(wo, self.eta)?;
         let t = 1.0 - f;
         Some(LocalSample {
             f: self.transmittance * (t / (wi.z.abs() * etap * etap)),
             wi,
-            pdf: t,
+            pdf: pt,
             delta: true,
         })
     }

@@ -4,7 +4,7 @@
 use super::material::PrincipledModel;
 use super::rough_plastic::CoatTable;
 use super::*;
-use crate::desc::{MaterialDesc, PrincipledDesc, Rgb, TextureDesc};
+use crate::desc::{CoatedBase, CoatedDesc, MaterialDesc, PrincipledDesc, Rgb, TextureDesc};
 use crate::texture::Tex;
 use glam::Vec3;
 
@@ -59,6 +59,7 @@ impl Material {
                     two_sided: false,
                 }),
             },
+            MaterialDesc::Coated(c) => coated(c, &mut tex),
             MaterialDesc::Glass { .. } | MaterialDesc::ThinGlass { .. } => glass(d),
             &MaterialDesc::Conductor {
                 alpha,
@@ -118,6 +119,63 @@ impl Material {
             }
         }
     }
+}
+
+/// A coated material: a fixed layered model where nothing is textured or anisotropic.
+fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material {
+    let roughness = |[au, av]: [f32; 2]| {
+        (au.max(av) > SMOOTH_ALPHA)
+            .then(|| Microfacet::anisotropic(NormalDistribution::Ggx, au, av))
+    };
+    let (base, base_texture, base_anisotropic) = match &c.base {
+        CoatedBase::Diffuse(t) => {
+            let reflectance = t
+                .as_constant()
+                .unwrap_or(Rgb::ZERO)
+                .clamp(Vec3::ZERO, Vec3::ONE);
+            let texture = t.as_constant().is_none().then(|| tex(t));
+            (Base::Diffuse(Diffuse { reflectance }), texture, false)
+        }
+        CoatedBase::Conductor { eta, k, alpha } => (
+            Base::Conductor(Conductor {
+                eta: *eta,
+                k: *k,
+                specular: Rgb::ONE,
+                distribution: roughness(*alpha),
+            }),
+            None,
+            alpha[0] != alpha[1],
+        ),
+    };
+    let eta = if c.coat_eta > 0.0 && c.coat_eta.is_finite() {
+        c.coat_eta
+    } else {
+        1.5
+    };
+    let layered = Layered {
+        coat: Coat {
+            eta,
+            roughness: roughness(c.coat_alpha),
+        },
+        base,
+        thickness: c.thickness.max(f32::MIN_POSITIVE),
+        albedo: c.albedo.clamp(Vec3::ZERO, Vec3::ONE),
+        g: c.g.clamp(-0.99, 0.99),
+        max_depth: c.max_depth.min(u16::MAX as u32) as u16,
+        samples: c.samples.clamp(1, u16::MAX as u32) as u16,
+    };
+    let anisotropic = base_anisotropic || c.coat_alpha[0] != c.coat_alpha[1];
+    if base_texture.is_none() && !anisotropic {
+        return Material::new(Bxdf::Layered(layered), false);
+    }
+    Material::Leaf(Leaf {
+        model: Model::Coated {
+            layered,
+            base_texture,
+            anisotropic,
+        },
+        two_sided: false,
+    })
 }
 
 /// Smooth, rough or thin glass. The side matters: inside and outside differ.

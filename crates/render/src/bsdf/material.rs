@@ -60,6 +60,15 @@ pub enum Model {
         /// Albedo of the transmission.
         transmittance: Tex,
     },
+    /// A layered model whose base albedo may be textured.
+    Coated {
+        /// The model, its base albedo replaced by the texture's where there is one.
+        layered: Layered,
+        /// The diffuse base's albedo.
+        base_texture: Option<Tex>,
+        /// Whether the coat or the base is anisotropic.
+        anisotropic: bool,
+    },
     /// A rough conductor with textured, possibly anisotropic roughness.
     Conductor {
         /// Roughness along the u tangent.
@@ -258,6 +267,7 @@ impl Material {
         match self {
             Material::Leaf(l) => match &l.model {
                 Model::Conductor { .. } => true,
+                Model::Coated { anisotropic, .. } => *anisotropic,
                 Model::Principled(p) => p.anisotropic.is_some(),
                 _ => false,
             },
@@ -407,6 +417,17 @@ impl Model {
                 }),
                 false,
             ),
+            Model::Coated {
+                layered,
+                base_texture,
+                anisotropic,
+            } => {
+                let mut l = *layered;
+                if let (Some(t), Base::Diffuse(d)) = (base_texture, &mut l.base) {
+                    d.reflectance = t.eval(p).clamp(Vec3::ZERO, Vec3::ONE);
+                }
+                (Bxdf::Layered(l), *anisotropic)
+            }
             Model::Conductor {
                 alpha_u,
                 alpha_v,

@@ -291,6 +291,19 @@ impl Bsdf {
         if pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || cos <= 0.0 {
             return None;
         }
+        if l.bxdf.is_stochastic() {
+            // The lobe's f / pdf is an estimate of its own value over its own density, not of
+            // f over `pdf`: the sample weighs the chosen lobe alone (chosen with probability
+            // its weight, which cancels), and carries the mixture's pdf for MIS.
+            let f = s.f * (l.attenuation(wi) * pdf / s.pdf);
+            return f.is_finite().then_some(BsdfSample {
+                f,
+                wi,
+                pdf,
+                delta: false,
+                cos,
+            });
+        }
         let f = self.f_cos(wo, wi) / cos;
         f.is_finite().then_some(BsdfSample {
             f,

@@ -2,7 +2,7 @@
 //! the integrator multiplies by |cos θi|. Both directions point away from the surface.
 //!
 //! One file per model, each with `f`, `sample` and `pdf` in the local frame: [`diffuse`],
-//! [`diffuse_transmission`], [`mirror`], [`dielectric`] (smooth glass), [`conductor`] (smooth or microfacet),
+//! [`diffuse_transmission`], [`layered`] (pbrt-v4's coated materials), [`mirror`], [`dielectric`] (smooth glass), [`conductor`] (smooth or microfacet),
 //! [`rough_dielectric`], [`plastic`], [`rough_plastic`]; [`microfacet`] holds the
 //! distributions, [`fresnel`] the reflectance formulas and [`scattering`] the reflected and
 //! refracted directions; [`bxdf`] dispatches among the models.
@@ -19,10 +19,12 @@ pub mod diffuse;
 pub mod diffuse_transmission;
 pub mod fresnel;
 pub mod from_desc;
+pub mod layered;
 pub mod material;
 pub mod microfacet;
 pub mod mirror;
 pub mod mixture;
+pub mod phase;
 pub mod plastic;
 pub mod principled;
 pub mod rough_dielectric;
@@ -30,12 +32,13 @@ pub mod rough_plastic;
 pub mod scattering;
 pub mod thin_dielectric;
 
-pub use bxdf::{Bxdf, LocalSample};
+pub use bxdf::{Bxdf, Lobes, LocalSample};
 pub use conductor::Conductor;
 pub use dielectric::{FresnelModel, SmoothDielectric};
 pub use diffuse::Diffuse;
 pub use diffuse_transmission::DiffuseTransmission;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+pub use layered::{Base, Coat, Layered};
 pub use material::{Leaf, Material, Model, ShadingPoint};
 pub use microfacet::{Microfacet, NormalDistribution};
 pub use mirror::Mirror;

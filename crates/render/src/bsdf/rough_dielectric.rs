@@ -3,7 +3,7 @@
 use super::fresnel::fresnel_dielectric;
 use super::microfacet::Microfacet;
 use super::scattering::{reflect, refract_about};
-use super::LocalSample;
+use super::{Lobes, LocalSample};
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
 
@@ -74,6 +74,12 @@ impl RoughDielectric {
 
     /// A sampled microfacet normal, then reflection (probability F) or refraction.
     pub fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<LocalSample> {
+        self.sample_lobes(wo, uc, u, Lobes::All)
+    }
+
+    /// [`RoughDielectric::sample`] restricted to `lobes` (at the sampled facet, the other
+    /// lobe's probability given to the one left).
+    pub fn sample_lobes(&self, wo: Vec3, uc: f32, u: Vec2, lobes: Lobes) -> Option<LocalSample> {
         if wo.z == 0.0 {
             return None;
         }
@@ -84,7 +90,8 @@ impl RoughDielectric {
             return None;
         }
         let f = fresnel_dielectric(wo.dot(wm), self.eta);
-        let (wi, reflection) = if uc < f {
+        let (pr, _) = lobes.choose(f, 1.0 - f)?;
+        let (wi, reflection) = if uc < pr {
             (reflect(wo, wm), true)
         } else {
             (refract_about(wo, wm, self.eta)?.0, false)
@@ -94,21 +101,29 @@ impl RoughDielectric {
         if (wi.z * wo.z > 0.0) != reflection || wi.z == 0.0 {
             return None;
         }
-        LocalSample::evaluated(wi, self.pdf(wo, wi), || self.f(wo, wi))
+        LocalSample::evaluated(wi, self.pdf_lobes(wo, wi, lobes), || self.f(wo, wi))
     }
 
     /// Density of [`RoughDielectric::sample`].
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.pdf_lobes(wo, wi, Lobes::All)
+    }
+
+    /// Density of [`RoughDielectric::sample_lobes`].
+    pub fn pdf_lobes(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> f32 {
         let Some((wm, etap, reflection)) = half_vector(wo, wi, self.eta) else {
             return 0.0;
         };
         let f = fresnel_dielectric(wo.dot(wm), self.eta);
+        let Some((pr, pt)) = lobes.choose(f, 1.0 - f) else {
+            return 0.0;
+        };
         let pdf_wm = self.distribution.pdf_wm(wo, wm);
         if reflection {
-            pdf_wm / (4.0 * wo.dot(wm).abs()) * f
+            pdf_wm / (4.0 * wo.dot(wm).abs()) * pr
         } else {
             let dwm_dwi = wi.dot(wm).abs() / (wi.dot(wm) + wo.dot(wm) / etap).powi(2);
-            pdf_wm * dwm_dwi * (1.0 - f)
+            pdf_wm * dwm_dwi * pt
         }
     }
 }

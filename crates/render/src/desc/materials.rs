@@ -180,6 +180,9 @@ pub enum MaterialDesc {
         /// Albedo of the transmission.
         transmittance: TextureDesc,
     },
+    /// A dielectric coat over a diffuse or conductor base with a scattering layer between
+    /// (pbrt-v4's `coateddiffuse` and `coatedconductor`, evaluated by random walks).
+    Coated(Box<CoatedDesc>),
     /// A smooth or rough dielectric.
     Glass {
         /// Reflectance scale.
@@ -313,6 +316,10 @@ impl MaterialDesc {
             MaterialDesc::TexturedDiffuse { .. } => "textured diffuse",
             MaterialDesc::Mirror { .. } => "mirror",
             MaterialDesc::DiffuseTransmission { .. } => "diffuse transmission",
+            MaterialDesc::Coated(c) => match c.base {
+                CoatedBase::Diffuse(_) => "coated diffuse",
+                CoatedBase::Conductor { .. } => "coated conductor",
+            },
             MaterialDesc::Glass { .. } => "glass",
             MaterialDesc::ThinGlass { .. } => "thin glass",
             MaterialDesc::Conductor { .. } => "conductor",
@@ -328,6 +335,43 @@ impl MaterialDesc {
             MaterialDesc::BumpMap { .. } => "bump map",
         }
     }
+}
+
+/// What lies under a [`MaterialDesc::Coated`] coat.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CoatedBase {
+    /// Lambertian of this albedo.
+    Diffuse(TextureDesc),
+    /// A conductor.
+    Conductor {
+        /// Real part of the complex index of refraction, per channel.
+        eta: Rgb,
+        /// Imaginary part, per channel.
+        k: Rgb,
+        /// Roughness α along u and v (0: smooth; GGX).
+        alpha: [f32; 2],
+    },
+}
+
+/// A coated material (pbrt-v4's layered BSDFs): coat, base and the layer between.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoatedDesc {
+    /// The base.
+    pub base: CoatedBase,
+    /// The coat's index of refraction relative to outside.
+    pub coat_eta: f32,
+    /// The coat's roughness α along u and v (0: smooth; GGX).
+    pub coat_alpha: [f32; 2],
+    /// Optical thickness of the layer.
+    pub thickness: f32,
+    /// Single-scattering albedo of the layer's medium (zero: none).
+    pub albedo: Rgb,
+    /// Henyey–Greenstein asymmetry of the medium.
+    pub g: f32,
+    /// Most scattering events a walk follows.
+    pub max_depth: u32,
+    /// Walks averaged by each evaluation.
+    pub samples: u32,
 }
 
 /// The parameters of a principled material, each a texture (numbers read as luminance), with

@@ -13,7 +13,9 @@ use crate::spectrum::{blackbody_to_rgb, sampled_to_rgb, xyz_to_srgb, SpectrumKin
 use crate::Error;
 use glam::{DVec3, Vec3};
 use pathlab_render::color::luminance_f64 as luminance;
-use pathlab_render::desc::{FresnelModel, MaterialDesc, NormalDistribution, Rgb, TextureDesc};
+use pathlab_render::desc::{
+    CoatedBase, CoatedDesc, FresnelModel, MaterialDesc, NormalDistribution, Rgb, TextureDesc,
+};
 
 /// pbrt-v4's named glasses: their index at the sodium d line (587.6 nm).
 const GLASSES: &[(&str, f32)] = &[
@@ -273,9 +275,15 @@ impl Builder {
 
     /// `roughness`, `uroughness`, `vroughness` and `remaproughness` as (α_u, α_v).
     fn roughness(&mut self, params: &ParamList) -> Result<(f32, f32), Error> {
-        let r = self.float_value(params, "roughness", 0.0)?;
-        let u = self.float_value(params, "uroughness", r)?;
-        let v = self.float_value(params, "vroughness", r)?;
+        self.roughness_of(params, "")
+    }
+
+    /// `{prefix}roughness`, `{prefix}uroughness` and `{prefix}vroughness` as α along u and v,
+    /// remapped as `remaproughness` says (pbrt-v4's default: remapped).
+    fn roughness_of(&mut self, params: &ParamList, prefix: &str) -> Result<(f32, f32), Error> {
+        let r = self.float_value(params, &format!("{prefix}roughness"), 0.0)?;
+        let u = self.float_value(params, &format!("{prefix}uroughness"), r)?;
+        let v = self.float_value(params, &format!("{prefix}vroughness"), r)?;
         let remap = self.bool(params, "remaproughness", true)?;
         // pbrt-v4's TrowbridgeReitzDistribution::RoughnessToAlpha is √roughness; below
         // α = 10⁻³ a surface is smooth.
@@ -292,11 +300,16 @@ impl Builder {
 
     /// The index of refraction `eta` (a number or a named glass), default 1.5.
     fn eta(&mut self, params: &ParamList) -> Result<f32, Error> {
-        match params.params.iter().rev().find(|p| p.name == "eta") {
-            Some(p) if p.ty == "float" => self.float(params, "eta", 1.5).map(|v| v as f32),
+        self.eta_of(params, "eta")
+    }
+
+    /// The index of refraction `name` (a number or a named glass), default 1.5.
+    fn eta_of(&mut self, params: &ParamList, name: &str) -> Result<f32, Error> {
+        match params.params.iter().rev().find(|p| p.name == name) {
+            Some(p) if p.ty == "float" => self.float(params, name, 1.5).map(|v| v as f32),
             Some(_) => {
                 let c = self
-                    .spectrum(params, "eta", Use::Unbounded)?
+                    .spectrum(params, name, Use::Unbounded)?
                     .unwrap_or(Vec3::splat(1.5));
                 Ok(c.x)
             }
@@ -400,26 +413,7 @@ impl Builder {
     /// pbrt-v4's `conductor`: by its `reflectance`, or `eta` and `k` (copper by default), smooth or rough (anisotropic where `uroughness` and `vroughness` differ).
     fn conductor(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
         let (au, av) = self.roughness(params)?;
-        let (eta, k) = match self.spectrum(params, "reflectance", Use::Albedo)? {
-            // pbrt-v4: a conductor given by its reflectance r has η = 1 and
-            // k = 2 √r / √(1 - r).
-            Some(r) => {
-                let r = r.clamp(Vec3::ZERO, Vec3::splat(0.9999));
-                (
-                    Vec3::ONE,
-                    2.0 * r.map(f32::sqrt) / (Vec3::ONE - r).map(f32::sqrt),
-                )
-            }
-            None => {
-                let eta = self.spectrum(params, "eta", Use::Unbounded)?;
-                let k = self.spectrum(params, "k", Use::Unbounded)?;
-                let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
-                (
-                    eta.unwrap_or(Vec3::from(cu_eta)),
-                    k.unwrap_or(Vec3::from(cu_k)),
-                )
-            }
-        };
+        let (eta, k) = self.conductor_optics(params, "eta", "k")?;
         let m = if au == av {
             MaterialDesc::Conductor {
                 alpha: au,
@@ -440,6 +434,34 @@ impl Builder {
         Ok(two_sided(m))
     }
 
+    /// A conductor's complex index: from its `reflectance` r (pbrt-v4: η = 1 and
+    /// k = 2 √r / √(1 - r)), or the `eta_name` and `k_name` spectra, copper by default.
+    fn conductor_optics(
+        &mut self,
+        params: &ParamList,
+        eta_name: &str,
+        k_name: &str,
+    ) -> Result<(Rgb, Rgb), Error> {
+        Ok(match self.spectrum(params, "reflectance", Use::Albedo)? {
+            Some(r) => {
+                let r = r.clamp(Vec3::ZERO, Vec3::splat(0.9999));
+                (
+                    Vec3::ONE,
+                    2.0 * r.map(f32::sqrt) / (Vec3::ONE - r).map(f32::sqrt),
+                )
+            }
+            None => {
+                let eta = self.spectrum(params, eta_name, Use::Unbounded)?;
+                let k = self.spectrum(params, k_name, Use::Unbounded)?;
+                let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
+                (
+                    eta.unwrap_or(Vec3::from(cu_eta)),
+                    k.unwrap_or(Vec3::from(cu_k)),
+                )
+            }
+        })
+    }
+
     /// pbrt-v4's `diffusetransmission`: reflectance and transmittance (0.25 each by default),
     /// both times `scale`.
     fn diffuse_transmission(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
@@ -452,61 +474,76 @@ impl Builder {
         })
     }
 
-    /// pbrt-v4's `coateddiffuse`, approximated (with a warning) by Mitsuba's plastic: a diffuse base under a dielectric coat, with no scattering inside the layer.
+    /// pbrt-v4's `coateddiffuse`: a dielectric coat (`roughness`, `eta`) over a Lambertian
+    /// base (`reflectance`), with the layer's `thickness`, `albedo`, `g`, `maxdepth` and
+    /// `nsamples`.
     fn coated_diffuse(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
-        let (au, av) = self.roughness(params)?;
-        let ior = self.eta(params)?;
-        let diffuse = self.color_texture(params, "reflectance", Rgb::splat(0.5))?;
-        for p in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
-            params.get(p);
-        }
-        self.warn("coateddiffuse: approximated by a diffuse base under a dielectric coat with no scattering inside the layer (Mitsuba's plastic), not pbrt-v4's stochastic layers");
-        let m = if au == 0.0 && av == 0.0 {
-            MaterialDesc::Plastic {
-                diffuse: diffuse.mean(),
-                specular: Rgb::ONE,
-                ior,
-                nonlinear: false,
-            }
-        } else {
-            MaterialDesc::RoughPlastic {
-                diffuse,
-                specular: Rgb::ONE,
-                alpha: 0.5 * (au + av),
-                ior,
-                nonlinear: false,
-                distribution: NormalDistribution::Ggx,
-            }
-        };
-        Ok(two_sided(m))
+        let coat_alpha = self.roughness_of(params, "")?;
+        let coat_eta = self.eta_of(params, "eta")?;
+        let reflectance = self.color_texture(params, "reflectance", Rgb::splat(0.5))?;
+        self.coated(
+            params,
+            CoatedBase::Diffuse(reflectance),
+            coat_eta,
+            coat_alpha,
+        )
     }
 
-    /// pbrt-v4's `coatedconductor`, approximated (with a warning) by its conductor without the coat.
+    /// pbrt-v4's `coatedconductor`: a dielectric coat (`interface.roughness`,
+    /// `interface.eta`) over a conductor (`conductor.eta` and `conductor.k`, copper by
+    /// default, or `reflectance`; `conductor.roughness`), with the layer's parameters.
     fn coated_conductor(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
-        self.warn("coatedconductor: approximated by its conductor without the coat");
-        let r = self.float_value(params, "conductor.roughness", 0.0)?;
-        let remap = self.bool(params, "remaproughness", true)?;
-        let a = if remap { r.sqrt() } else { r } as f32;
-        let eta = self.spectrum(params, "conductor.eta", Use::Unbounded)?;
-        let k = self.spectrum(params, "conductor.k", Use::Unbounded)?;
-        let (cu_eta, cu_k) = named_conductor("Cu").unwrap_or(([1.0; 3], [0.0; 3]));
-        for p in [
-            "interface.eta",
-            "interface.roughness",
-            "thickness",
-            "albedo",
-            "g",
-            "maxdepth",
-            "nsamples",
-        ] {
-            params.get(p);
+        let coat_alpha = self.roughness_of(params, "interface.")?;
+        let coat_eta = self.eta_of(params, "interface.eta")?;
+        let alpha = self.roughness_of(params, "conductor.")?;
+        let (eta, k) = self.conductor_optics(params, "conductor.eta", "conductor.k")?;
+        let base = CoatedBase::Conductor {
+            eta,
+            k,
+            alpha: [alpha.0, alpha.1],
+        };
+        self.coated(params, base, coat_eta, coat_alpha)
+    }
+
+    /// The layer's parameters shared by both coated materials, with pbrt-v4's defaults.
+    fn coated(
+        &mut self,
+        params: &ParamList,
+        base: CoatedBase,
+        coat_eta: f32,
+        coat_alpha: (f32, f32),
+    ) -> Result<MaterialDesc, Error> {
+        let thickness = self.float_value(params, "thickness", 0.01)? as f32;
+        let albedo = self.color_texture(params, "albedo", Rgb::ZERO)?;
+        if albedo.as_constant().is_none() {
+            self.warn(
+                "\"texture albedo\": a textured layer albedo is not supported; its mean is used",
+            );
         }
-        Ok(two_sided(MaterialDesc::Conductor {
-            alpha: if a < 1e-3 { 0.0 } else { a },
-            eta: eta.unwrap_or(Vec3::from(cu_eta)),
-            k: k.unwrap_or(Vec3::from(cu_k)),
-            distribution: NormalDistribution::Ggx,
-        }))
+        let g = self.float_value(params, "g", 0.0)? as f32;
+        let max_depth = self.float(params, "maxdepth", 10.0)?;
+        let samples = self.float(params, "nsamples", 1.0)?;
+        if !(thickness > 0.0 && thickness.is_finite()) {
+            return Err(self.error(format!("thickness {thickness}: must be a positive number")));
+        }
+        if !(0.0..=1_000.0).contains(&max_depth) || !(1.0..=1_000.0).contains(&samples) {
+            return Err(self.error(format!(
+                "maxdepth {max_depth} and nsamples {samples}: expected 0 to 1000 and 1 to 1000"
+            )));
+        }
+        if !(-1.0 < g && g < 1.0) {
+            return Err(self.error(format!("g {g}: must lie strictly between -1 and 1")));
+        }
+        Ok(MaterialDesc::Coated(Box::new(CoatedDesc {
+            base,
+            coat_eta,
+            coat_alpha: [coat_alpha.0, coat_alpha.1],
+            thickness,
+            albedo: albedo.mean().clamp(Rgb::ZERO, Rgb::ONE),
+            g,
+            max_depth: max_depth as u32,
+            samples: samples as u32,
+        })))
     }
 
     /// pbrt-v4's `mix` of two named materials.
