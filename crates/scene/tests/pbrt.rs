@@ -575,3 +575,34 @@ Shape "sphere" "float radius" 1
     assert!(se > 0.0 && se < 0.01, "standard error {se}");
     assert!((mean - 1.0).abs() < 4.0 * se, "image mean {mean} ± {se}");
 }
+
+#[test]
+fn loop_subdivision_surfaces_are_subdivided_at_load() {
+    let scene = |levels: &str| {
+        format!(
+            r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+WorldBegin
+Shape "loopsubdiv" {levels} "integer indices" [ 0 1 2  0 2 3  0 3 1  1 3 2 ]
+  "point3 P" [ 0 0 1  0.943 0 -0.333  -0.471 0.816 -0.333  -0.471 -0.816 -0.333 ]
+"#
+        )
+    };
+    let desc = load_text("loop", &[("loop.pbrt", &scene("\"integer levels\" 2"))]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let m = &desc.meshes[0];
+    assert_eq!(m.indices.len(), 4 * 16 * 3);
+    assert_eq!(m.normals.len(), m.positions.len());
+    // The limit surface shrinks inside the control tetrahedron (circumradius 1).
+    assert!(m.positions.iter().all(|p| p.length() < 0.9));
+    // pbrt-v4's default is 3 levels.
+    let desc = load_text("loop3", &[("loop.pbrt", &scene(""))]).unwrap();
+    assert_eq!(desc.meshes[0].indices.len(), 4 * 64 * 3);
+    let err = load_text(
+        "loop-huge",
+        &[("loop.pbrt", &scene("\"integer levels\" 40"))],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("loop.pbrt") && err.contains("levels"), "{err}");
+}

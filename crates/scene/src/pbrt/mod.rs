@@ -13,6 +13,7 @@
 //!   file and line, never ignored silently.
 
 mod lexer;
+mod loop_subdiv;
 mod materials;
 mod params;
 mod shapes;

@@ -52,11 +52,7 @@ impl Builder {
             "trianglemesh" => self.triangle_mesh(&params)?,
             "plymesh" => self.ply_mesh(&params)?,
             "bilinearmesh" => self.bilinear_mesh(&params)?,
-            "loopsubdiv" => {
-                self.float(&params, "levels", 3.0)?;
-                self.warn("Shape \"loopsubdiv\": not subdivided; its control mesh is rendered");
-                self.triangle_mesh(&params)?
-            }
+            "loopsubdiv" => self.loop_subdiv(&params)?,
             "disk" => self.disk(&params)?,
             "cylinder" => self.cylinder(&params)?,
             other => {
@@ -279,6 +275,30 @@ impl Builder {
 
     fn triangle_mesh(&self, params: &ParamList) -> Result<ObjectMesh, Error> {
         self.mesh_arrays(params, 3)
+    }
+
+    /// `loopsubdiv`: the control mesh subdivided `levels` times (3 by default) and moved to
+    /// its limit surface.
+    fn loop_subdiv(&mut self, params: &ParamList) -> Result<ObjectMesh, Error> {
+        let levels = self.float(params, "levels", 3.0)?;
+        let m = self.mesh_arrays(params, 3)?;
+        let triangles = (m.indices.len() / 3) as f64;
+        if !(0.0..=12.0).contains(&levels) || triangles * 4f64.powf(levels.floor()) > 64e6 {
+            return Err(self.error(format!(
+                "Shape \"loopsubdiv\": {levels} levels of {triangles} triangles would make more than 64 million"
+            )));
+        }
+        if !m.uvs.is_empty() || !m.normals.is_empty() {
+            self.warn("Shape \"loopsubdiv\": its uv and N are not subdivided; the limit surface's normals are used");
+        }
+        let (positions, indices, normals) =
+            super::loop_subdiv::subdivide(m.positions, m.indices, levels as u32);
+        Ok(ObjectMesh {
+            positions,
+            indices,
+            normals,
+            uvs: Vec::new(),
+        })
     }
 
     /// Bilinear patches (vertices p00, p10, p01, p11) as two triangles each.
