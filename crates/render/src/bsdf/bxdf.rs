@@ -166,3 +166,13 @@ pub(crate) fn usable_ior(ior: f32) -> f32 {
 
 /// Roughness below which a microfacet model is drawn as its smooth (delta) limit.
 pub(crate) const SMOOTH_ALPHA: f32 = 1e-4;
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_bxdf_stays_as_small_as_its_largest_fixed_model() {
+        // Every shading point copies one or more; the layered model keeps its stack behind a
+        // reference so that it adds nothing.
+        assert!(std::mem::size_of::<super::Bxdf>() <= std::mem::size_of::<super::Principled>());
+    }
+}

@@ -127,14 +127,14 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
         (au.max(av) > SMOOTH_ALPHA)
             .then(|| Microfacet::anisotropic(NormalDistribution::Ggx, au, av))
     };
-    let (base, base_texture, base_anisotropic) = match &c.base {
+    let (base, reflectance, base_texture, base_anisotropic) = match &c.base {
         CoatedBase::Diffuse(t) => {
             let reflectance = t
                 .as_constant()
                 .unwrap_or(Rgb::ZERO)
                 .clamp(Vec3::ZERO, Vec3::ONE);
             let texture = t.as_constant().is_none().then(|| tex(t));
-            (Base::Diffuse(Diffuse { reflectance }), texture, false)
+            (Base::Diffuse, reflectance, texture, false)
         }
         CoatedBase::Conductor { eta, k, alpha } => (
             Base::Conductor(Conductor {
@@ -143,6 +143,7 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
                 specular: Rgb::ONE,
                 distribution: roughness(*alpha),
             }),
+            Rgb::ZERO,
             None,
             alpha[0] != alpha[1],
         ),
@@ -152,7 +153,7 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
     } else {
         1.5
     };
-    let layered = Layered {
+    let stack = LayerStack {
         coat: Coat {
             eta,
             roughness: roughness(c.coat_alpha),
@@ -164,6 +165,7 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
         max_depth: c.max_depth.min(u16::MAX as u32) as u16,
         samples: c.samples.clamp(1, u16::MAX as u32) as u16,
     };
+    let layered = Layered::new(stack, reflectance);
     let anisotropic = base_anisotropic || c.coat_alpha[0] != c.coat_alpha[1];
     if base_texture.is_none() && !anisotropic {
         return Material::new(Bxdf::Layered(layered), false);

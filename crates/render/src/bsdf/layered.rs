@@ -27,6 +27,8 @@ use crate::desc::Rgb;
 use crate::integrator::power_heuristic;
 use glam::{Vec2, Vec3};
 use pathlab_mc::rng::{hash_words, Pcg32};
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
 
 /// The dielectric coat on top.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,15 +42,17 @@ pub struct Coat {
 /// What lies under the coat.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Base {
-    /// Lambertian.
-    Diffuse(Diffuse),
+    /// Lambertian, of the albedo [`Layered::reflectance`] gives.
+    Diffuse,
     /// A smooth or rough conductor.
     Conductor(Conductor),
 }
 
-/// A coat over a base with a medium between them (see the module's description).
+/// A coat over a base with a medium between them (see the module's description), all but the
+/// diffuse base's albedo: interned ([`LayerStack::interned`]) so that a [`Layered`] is a
+/// reference and a colour, and a BSDF holding one stays small.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Layered {
+pub struct LayerStack {
     /// The top interface.
     pub coat: Coat,
     /// The bottom interface.
@@ -63,6 +67,50 @@ pub struct Layered {
     pub max_depth: u16,
     /// Walks averaged by each `f` and `pdf` estimate.
     pub samples: u16,
+}
+
+impl LayerStack {
+    /// The one shared copy of this stack (stacks are few: one per coated material of the
+    /// scenes loaded, kept for the life of the program).
+    pub fn interned(self) -> &'static LayerStack {
+        static STACKS: OnceLock<Mutex<HashMap<Vec<u32>, &'static LayerStack>>> = OnceLock::new();
+        let bits = |c: Rgb| [c.x, c.y, c.z].map(f32::to_bits);
+        let mut key = vec![
+            self.coat.eta.to_bits(),
+            self.thickness.to_bits(),
+            self.g.to_bits(),
+            self.max_depth as u32,
+            self.samples as u32,
+        ];
+        key.extend(bits(self.albedo));
+        let facets = |m: Option<Microfacet>| match m {
+            None => [0, 0, 0],
+            Some(m) => [1 + m.kind as u32, m.alpha.to_bits(), m.alpha_y.to_bits()],
+        };
+        key.extend(facets(self.coat.roughness));
+        if let Base::Conductor(c) = self.base {
+            key.extend(bits(c.eta));
+            key.extend(bits(c.k));
+            key.extend(bits(c.specular));
+            key.extend(facets(c.distribution));
+        }
+        let mut stacks = STACKS
+            .get_or_init(Default::default)
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        stacks
+            .entry(key)
+            .or_insert_with(|| Box::leak(Box::new(self)))
+    }
+}
+
+/// A layered BSDF: a [`LayerStack`] and, for a diffuse base, its albedo.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layered {
+    /// Coat, base and medium.
+    pub stack: &'static LayerStack,
+    /// Albedo of a diffuse base (unused over a conductor).
+    pub reflectance: Rgb,
 }
 
 /// Whether a walk carries radiance (from the camera) or importance (from a light): refraction
@@ -86,7 +134,8 @@ struct Event {
 #[derive(Clone, Copy)]
 enum Interface<'a> {
     Top(&'a Coat),
-    Bottom(&'a Base),
+    Diffuse(Diffuse),
+    Conductor(&'a Conductor),
 }
 
 /// η'² undone on a transmission from `wo` to `wi` (the radiance scaling of refraction, which
@@ -126,8 +175,8 @@ impl Interface<'_> {
     fn specular(self) -> bool {
         match self {
             Interface::Top(c) => c.smooth().is_some(),
-            Interface::Bottom(Base::Diffuse(_)) => false,
-            Interface::Bottom(Base::Conductor(c)) => c.distribution.is_none(),
+            Interface::Diffuse(_) => false,
+            Interface::Conductor(c) => c.distribution.is_none(),
         }
     }
 
@@ -137,8 +186,8 @@ impl Interface<'_> {
                 Some(r) => r.f(wo, wi) * adjoint(mode, wo, wi, c.eta),
                 None => Rgb::ZERO,
             },
-            Interface::Bottom(Base::Diffuse(d)) => d.f(wo, wi),
-            Interface::Bottom(Base::Conductor(c)) => c.f(wo, wi),
+            Interface::Diffuse(d) => d.f(wo, wi),
+            Interface::Conductor(c) => c.f(wo, wi),
         }
     }
 
@@ -146,8 +195,8 @@ impl Interface<'_> {
         match self {
             Interface::Top(c) => c.rough().map_or(0.0, |r| r.pdf_lobes(wo, wi, lobes)),
             _ if lobes == Lobes::Transmission => 0.0,
-            Interface::Bottom(Base::Diffuse(d)) => d.pdf(wo, wi),
-            Interface::Bottom(Base::Conductor(c)) => c.pdf(wo, wi),
+            Interface::Diffuse(d) => d.pdf(wo, wi),
+            Interface::Conductor(c) => c.pdf(wo, wi),
         }
     }
 
@@ -165,8 +214,8 @@ impl Interface<'_> {
                 }
             }
             _ if lobes == Lobes::Transmission => return None,
-            Interface::Bottom(Base::Diffuse(d)) => d.sample(wo, u)?,
-            Interface::Bottom(Base::Conductor(c)) => c.sample(wo, u)?,
+            Interface::Diffuse(d) => d.sample(wo, u)?,
+            Interface::Conductor(c) => c.sample(wo, u)?,
         };
         (s.pdf > 0.0 && s.wi.z != 0.0 && s.f.max_element() > 0.0).then_some(Event {
             f: s.f,
@@ -212,20 +261,33 @@ fn next(rng: &mut Pcg32) -> f32 {
 }
 
 impl Layered {
-    fn top(&self) -> Interface<'_> {
-        Interface::Top(&self.coat)
+    /// A layered BSDF of `stack` (interned here) and base albedo `reflectance`.
+    pub fn new(stack: LayerStack, reflectance: Rgb) -> Self {
+        Layered {
+            stack: stack.interned(),
+            reflectance,
+        }
     }
 
-    fn bottom(&self) -> Interface<'_> {
-        Interface::Bottom(&self.base)
+    fn top(&self) -> Interface<'static> {
+        Interface::Top(&self.stack.coat)
+    }
+
+    fn bottom(&self) -> Interface<'static> {
+        match &self.stack.base {
+            Base::Diffuse => Interface::Diffuse(Diffuse {
+                reflectance: self.reflectance,
+            }),
+            Base::Conductor(c) => Interface::Conductor(c),
+        }
     }
 
     fn has_medium(&self) -> bool {
-        self.albedo.max_element() > 0.0
+        self.stack.albedo.max_element() > 0.0
     }
 
     fn phase(&self) -> HenyeyGreenstein {
-        HenyeyGreenstein { g: self.g }
+        HenyeyGreenstein { g: self.stack.g }
     }
 
     /// f(wo, wi): the coat's reflection plus the mean of `samples` random walks' estimates.
@@ -237,10 +299,10 @@ impl Layered {
         if wo.z * wi.z <= 0.0 {
             return Rgb::ZERO;
         }
-        let n = self.samples.max(1) as f32;
+        let n = self.stack.samples.max(1) as f32;
         let mut f = self.top().f(wo, wi, Mode::Radiance) * n;
         let mut rng = rng_for(wo, wi, 1);
-        for _ in 0..self.samples.max(1) {
+        for _ in 0..self.stack.samples.max(1) {
             f += self.walk_estimate(wo, wi, &mut rng);
         }
         f / n
@@ -250,7 +312,7 @@ impl Layered {
     /// layer (pbrt-v4's `LayeredBxDF::f` loop, for the coat as entrance and exit).
     fn walk_estimate(&self, wo: Vec3, wi: Vec3, rng: &mut Pcg32) -> Rgb {
         let (top, bottom) = (self.top(), self.bottom());
-        let thickness = self.thickness;
+        let thickness = self.stack.thickness;
         let exit_z = thickness;
         let mut r = || next(rng);
         let mut f = Rgb::ZERO;
@@ -267,7 +329,7 @@ impl Layered {
         let mut z = thickness;
         let mut w = wos.wi;
         let phase = self.phase();
-        for depth in 0..self.max_depth {
+        for depth in 0..self.stack.max_depth {
             if depth > 3 && beta.max_element() < 0.25 {
                 let q = (1.0 - beta.max_element()).max(0.0);
                 if r() < q {
@@ -292,7 +354,7 @@ impl Layered {
                         power_heuristic(1, wis.pdf, 1, phase.p(-w, -wis.wi))
                     };
                     f += beta
-                        * self.albedo
+                        * self.stack.albedo
                         * phase.p(-w, -wis.wi)
                         * wt
                         * tr(zp - exit_z, wis.wi)
@@ -302,7 +364,7 @@ impl Layered {
                     if ps.p <= 0.0 || ps.wi.z == 0.0 {
                         continue;
                     }
-                    beta *= self.albedo; // p / pdf = 1
+                    beta *= self.stack.albedo; // p / pdf = 1
                     w = ps.wi;
                     z = zp;
                     if (z < exit_z && w.z > 0.0 || z > exit_z && w.z < 0.0) && !top.specular() {
@@ -400,10 +462,10 @@ impl Layered {
         let mut f = entry.f * entry.wi.z.abs();
         let mut pdf = entry.pdf;
         let mut w = entry.wi;
-        let thickness = self.thickness;
+        let thickness = self.stack.thickness;
         let mut z = thickness;
         let phase = self.phase();
-        for depth in 0..self.max_depth {
+        for depth in 0..self.stack.max_depth {
             let rr_beta = f.max_element() / pdf;
             if depth > 3 && rr_beta < 0.25 {
                 let q = (1.0 - rr_beta).max(0.0);
@@ -426,7 +488,7 @@ impl Layered {
                     if ps.p <= 0.0 || ps.wi.z == 0.0 {
                         return None;
                     }
-                    f *= self.albedo * ps.p;
+                    f *= self.stack.albedo * ps.p;
                     pdf *= ps.p;
                     w = ps.wi;
                     z = zp;
@@ -460,7 +522,7 @@ impl Layered {
             (wo, wi) = (-wo, -wi);
         }
         let (top, bottom) = (self.top(), self.bottom());
-        let n = self.samples.max(1);
+        let n = self.stack.samples.max(1);
         let mut sum = 0.0;
         if wo.z * wi.z > 0.0 {
             sum += n as f32 * top.pdf(wo, wi, Lobes::Reflection);
@@ -519,19 +581,23 @@ mod tests {
     use pathlab_mc::estimator::RunningStats;
 
     /// A white or coloured Lambertian base under a coat of index 1.5, no medium.
-    fn coated_diffuse(rho: Rgb, roughness: Option<f32>, max_depth: u16) -> Layered {
-        Layered {
+    fn stack(roughness: Option<f32>, max_depth: u16) -> LayerStack {
+        LayerStack {
             coat: Coat {
                 eta: 1.5,
                 roughness: roughness.map(|a| Microfacet::new(NormalDistribution::Ggx, a)),
             },
-            base: Base::Diffuse(Diffuse { reflectance: rho }),
+            base: Base::Diffuse,
             thickness: f32::MIN_POSITIVE,
             albedo: Rgb::ZERO,
             g: 0.0,
             max_depth,
             samples: 1,
         }
+    }
+
+    fn coated_diffuse(rho: Rgb, roughness: Option<f32>, max_depth: u16) -> Layered {
+        Layered::new(stack(roughness, max_depth), rho)
     }
 
     fn direction(theta_deg: f32, phi_deg: f32) -> Vec3 {
@@ -608,21 +674,27 @@ mod tests {
         let (eta, k) = (Rgb::new(0.2, 0.92, 1.1), Rgb::new(3.9, 2.45, 2.14));
         let cases = [
             coated_diffuse(Rgb::new(0.7, 0.4, 0.2), Some(0.3), 100),
-            Layered {
-                albedo: Rgb::new(0.8, 0.6, 0.3),
-                g: 0.4,
-                thickness: 0.3,
-                ..coated_diffuse(Rgb::splat(0.5), Some(0.15), 100)
-            },
-            Layered {
-                base: Base::Conductor(Conductor {
-                    eta,
-                    k,
-                    specular: Rgb::ONE,
-                    distribution: Some(Microfacet::new(NormalDistribution::Ggx, 0.4)),
-                }),
-                ..coated_diffuse(Rgb::ONE, Some(0.2), 100)
-            },
+            Layered::new(
+                LayerStack {
+                    albedo: Rgb::new(0.8, 0.6, 0.3),
+                    g: 0.4,
+                    thickness: 0.3,
+                    ..stack(Some(0.15), 100)
+                },
+                Rgb::splat(0.5),
+            ),
+            Layered::new(
+                LayerStack {
+                    base: Base::Conductor(Conductor {
+                        eta,
+                        k,
+                        specular: Rgb::ONE,
+                        distribution: Some(Microfacet::new(NormalDistribution::Ggx, 0.4)),
+                    }),
+                    ..stack(Some(0.2), 100)
+                },
+                Rgb::ONE,
+            ),
         ];
         for (i, b) in cases.iter().enumerate() {
             for theta in [20.0, 70.0] {
@@ -654,11 +726,19 @@ mod tests {
 
     #[test]
     fn estimates_are_fixed_functions_of_their_arguments_and_both_sides_alike() {
-        let b = Layered {
-            albedo: Rgb::splat(0.5),
-            thickness: 0.2,
-            ..coated_diffuse(Rgb::splat(0.6), Some(0.3), 10)
-        };
+        let b = Layered::new(
+            LayerStack {
+                albedo: Rgb::splat(0.5),
+                thickness: 0.2,
+                ..stack(Some(0.3), 10)
+            },
+            Rgb::splat(0.6),
+        );
+        // One stack interned once.
+        assert!(std::ptr::eq(
+            b.stack,
+            Layered::new(*b.stack, Rgb::ONE).stack
+        ));
         let (wo, wi) = (direction(30.0, 10.0), direction(50.0, 200.0));
         assert_eq!(b.f(wo, wi), b.f(wo, wi));
         assert_eq!(b.pdf(wo, wi), b.pdf(wo, wi));

@@ -423,8 +423,8 @@ impl Model {
                 anisotropic,
             } => {
                 let mut l = *layered;
-                if let (Some(t), Base::Diffuse(d)) = (base_texture, &mut l.base) {
-                    d.reflectance = t.eval(p).clamp(Vec3::ZERO, Vec3::ONE);
+                if let Some(t) = base_texture {
+                    l.reflectance = t.eval(p).clamp(Vec3::ZERO, Vec3::ONE);
                 }
                 (Bxdf::Layered(l), *anisotropic)
             }
