@@ -606,3 +606,55 @@ Shape "loopsubdiv" {levels} "integer indices" [ 0 1 2  0 2 3  0 3 1  1 3 2 ]
     .to_string();
     assert!(err.contains("loop.pbrt") && err.contains("levels"), "{err}");
 }
+
+#[test]
+fn a_screen_window_shows_that_part_of_the_screen() {
+    use pathlab_render::camera::Camera;
+    // The full view at 200 x 100 (screen window [-2, 2, -1, 1]), and its right half alone at
+    // 100 x 100 (window [0, 2, -1, 1]): a world point lands 100 pixels further left there.
+    // Likewise the top-left quarter at 100 x 50, and an orthographic camera.
+    let scene = |projection: &str, window: &str, (w, h): (u32, u32)| {
+        format!(
+            r#"LookAt 0.3 0.2 5  0 0 0  0 1 0
+Camera "{projection}" {window}
+Film "rgb" "integer xresolution" {w} "integer yresolution" {h}
+WorldBegin
+Shape "sphere"
+"#
+        )
+    };
+    let points = [
+        glam::Vec3::new(0.5, 0.2, 0.1),
+        glam::Vec3::new(1.2, -0.4, -0.3),
+        glam::Vec3::new(-0.8, 0.6, 0.2),
+    ];
+    for projection in ["perspective", "orthographic"] {
+        let camera = |tag: &str, window: &str, size: (u32, u32)| {
+            let text = scene(projection, window, size);
+            let desc = load_text(tag, &[("window.pbrt", &text)]).unwrap();
+            assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+            Camera::new(&desc.camera, desc.resolution)
+        };
+        let full = camera("full", "", (200, 100));
+        let right = camera("right", "\"float screenwindow\" [ 0 2 -1 1 ]", (100, 100));
+        let corner = camera("corner", "\"float screenwindow\" [ -2 0 0 1 ]", (100, 50));
+        for p in points {
+            let f = full.raster_position(p).unwrap();
+            let r = right.raster_position(p).unwrap();
+            let c = corner.raster_position(p).unwrap();
+            assert!(
+                (r - (f - glam::Vec2::new(100.0, 0.0))).length() < 1e-3,
+                "{projection}: {f} {r}"
+            );
+            assert!((c - f).length() < 1e-3, "{projection}: {f} {c}");
+        }
+    }
+    // A window of another shape than the film: warned.
+    let text = scene(
+        "perspective",
+        "\"float screenwindow\" [ -1 1 -1 1 ]",
+        (200, 100),
+    );
+    let desc = load_text("stretched", &[("window.pbrt", &text)]).unwrap();
+    assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
+}

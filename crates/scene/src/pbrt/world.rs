@@ -249,13 +249,67 @@ impl Builder {
         for p in ["shutteropen", "shutterclose"] {
             params.get(p);
         }
-        if params.has("screenwindow") || params.has("frameaspectratio") {
-            params.get("screenwindow");
-            params.get("frameaspectratio");
-            self.warn("Camera: screenwindow and frameaspectratio are not supported; the film's aspect is used");
-        }
+        self.screen_window(&params, &mut camera, aspect)?;
         self.warn_unused(&format!("Camera \"{kind}\""), &params);
         self.desc.camera = camera;
+        Ok(())
+    }
+
+    /// pbrt-v4's `screenwindow` [x0 x1 y0 y1] (and `frameaspectratio`, which sets the default
+    /// window [-a, a, -1, 1] or [-1, 1, -1/a, 1/a]): the part of the screen the film shows,
+    /// in units of tan(fov / 2) on the screen's shorter axis (of world units for an
+    /// orthographic camera), as a vertical field of view and a shift of the image's centre.
+    /// A window whose shape differs from the film's would need non-square pixels: warned, the
+    /// window's height kept.
+    fn screen_window(
+        &mut self,
+        params: &ParamList,
+        camera: &mut CameraDesc,
+        aspect: f32,
+    ) -> Result<(), Error> {
+        let frame = self.float(params, "frameaspectratio", aspect as f64)? as f32;
+        if !(frame > 0.0 && frame.is_finite()) {
+            return Err(self.error(format!(
+                "Camera: frameaspectratio {frame} must be a positive number"
+            )));
+        }
+        let window = match params.get("screenwindow") {
+            None if (frame - aspect).abs() <= 1e-4 * aspect => return Ok(()),
+            None if frame > 1.0 => [-frame, frame, -1.0, 1.0],
+            None => [-1.0, 1.0, -1.0 / frame, 1.0 / frame],
+            Some(p) => match p.numbers() {
+                Some(&[x0, x1, y0, y1]) if x0 < x1 && y0 < y1 => {
+                    [x0 as f32, x1 as f32, y0 as f32, y1 as f32]
+                }
+                _ => {
+                    return Err(self.error(format!(
+                        "\"{} screenwindow\" (line {}): expected four numbers x0 x1 y0 y1 with x0 < x1 and y0 < y1",
+                        p.ty, p.line
+                    )))
+                }
+            },
+        };
+        let [x0, x1, y0, y1] = window;
+        let (hx, hy) = (0.5 * (x1 - x0), 0.5 * (y1 - y0));
+        if (hx / hy - aspect).abs() > 1e-3 * aspect {
+            self.warn(format!(
+                "Camera: a screen window of aspect {:.4} on a film of aspect {aspect:.4} needs non-square pixels; the window's height is kept",
+                hx / hy
+            ));
+        }
+        camera.principal_point_offset =
+            Vec2::new(0.5 * (x0 + x1) / (2.0 * hx), -0.5 * (y0 + y1) / (2.0 * hy));
+        match &mut camera.projection {
+            Projection::Orthographic { half_extent } => {
+                *half_extent = Vec2::new(hy * aspect, hy);
+            }
+            Projection::Perspective => {
+                // The screen's unit is tan(fov / 2) on the shorter axis.
+                let unit = (0.5 * camera.fov_degrees.to_radians()).tan();
+                camera.fov_degrees = 2.0 * (hy * unit).atan().to_degrees();
+                camera.fov_axis = FovAxis::Y;
+            }
+        }
         Ok(())
     }
 
