@@ -87,22 +87,23 @@ impl Camera {
         self
     }
 
-    /// The film position of the sample `u` ∈ [0, 1)² of pixel `pixel`: uniform in the pixel
-    /// for a box filter, otherwise drawn from the filter around the pixel's centre, restricted
-    /// to the image (so that each pixel's expected value is the filter-weighted average of the
-    /// radiance over the image, as splatting samples into neighbouring pixels gives).
+    /// The film position of the sample `u` ∈ [0, 1)² of pixel `pixel` and the weight its
+    /// radiance takes: uniform in the pixel for a box filter, otherwise drawn from the filter
+    /// around the pixel's centre, restricted to the image (so that each pixel's expected
+    /// value is the filter-weighted average of the radiance over the image, as splatting
+    /// samples into neighbouring pixels gives). The weight is one except under filters with
+    /// negative lobes (see [`FilterSampler`]).
     #[inline]
-    pub fn film_position(&self, pixel: [u32; 2], u: Vec2) -> Vec2 {
+    pub fn film_sample(&self, pixel: [u32; 2], u: Vec2) -> (Vec2, f32) {
         let p = Vec2::new(pixel[0] as f32, pixel[1] as f32);
         match &self.filter {
-            None => p + u,
+            None => (p + u, 1.0),
             Some(f) => {
                 let c = p + 0.5;
                 let (w, h) = (self.resolution[0] as f32, self.resolution[1] as f32);
-                Vec2::new(
-                    c.x + f.sample(u.x, -c.x, w - c.x),
-                    c.y + f.sample(u.y, -c.y, h - c.y),
-                )
+                let (x, wx) = f.sample(u.x, -c.x, w - c.x);
+                let (y, wy) = f.sample(u.y, -c.y, h - c.y);
+                (Vec2::new(c.x + x, c.y + y), wx * wy)
             }
         }
     }
@@ -183,13 +184,46 @@ impl Camera {
 }
 
 /// Draws pixel sample offsets from a filter's one-dimensional profile (the filters are
-/// separable): the inverse of its tabulated cumulative distribution, restricted to an interval
-/// (the part of the filter inside the image).
+/// separable): the inverse of its tabulated cumulative distribution of |f|, restricted to an
+/// interval (the part of the filter inside the image). Filters with negative lobes give each
+/// offset a signed weight, sign(f) ∫|f| / ∫f over the interval, whose mean is one: the
+/// weighted samples' mean is then the filter-weighted average of the radiance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FilterSampler {
     radius: f32,
-    /// Cumulative weight at the edges of `BINS` equal bins over [-radius, radius], from 0 to 1.
+    /// Cumulative |f| at the edges of `BINS` equal bins over [-radius, radius], from 0 to 1.
     cdf: Vec<f32>,
+    /// Cumulative f at the same edges, on the same scale; `None` where f ≥ 0 (it equals
+    /// `cdf`, and every weight is one).
+    signed: Option<Vec<f32>>,
+}
+
+/// Mitchell and Netravali's cubic at |x| ≤ 2.
+fn mitchell_1d(x: f64, b: f64, c: f64) -> f64 {
+    let x = x.abs();
+    let v = if x <= 1.0 {
+        (12.0 - 9.0 * b - 6.0 * c) * x * x * x
+            + (-18.0 + 12.0 * b + 6.0 * c) * x * x
+            + (6.0 - 2.0 * b)
+    } else if x <= 2.0 {
+        (-b - 6.0 * c) * x * x * x
+            + (6.0 * b + 30.0 * c) * x * x
+            + (-12.0 * b - 48.0 * c) * x
+            + (8.0 * b + 24.0 * c)
+    } else {
+        0.0
+    };
+    v / 6.0
+}
+
+/// sin(πx) / (πx).
+fn sinc(x: f64) -> f64 {
+    let px = std::f64::consts::PI * x;
+    if px.abs() < 1e-5 {
+        1.0 - px * px / 6.0
+    } else {
+        px.sin() / px
+    }
 }
 
 impl FilterSampler {
@@ -218,21 +252,58 @@ impl FilterSampler {
                     }),
                 )
             }
+            PixelFilter::Mitchell { radius, b, c } => {
+                let r = radius.max(1e-3);
+                let (b, c) = (b as f64, c as f64);
+                (
+                    r,
+                    Box::new(move |x: f32| mitchell_1d(2.0 * x as f64 / r as f64, b, c)),
+                )
+            }
+            PixelFilter::LanczosSinc { radius, tau } => {
+                let r = radius.max(1e-3);
+                let tau = tau.max(1e-3) as f64;
+                (
+                    r,
+                    Box::new(move |x: f32| {
+                        let x = x as f64;
+                        if x.abs() > r as f64 {
+                            0.0
+                        } else {
+                            sinc(x) * sinc(x / tau)
+                        }
+                    }),
+                )
+            }
         };
         let n = Self::BINS;
-        let mut cdf = Vec::with_capacity(n + 1);
-        let mut sum = 0.0f64;
-        cdf.push(0.0);
         let step = 2.0 * radius / n as f32;
-        for i in 0..n {
-            // Midpoint rule in each bin.
-            sum += weight(-radius + (i as f32 + 0.5) * step);
-            cdf.push(sum as f32);
-        }
-        for c in &mut cdf {
-            *c /= sum as f32;
-        }
-        Some(FilterSampler { radius, cdf })
+        // Midpoint rule in each bin.
+        let values: Vec<f64> = (0..n)
+            .map(|i| weight(-radius + (i as f32 + 0.5) * step))
+            .collect();
+        let cumulative = |f: &dyn Fn(f64) -> f64| {
+            let mut sum = 0.0f64;
+            let mut c = Vec::with_capacity(n + 1);
+            c.push(0.0);
+            for v in &values {
+                sum += f(*v);
+                c.push(sum);
+            }
+            c
+        };
+        let abs = cumulative(&f64::abs);
+        let total = abs[n];
+        let scale = |c: Vec<f64>| c.into_iter().map(|v| (v / total) as f32).collect();
+        let signed = values
+            .iter()
+            .any(|v| *v < 0.0)
+            .then(|| scale(cumulative(&|v| v)));
+        Some(FilterSampler {
+            radius,
+            cdf: scale(abs),
+            signed,
+        })
     }
 
     /// The filter's radius in pixels.
@@ -240,20 +311,22 @@ impl FilterSampler {
         self.radius
     }
 
-    /// The cumulative distribution at offset `x`.
-    fn cdf_at(&self, x: f32) -> f32 {
+    /// `table` (a cumulative distribution) at offset `x`.
+    fn cumulative_at(&self, table: &[f32], x: f32) -> f32 {
         let t = ((x + self.radius) / (2.0 * self.radius) * Self::BINS as f32)
             .clamp(0.0, Self::BINS as f32);
         let i = (t as usize).min(Self::BINS - 1);
         let f = t - i as f32;
-        self.cdf[i] + f * (self.cdf[i + 1] - self.cdf[i])
+        table[i] + f * (table[i + 1] - table[i])
     }
 
-    /// An offset in [lo, hi] ∩ [-radius, radius] drawn with density ∝ the filter, from `u`.
-    pub fn sample(&self, u: f32, lo: f32, hi: f32) -> f32 {
+    /// An offset in [lo, hi] ∩ [-radius, radius] drawn with density ∝ |f|, from `u`, and its
+    /// weight (one for filters without negative lobes).
+    pub fn sample(&self, u: f32, lo: f32, hi: f32) -> (f32, f32) {
+        let (lo, hi) = (lo.max(-self.radius), hi.min(self.radius));
         let (a, b) = (
-            self.cdf_at(lo.max(-self.radius)),
-            self.cdf_at(hi.min(self.radius)),
+            self.cumulative_at(&self.cdf, lo),
+            self.cumulative_at(&self.cdf, hi),
         );
         let target = a + u * (b - a);
         // The bin holding `target`, then linear within it (the density is constant per bin).
@@ -269,13 +342,102 @@ impl FilterSampler {
             0.5
         };
         let step = 2.0 * self.radius / Self::BINS as f32;
-        (-self.radius + (i as f32 + f) * step).clamp(lo, hi)
+        let x = (-self.radius + (i as f32 + f) * step).clamp(lo, hi);
+        let Some(signed) = &self.signed else {
+            return (x, 1.0);
+        };
+        // sign(f) in the bin, times ∫|f| / ∫f over the interval.
+        let negative = signed[i + 1] < signed[i];
+        let net = self.cumulative_at(signed, hi) - self.cumulative_at(signed, lo);
+        let w = if net > 0.0 { (b - a) / net } else { 0.0 };
+        (x, if negative { -w } else { w })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn signed_filters_weigh_samples_to_the_filter_weighted_average() {
+        use pathlab_mc::estimator::RunningStats;
+        use pathlab_mc::rng::Pcg32;
+        // E[w g(x)] = ∫ f g / ∫ f over the interval, for g = 1, x, x²: the weighted samples
+        // estimate the filter-normalised average of any function of the offset.
+        let filters = [
+            PixelFilter::Mitchell {
+                radius: 2.0,
+                b: 1.0 / 3.0,
+                c: 1.0 / 3.0,
+            },
+            PixelFilter::Mitchell {
+                radius: 2.0,
+                b: 0.0,
+                c: 0.5,
+            },
+            PixelFilter::LanczosSinc {
+                radius: 4.0,
+                tau: 3.0,
+            },
+        ];
+        let profile = |filter: PixelFilter, x: f64| match filter {
+            PixelFilter::Mitchell { radius, b, c } => {
+                mitchell_1d(2.0 * x / radius as f64, b as f64, c as f64)
+            }
+            PixelFilter::LanczosSinc { radius, tau } if x.abs() <= radius as f64 => {
+                sinc(x) * sinc(x / tau as f64)
+            }
+            _ => 0.0,
+        };
+        let mut rng = Pcg32::new(2, 8);
+        for filter in filters {
+            let sampler = FilterSampler::new(filter).unwrap();
+            let r = sampler.radius();
+            for (lo, hi) in [(-10.0f32, 10.0f32), (-0.5, 10.0), (-10.0, 1.2)] {
+                let (a, b) = (lo.max(-r) as f64, hi.min(r) as f64);
+                let n = 200_000;
+                let h = (b - a) / n as f64;
+                let moment = |k: i32| -> f64 {
+                    (0..n)
+                        .map(|i| {
+                            let x = a + (i as f64 + 0.5) * h;
+                            profile(filter, x) * x.powi(k)
+                        })
+                        .sum::<f64>()
+                        * h
+                };
+                let mass = moment(0);
+                let mut stats = [
+                    RunningStats::new(),
+                    RunningStats::new(),
+                    RunningStats::new(),
+                ];
+                let mut negative = 0;
+                for _ in 0..400_000 {
+                    let (x, w) = sampler.sample(rng.uniform_f32(), lo, hi);
+                    negative += (w < 0.0) as u32;
+                    for (k, s) in stats.iter_mut().enumerate() {
+                        s.push(w as f64 * (x as f64).powi(k as i32));
+                    }
+                }
+                assert!(negative > 0, "{filter:?}: no negative lobe sampled");
+                for (k, s) in stats.iter().enumerate() {
+                    let exact = moment(k as i32) / mass;
+                    assert!(
+                        (s.mean() - exact).abs() < 4.0 * s.std_error() + 2e-3,
+                        "{filter:?} over [{lo}, {hi}], moment {k}: {} ± {} vs {exact}",
+                        s.mean(),
+                        s.std_error()
+                    );
+                }
+            }
+        }
+        // Filters without negative lobes weigh every sample exactly one.
+        let tent = FilterSampler::new(PixelFilter::Tent { radius: 1.5 }).unwrap();
+        for i in 0..100 {
+            assert_eq!(tent.sample(i as f32 / 100.0, -0.7, 3.0).1, 1.0);
+        }
+    }
 
     #[test]
     fn filter_offsets_fit_the_filter_profile_over_any_interval() {
@@ -293,10 +455,19 @@ mod tests {
             }
         };
         type Profile = Box<dyn Fn(f64) -> f64>;
-        let filters: [(PixelFilter, Profile); 3] = [
+        let filters: [(PixelFilter, Profile); 4] = [
             (
                 PixelFilter::Tent { radius: 1.0 },
                 Box::new(|x: f64| (1.0 - x.abs()).max(0.0)),
+            ),
+            // A filter with negative lobes is sampled in proportion to |f|.
+            (
+                PixelFilter::Mitchell {
+                    radius: 2.0,
+                    b: 1.0 / 3.0,
+                    c: 1.0 / 3.0,
+                },
+                Box::new(|x: f64| mitchell_1d(x, 1.0 / 3.0, 1.0 / 3.0).abs()),
             ),
             (PixelFilter::gaussian(0.5), Box::new(gaussian(0.5, 2.0))),
             (
@@ -323,7 +494,7 @@ mod tests {
                     .sum::<f64>()
                     * h;
                 let samples: Vec<f64> = (0..200_000)
-                    .map(|_| sampler.sample(rng.uniform_f32(), lo, hi) as f64)
+                    .map(|_| sampler.sample(rng.uniform_f32(), lo, hi).0 as f64)
                     .collect();
                 assert!(samples.iter().all(|&x| x >= a && x <= b));
                 let t = chi2_test_1d(samples, |x| profile(x) / mass, [a, b], 40);

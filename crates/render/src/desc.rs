@@ -147,6 +147,24 @@ pub enum PixelFilter {
         /// Where the filter ends, in pixels.
         radius: f32,
     },
+    /// Mitchell and Netravali's cubic of parameters B and C over `radius` (pbrt-v4's
+    /// `mitchell`; negative lobes, so samples carry signed weights).
+    Mitchell {
+        /// Radius in pixels.
+        radius: f32,
+        /// B.
+        b: f32,
+        /// C.
+        c: f32,
+    },
+    /// A sinc windowed by a Lanczos sinc of `tau` lobes over `radius` (pbrt-v4's `sinc`;
+    /// negative lobes).
+    LanczosSinc {
+        /// Radius in pixels.
+        radius: f32,
+        /// Lobes of the window.
+        tau: f32,
+    },
 }
 
 impl PixelFilter {

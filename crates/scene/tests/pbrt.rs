@@ -658,3 +658,61 @@ Shape "sphere"
     let desc = load_text("stretched", &[("window.pbrt", &text)]).unwrap();
     assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
 }
+
+#[test]
+fn mitchell_and_sinc_filters_are_read_and_render() {
+    use pathlab_render::desc::PixelFilter;
+    let scene = |filter: &str| {
+        format!(
+            r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+PixelFilter {filter}
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+"#
+        )
+    };
+    for (filter, expected) in [
+        (
+            "\"mitchell\"",
+            PixelFilter::Mitchell {
+                radius: 2.0,
+                b: 1.0 / 3.0,
+                c: 1.0 / 3.0,
+            },
+        ),
+        (
+            "\"mitchell\" \"float xradius\" 1.5 \"float B\" 0 \"float C\" 0.5",
+            PixelFilter::Mitchell {
+                radius: 1.5,
+                b: 0.0,
+                c: 0.5,
+            },
+        ),
+        (
+            "\"sinc\"",
+            PixelFilter::LanczosSinc {
+                radius: 4.0,
+                tau: 3.0,
+            },
+        ),
+    ] {
+        let desc = load_text("filters", &[("filter.pbrt", &scene(filter))]).unwrap();
+        assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+        assert_eq!(desc.filter, expected);
+        // Under a sky of radiance 1 every pixel's expected value is 1; the signed weights
+        // make noise, whose spread over the pixels gives the tolerance.
+        let film = render_film(&desc, 256, 1);
+        let means: Vec<f64> = film.pixels().iter().map(|p| p.mean().x).collect();
+        let n = means.len() as f64;
+        let mean = means.iter().sum::<f64>() / n;
+        let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (n - 1.0);
+        let se = (var / n).sqrt();
+        assert!(se > 0.0, "{filter}: no noise from negative lobes?");
+        assert!(
+            (mean - 1.0).abs() < 4.0 * se,
+            "{filter}: image mean {mean} ± {se}"
+        );
+    }
+}

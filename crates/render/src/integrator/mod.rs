@@ -93,21 +93,20 @@ pub fn li_one_at_a_time<I: Integrator + ?Sized>(
     stats: &mut PathStats,
 ) {
     for s in samples {
-        let ray = camera_ray(scene, sampler, s);
-        out(s.tag, integrator.li(scene, ray, sampler, stats));
+        let (ray, weight) = camera_ray(scene, sampler, s);
+        out(s.tag, integrator.li(scene, ray, sampler, stats) * weight);
     }
 }
 
 /// Positions `sampler` at pixel sample `s` and makes its camera ray from the first
-/// dimensions: the position in the pixel, then the point on the lens.
+/// dimensions: the position in the pixel, then the point on the lens; with the weight the
+/// sample's radiance takes (one, except under a pixel filter with negative lobes).
 #[inline]
-pub fn camera_ray(scene: &Scene, sampler: &mut AnySampler, s: SampleRef) -> Ray {
+pub fn camera_ray(scene: &Scene, sampler: &mut AnySampler, s: SampleRef) -> (Ray, f32) {
     sampler.start_pixel_sample(s.pixel, s.index, 0);
-    let film = scene
-        .camera()
-        .film_position(s.pixel, sampler.next_pixel_2d());
+    let (film, weight) = scene.camera().film_sample(s.pixel, sampler.next_pixel_2d());
     let u_lens = sampler.next_2d();
-    scene.camera().generate_ray(film, u_lens)
+    (scene.camera().generate_ray(film, u_lens), weight)
 }
 
 /// Which integrator, with its settings.

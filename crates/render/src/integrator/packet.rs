@@ -132,6 +132,8 @@ fn scatter(a: &ScatterIn, out: &mut ScatterOut) {
 struct Lane {
     tag: u32,
     st: PathState,
+    /// The weight of the sample's radiance (the pixel filter's; one for most filters).
+    weight: f32,
 }
 
 impl PathIntegrator {
@@ -197,7 +199,7 @@ impl PathIntegrator {
                     }
                 }
                 if !self.arrive(scene, st, hits[i].as_ref()) {
-                    out(lane.tag, st.l);
+                    out(lane.tag, st.l * lane.weight);
                     lanes[i] = None;
                     hits[i] = None;
                     continue;
@@ -206,7 +208,7 @@ impl PathIntegrator {
                 let Some(si) = &hits[i] else { continue };
                 let Some((diffuse, two_sided)) = scene.material(si.material).as_lambertian() else {
                     if !self.scatter(scene, st, si, smp, stats) {
-                        out(lane.tag, st.l);
+                        out(lane.tag, st.l * lane.weight);
                         lanes[i] = None;
                     }
                     hits[i] = None;
@@ -249,7 +251,7 @@ impl PathIntegrator {
                 };
                 let goes_on = self.finish_bounce(scene, i, &mut lane.st, si, &b, u[6][i], stats);
                 if !goes_on {
-                    out(lane.tag, lane.st.l);
+                    out(lane.tag, lane.st.l * lane.weight);
                     lanes[i] = None;
                 }
             }
@@ -304,10 +306,11 @@ fn start_paths(
             let Some(s) = samples.next() else {
                 return false;
             };
-            let ray = camera_ray(scene, smp, s);
+            let (ray, weight) = camera_ray(scene, smp, s);
             *lane = Some(Lane {
                 tag: s.tag,
                 st: PathState::new(ray),
+                weight,
             });
         }
     }

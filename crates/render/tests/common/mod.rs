@@ -208,8 +208,8 @@ pub fn packets_match_one_path_at_a_time(scene: &Scene, bvh: bool) {
             );
             let mut stats = PathStats::default();
             for s in &samples {
-                let ray = camera_ray(scene, &mut sampler, *s);
-                let l = integrator.li(scene, ray, &mut sampler, &mut stats);
+                let (ray, weight) = camera_ray(scene, &mut sampler, *s);
+                let l = integrator.li(scene, ray, &mut sampler, &mut stats) * weight;
                 let p = packed[s.tag as usize].expect("every sample is estimated");
                 assert_eq!(
                     p.to_array().map(f32::to_bits),

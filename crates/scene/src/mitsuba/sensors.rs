@@ -226,6 +226,23 @@ fn film_settings(ctx: &mut Ctx, film: Obj) -> Result<(), Error> {
                 radius: ctx.positive(*f, "radius", 1.0)? as f32,
             },
             "gaussian" => PixelFilter::gaussian(ctx.positive(*f, "stddev", 0.5)? as f32),
+            "mitchell" => PixelFilter::Mitchell {
+                radius: 2.0,
+                b: ctx.float(*f, "B", 1.0 / 3.0)? as f32,
+                c: ctx.float(*f, "C", 1.0 / 3.0)? as f32,
+            },
+            "catmullrom" => PixelFilter::Mitchell {
+                radius: 2.0,
+                b: 0.0,
+                c: 0.5,
+            },
+            "lanczos" => {
+                let lobes = ctx.positive(*f, "lobes", 3.0)? as f32;
+                PixelFilter::LanczosSinc {
+                    radius: lobes,
+                    tau: lobes,
+                }
+            }
             _ => {
                 let what = ctx.what(*f);
                 ctx.warn(

@@ -87,25 +87,26 @@ impl Builder {
                         }
                         PixelFilter::Box
                     }
-                    "triangle" => {
-                        let r = self.float(&params, "xradius", 2.0)?;
-                        let ry = self.float(&params, "yradius", r)?;
-                        if (r - ry).abs() > 1e-6 {
-                            self.warn("PixelFilter \"triangle\": different x and y radii; the x radius is used");
-                        }
-                        PixelFilter::Tent { radius: r as f32 }
-                    }
+                    "triangle" => PixelFilter::Tent {
+                        radius: self.filter_radius(&params, kind.as_str(), 2.0)?,
+                    },
                     "gaussian" => {
                         let sigma = self.float(&params, "sigma", 0.5)?;
-                        let r = self.float(&params, "xradius", 1.5)?;
-                        let ry = self.float(&params, "yradius", r)?;
-                        if (r - ry).abs() > 1e-6 {
-                            self.warn("PixelFilter \"gaussian\": different x and y radii; the x radius is used");
-                        }
                         PixelFilter::Gaussian {
                             stddev: sigma as f32,
-                            radius: r as f32,
+                            radius: self.filter_radius(&params, kind.as_str(), 1.5)?,
                         }
+                    }
+                    "mitchell" => {
+                        let r = self.filter_radius(&params, kind.as_str(), 2.0)?;
+                        let b = self.float(&params, "B", 1.0 / 3.0)? as f32;
+                        let c = self.float(&params, "C", 1.0 / 3.0)? as f32;
+                        PixelFilter::Mitchell { radius: r, b, c }
+                    }
+                    "sinc" => {
+                        let r = self.filter_radius(&params, kind.as_str(), 4.0)?;
+                        let tau = self.float(&params, "tau", 3.0)? as f32;
+                        PixelFilter::LanczosSinc { radius: r, tau }
                     }
                     other => {
                         self.warn(format!("PixelFilter \"{other}\": not supported; pbrt-v4's default Gaussian (σ = 0.5, radius 1.5) is used"));
@@ -253,6 +254,29 @@ impl Builder {
         self.warn_unused(&format!("Camera \"{kind}\""), &params);
         self.desc.camera = camera;
         Ok(())
+    }
+
+    /// A filter's `xradius` (`default` without one); a different `yradius` is warned about,
+    /// the filters being one radius in both axes here. A radius must be positive.
+    fn filter_radius(
+        &mut self,
+        params: &ParamList,
+        kind: &str,
+        default: f64,
+    ) -> Result<f32, Error> {
+        let r = self.float(params, "xradius", default)?;
+        let ry = self.float(params, "yradius", r)?;
+        if !(r > 0.0 && r.is_finite()) {
+            return Err(self.error(format!(
+                "PixelFilter \"{kind}\": radius {r} must be positive"
+            )));
+        }
+        if (r - ry).abs() > 1e-6 {
+            self.warn(format!(
+                "PixelFilter \"{kind}\": different x and y radii; the x radius is used"
+            ));
+        }
+        Ok(r as f32)
     }
 
     /// pbrt-v4's `screenwindow` [x0 x1 y0 y1] (and `frameaspectratio`, which sets the default
