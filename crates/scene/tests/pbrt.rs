@@ -716,3 +716,65 @@ LightSource "infinite" "rgb L" [ 1 1 1 ]
         );
     }
 }
+
+#[test]
+fn area_lights_emit_their_image_and_name_a_missing_one() {
+    use glam::Vec3;
+    use std::f64::consts::PI;
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-area-image");
+    std::fs::create_dir_all(&dir).unwrap();
+    // Mean luminance 0.5: one black texel, one white.
+    pathlab_render::image_io::write_exr(&dir.join("glow.exr"), 2, 1, &[Vec3::ZERO, Vec3::ONE], &[])
+        .unwrap();
+    let scene = |file: &str, extra: &str| {
+        format!(
+            r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+WorldBegin
+AreaLightSource "diffuse" "string filename" "{file}" "float scale" 2 {extra}
+Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  1 1 0  0 1 0 ] "integer indices" [ 0 1 2  0 2 3 ]
+  "point2 uv" [ 0 0  1 0  1 1  0 1 ]
+"#
+        )
+    };
+    std::fs::write(dir.join("image.pbrt"), scene("glow.exr", "")).unwrap();
+    let desc = pathlab_scene::load(dir.join("image.pbrt").to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let mesh = &desc.meshes[0];
+    assert_eq!(mesh.emission.unwrap().radiance, Vec3::splat(2.0));
+    let t = pathlab_render::texture::Tex::from_desc(mesh.emission_texture.as_ref().unwrap());
+    let at = |u: f32| {
+        t.eval(&pathlab_render::texture::TexPoint::uv(glam::Vec2::new(
+            u, 0.5,
+        )))
+    };
+    assert_eq!((at(0.25), at(0.75)), (Vec3::ZERO, Vec3::ONE));
+    // With a power, each triangle (area ½) emits it: L = scale Φ / (π A × mean luminance).
+    std::fs::write(
+        dir.join("power.pbrt"),
+        scene("glow.exr", "\"float power\" 3"),
+    )
+    .unwrap();
+    let desc = pathlab_scene::load(dir.join("power.pbrt").to_str().unwrap()).unwrap();
+    let l = desc.meshes[0].emission.unwrap().radiance.x as f64;
+    let expected = 2.0 * 3.0 / (PI * 0.5 * 0.5);
+    assert!((l - expected).abs() < 1e-4 * expected, "{l} vs {expected}");
+    // A missing image: one warning naming it, and the light still emits.
+    std::fs::write(dir.join("missing.pbrt"), scene("gone.exr", "")).unwrap();
+    let desc = pathlab_scene::load(dir.join("missing.pbrt").to_str().unwrap()).unwrap();
+    assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
+    assert!(
+        desc.warnings[0].contains("gone.exr"),
+        "{}",
+        desc.warnings[0]
+    );
+    assert!(desc.meshes[0].emission.is_some());
+    // L and an image together are an error, as in pbrt-v4.
+    std::fs::write(
+        dir.join("both.pbrt"),
+        scene("glow.exr", "\"rgb L\" [ 1 1 1 ]"),
+    )
+    .unwrap();
+    let err = pathlab_scene::load(dir.join("both.pbrt").to_str().unwrap()).unwrap_err();
+    assert!(err.to_string().contains("both.pbrt"), "{err}");
+}

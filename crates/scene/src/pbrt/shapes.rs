@@ -17,6 +17,34 @@ use std::sync::Arc;
 /// Segments around a tessellated disk or cylinder: the area is right to 0.03%.
 const SEGMENTS: usize = 256;
 
+/// An area light's emission: its radiance (times the image's texel where it has one), and
+/// the power each of its shapes emits where the file gives one.
+struct AreaEmission {
+    emission: Emission,
+    power: Option<f64>,
+    texture: Option<TextureDesc>,
+}
+
+impl AreaEmission {
+    /// The radiance scaled, where a power is given, so that a shape of `area` emits it: pbrt-v4
+    /// divides by π A × sides and by the image's mean luminance.
+    fn for_area(&self, area: f64) -> Emission {
+        let Some(watts) = self.power else {
+            return self.emission;
+        };
+        let image = self
+            .texture
+            .as_ref()
+            .map_or(1.0, |t| pathlab_render::color::luminance(t.mean()) as f64);
+        let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
+        let k = watts / (std::f64::consts::PI * area * sides * image.max(1e-12));
+        Emission {
+            radiance: self.emission.radiance * k as f32,
+            ..self.emission
+        }
+    }
+}
+
 /// A mesh in the shape's own space.
 #[derive(Default)]
 struct ObjectMesh {
@@ -39,13 +67,10 @@ impl Builder {
             return Err(self.error(format!("Shape \"{kind}\": its transform is singular")));
         }
         let material = self.shape_material(&params, state)?;
-        let (emission, power) = match self.area_emission(state)? {
-            Some((e, p)) => (Some(e), p),
-            None => (None, None),
-        };
+        let emission = self.area_emission(state)?;
         let mesh = match kind {
             "sphere" => {
-                self.sphere(&params, m, material, emission, power, state)?;
+                self.sphere(&params, m, material, emission.as_ref(), state)?;
                 self.warn_unused(&format!("Shape \"{kind}\""), &params);
                 return Ok(());
             }
@@ -67,9 +92,10 @@ impl Builder {
         let mut out = place(mesh, m, state.reverse_orientation);
         out.name = format!("{}:{} {kind}", self.file.display(), self.line);
         out.material = material;
-        out.emission = emission;
-        match (emission, power) {
-            (Some(e), Some(watts)) => {
+        out.emission = emission.as_ref().map(|e| e.emission);
+        out.emission_texture = emission.as_ref().and_then(|e| e.texture.clone());
+        match emission {
+            Some(e) if e.power.is_some() => {
                 // pbrt-v4 makes a light of each triangle of a mesh (each patch of a bilinear
                 // mesh), each emitting `power`; a disk or cylinder is one light.
                 let per_unit = match kind {
@@ -77,9 +103,7 @@ impl Builder {
                     "bilinearmesh" => 2,
                     _ => 1,
                 };
-                self.desc
-                    .meshes
-                    .extend(split_by_power(out, e, watts, per_unit));
+                self.desc.meshes.extend(split_by_power(out, &e, per_unit));
             }
             _ => self.desc.meshes.push(out),
         }
@@ -129,11 +153,8 @@ impl Builder {
         m
     }
 
-    /// The emission of the current area light, if any, and its `power` (watts per pbrt shape).
-    fn area_emission(
-        &mut self,
-        state: &GraphicsState,
-    ) -> Result<Option<(Emission, Option<f64>)>, Error> {
+    /// The emission of the current area light, if any.
+    fn area_emission(&mut self, state: &GraphicsState) -> Result<Option<AreaEmission>, Error> {
         let Some((kind, params, line)) = &state.area_light else {
             return Ok(None);
         };
@@ -147,27 +168,33 @@ impl Builder {
             self.line = here;
             return Ok(None);
         }
-        let l = self
-            .spectrum(&params, "L", Use::Illuminant)?
-            .unwrap_or(Vec3::ONE);
+        let l = self.spectrum(&params, "L", Use::Illuminant)?;
         let scale = self.float(&params, "scale", 1.0)? as f32;
         let two_sided = self.bool(&params, "twosided", false)?;
         // pbrt-v4: a power of 0 or less is no power at all.
         let power = Some(self.float(&params, "power", -1.0)?).filter(|&p| p > 0.0);
+        let mut texture = None;
         if let Some(file) = self.string(&params, "filename")? {
-            self.warn(format!(
-                "AreaLightSource: image emission (\"{file}\") is not supported; L is used"
-            ));
+            if l.is_some() {
+                return Err(self.error("AreaLightSource: both \"L\" and \"filename\" are given"));
+            }
+            match crate::texture::load(&self.resolve(&file), false) {
+                Ok(image) => texture = Some(TextureDesc::image(image)),
+                Err(e) => self.warn(format!(
+                    "AreaLightSource: {e}; it emits white light of radiance scale instead"
+                )),
+            }
         }
         self.warn_unused("AreaLightSource \"diffuse\"", &params);
         self.line = here;
-        Ok(Some((
-            Emission {
-                radiance: l * scale,
+        Ok(Some(AreaEmission {
+            emission: Emission {
+                radiance: l.unwrap_or(Vec3::ONE) * scale,
                 two_sided,
             },
             power,
-        )))
+            texture,
+        }))
     }
 
     fn param_numbers<'p>(
@@ -433,8 +460,7 @@ impl Builder {
         params: &ParamList,
         m: DMat4,
         material: usize,
-        emission: Option<Emission>,
-        power: Option<f64>,
+        emission: Option<&AreaEmission>,
         state: &GraphicsState,
     ) -> Result<(), Error> {
         let radius = self.float(params, "radius", 1.0)?;
@@ -473,21 +499,16 @@ impl Builder {
             axes.z_axis / scales[2],
         );
         let world_radius = radius * scales[0];
-        let emission = match (emission, power) {
-            (Some(e), Some(watts)) => Some(with_power(
-                e,
-                watts,
-                4.0 * std::f64::consts::PI * world_radius * world_radius,
-            )),
-            _ => emission,
-        };
+        let area = 4.0 * std::f64::consts::PI * world_radius * world_radius;
+        let emission_texture = emission.and_then(|e| e.texture.clone());
+        let emission = emission.map(|e| e.for_area(area));
         self.desc.spheres.push(SphereDesc {
             center: m.transform_point3(DVec3::ZERO).as_vec3(),
             radius: world_radius as f32,
             material,
             emission,
             to_object: rot.transpose().as_mat3(),
-            emission_texture: None,
+            emission_texture,
         });
         Ok(())
     }
@@ -535,22 +556,11 @@ fn place(o: ObjectMesh, m: DMat4, reverse: bool) -> MeshDesc {
     }
 }
 
-/// `e` scaled as pbrt-v4 scales an area light of `area` given its `power` Φ: the radiance
-/// L × Φ / (π A × sides), so that the light emits Φ where L is white of luminance one.
-fn with_power(e: Emission, watts: f64, area: f64) -> Emission {
-    let sides = if e.two_sided { 2.0 } else { 1.0 };
-    let k = watts / (std::f64::consts::PI * area * sides);
-    Emission {
-        radiance: e.radiance * k as f32,
-        ..e
-    }
-}
-
 /// The emitting mesh `mesh` as pbrt-v4 lights it when its area light has a `power`: each run
-/// of `per_unit` triangles (one pbrt shape) emits `watts`, so shapes of different areas have
+/// of `per_unit` triangles (one pbrt shape) emits that power, so shapes of different areas have
 /// different radiance. Shapes of equal area (to 1e-6) share one mesh; each mesh keeps only
 /// the vertices its triangles use.
-fn split_by_power(mesh: MeshDesc, e: Emission, watts: f64, per_unit: usize) -> Vec<MeshDesc> {
+fn split_by_power(mesh: MeshDesc, e: &AreaEmission, per_unit: usize) -> Vec<MeshDesc> {
     let per_unit = per_unit.max(1);
     let corner = |i: u32| mesh.positions[i as usize].as_dvec3();
     let triangle_area = |t: &[u32]| {
@@ -582,7 +592,7 @@ fn split_by_power(mesh: MeshDesc, e: Emission, watts: f64, per_unit: usize) -> V
                 .flat_map(|&u| u * per_unit..((u + 1) * per_unit).min(tris.len()))
                 .collect();
             let mut part = submesh(&mesh, &triangles);
-            part.emission = Some(with_power(e, watts, area));
+            part.emission = Some(e.for_area(area));
             if g > 0 {
                 part.name = format!("{} (shapes of area {area:.4e})", mesh.name);
             }
