@@ -778,3 +778,14 @@ Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  1 1 0  0 1 0 ] "integer indices"
     let err = pathlab_scene::load(dir.join("both.pbrt").to_str().unwrap()).unwrap_err();
     assert!(err.to_string().contains("both.pbrt"), "{err}");
 }
+
+#[test]
+fn a_film_clamp_is_warned_about_not_ignored() {
+    let scene = r#"Film "rgb" "integer xresolution" 8 "integer yresolution" 8 "float maxcomponentvalue" 10
+Camera "perspective"
+WorldBegin
+"#;
+    let desc = load_text("clamp", &[("clamp.pbrt", scene)]).unwrap();
+    assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
+    assert!(desc.warnings[0].contains("maxcomponentvalue"));
+}

@@ -181,8 +181,12 @@ impl Builder {
                 )));
             }
             (w, h) = (xr as u32, yr as u32);
-            for p in ["filename", "savefp16", "maxcomponentvalue"] {
+            for p in ["filename", "savefp16"] {
                 params.get(p);
+            }
+            let clamp = self.float(&params, "maxcomponentvalue", f64::INFINITY)?;
+            if clamp.is_finite() {
+                self.warn(format!("Film: maxcomponentvalue {clamp} (a clamp of each sample) is not supported; samples are not clamped"));
             }
             if params.has("cropwindow") || params.has("pixelbounds") {
                 params.get("cropwindow");
