@@ -8,6 +8,7 @@ use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
 use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
 use pathlab_scene::Error;
+use pathlab_testkit::render::assert_mean;
 use std::path::{Path, PathBuf};
 
 fn data(name: &str) -> PathBuf {
@@ -439,13 +440,8 @@ Shape "sphere" "float radius" 1
     let desc = load_text("furnace", &[("furnace.pbrt", scene)]).unwrap();
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
     let film = render_film(&desc, 64, 5);
-    let means: Vec<f64> = film.pixels().iter().map(|p| p.mean().x).collect();
-    let n = means.len() as f64;
-    let mean = means.iter().sum::<f64>() / n;
-    let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (n - 1.0);
-    let se = (var / n).sqrt();
-    assert!(se > 0.0 && se < 0.01, "standard error {se}");
-    assert!((mean - 1.0).abs() < 4.0 * se, "image mean {mean} ± {se}");
+    assert!(film.image_mean_std_error().x < 0.01);
+    assert_mean("diffuse transmission furnace", &film, DVec3::ONE);
 }
 
 #[test]
@@ -567,13 +563,8 @@ Shape "sphere" "float radius" 1
     // returns all the light it receives: under a uniform sky the sphere's radiance is the
     // sky's, 1. (pbrt-v4's default thickness 0.01 absorbs a little at each crossing.)
     let film = render_film(&desc, 64, 5);
-    let means: Vec<f64> = film.pixels().iter().map(|p| p.mean().y).collect();
-    let n = means.len() as f64;
-    let mean = means.iter().sum::<f64>() / n;
-    let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (n - 1.0);
-    let se = (var / n).sqrt();
-    assert!(se > 0.0 && se < 0.01, "standard error {se}");
-    assert!((mean - 1.0).abs() < 4.0 * se, "image mean {mean} ± {se}");
+    assert!(film.image_mean_std_error().y < 0.01);
+    assert_mean("coated furnace", &film, DVec3::ONE);
 }
 
 #[test]
@@ -702,18 +693,13 @@ LightSource "infinite" "rgb L" [ 1 1 1 ]
         assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
         assert_eq!(desc.filter, expected);
         // Under a sky of radiance 1 every pixel's expected value is 1; the signed weights
-        // make noise, whose spread over the pixels gives the tolerance.
+        // make noise, whose standard error gives the tolerance.
         let film = render_film(&desc, 256, 1);
-        let means: Vec<f64> = film.pixels().iter().map(|p| p.mean().x).collect();
-        let n = means.len() as f64;
-        let mean = means.iter().sum::<f64>() / n;
-        let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (n - 1.0);
-        let se = (var / n).sqrt();
-        assert!(se > 0.0, "{filter}: no noise from negative lobes?");
         assert!(
-            (mean - 1.0).abs() < 4.0 * se,
-            "{filter}: image mean {mean} ± {se}"
+            film.image_mean_std_error().x > 0.0,
+            "{filter}: no noise from negative lobes?"
         );
+        assert_mean(filter, &film, DVec3::ONE);
     }
 }
 
