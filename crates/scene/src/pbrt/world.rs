@@ -76,47 +76,7 @@ impl Builder {
                 self.warn_unused(&format!("Sampler \"{kind}\""), &params);
             }
             "PixelFilter" => {
-                let filter = match kind.as_str() {
-                    "box" => {
-                        let r = self.float(&params, "xradius", 0.5)?;
-                        self.float(&params, "yradius", r)?;
-                        if (r - 0.5).abs() > 1e-6 {
-                            self.warn(format!(
-                                "PixelFilter \"box\": radius {r} is read as 0.5 (the pixel)"
-                            ));
-                        }
-                        PixelFilter::Box
-                    }
-                    "triangle" => PixelFilter::Tent {
-                        radius: self.filter_radius(&params, kind.as_str(), 2.0)?,
-                    },
-                    "gaussian" => {
-                        let sigma = self.float(&params, "sigma", 0.5)?;
-                        PixelFilter::Gaussian {
-                            stddev: sigma as f32,
-                            radius: self.filter_radius(&params, kind.as_str(), 1.5)?,
-                        }
-                    }
-                    "mitchell" => {
-                        let r = self.filter_radius(&params, kind.as_str(), 2.0)?;
-                        let b = self.float(&params, "B", 1.0 / 3.0)? as f32;
-                        let c = self.float(&params, "C", 1.0 / 3.0)? as f32;
-                        PixelFilter::Mitchell { radius: r, b, c }
-                    }
-                    "sinc" => {
-                        let r = self.filter_radius(&params, kind.as_str(), 4.0)?;
-                        let tau = self.float(&params, "tau", 3.0)? as f32;
-                        PixelFilter::LanczosSinc { radius: r, tau }
-                    }
-                    other => {
-                        self.warn(format!("PixelFilter \"{other}\": not supported; pbrt-v4's default Gaussian (σ = 0.5, radius 1.5) is used"));
-                        for p in &params.params {
-                            p.used.set(true);
-                        }
-                        PBRT_DEFAULT_FILTER
-                    }
-                };
-                self.desc.filter = filter;
+                self.desc.filter = self.pixel_filter(&kind, &params)?;
                 self.warn_unused(&format!("PixelFilter \"{kind}\""), &params);
             }
             "Integrator" => {
@@ -258,6 +218,51 @@ impl Builder {
         self.warn_unused(&format!("Camera \"{kind}\""), &params);
         self.desc.camera = camera;
         Ok(())
+    }
+
+    /// pbrt-v4's `PixelFilter`: box, triangle, gaussian, mitchell and sinc with their radii
+    /// and parameters; others are warned about and pbrt-v4's default Gaussian is used.
+    fn pixel_filter(&mut self, kind: &str, params: &ParamList) -> Result<PixelFilter, Error> {
+        Ok(match kind {
+            "box" => {
+                let r = self.float(params, "xradius", 0.5)?;
+                self.float(params, "yradius", r)?;
+                if (r - 0.5).abs() > 1e-6 {
+                    self.warn(format!(
+                        "PixelFilter \"box\": radius {r} is read as 0.5 (the pixel)"
+                    ));
+                }
+                PixelFilter::Box
+            }
+            "triangle" => PixelFilter::Tent {
+                radius: self.filter_radius(params, kind, 2.0)?,
+            },
+            "gaussian" => {
+                let sigma = self.float(params, "sigma", 0.5)?;
+                PixelFilter::Gaussian {
+                    stddev: sigma as f32,
+                    radius: self.filter_radius(params, kind, 1.5)?,
+                }
+            }
+            "mitchell" => {
+                let r = self.filter_radius(params, kind, 2.0)?;
+                let b = self.float(params, "B", 1.0 / 3.0)? as f32;
+                let c = self.float(params, "C", 1.0 / 3.0)? as f32;
+                PixelFilter::Mitchell { radius: r, b, c }
+            }
+            "sinc" => {
+                let r = self.filter_radius(params, kind, 4.0)?;
+                let tau = self.float(params, "tau", 3.0)? as f32;
+                PixelFilter::LanczosSinc { radius: r, tau }
+            }
+            other => {
+                self.warn(format!("PixelFilter \"{other}\": not supported; pbrt-v4's default Gaussian (σ = 0.5, radius 1.5) is used"));
+                for p in &params.params {
+                    p.used.set(true);
+                }
+                PBRT_DEFAULT_FILTER
+            }
+        })
     }
 
     /// A filter's `xradius` (`default` without one); a different `yradius` is warned about,

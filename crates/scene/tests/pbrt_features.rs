@@ -1,0 +1,443 @@
+//! pbrt-v4's materials, textures, lights, shapes, camera and pixel filters, each checked
+//! against pbrt-v4's definition: values at points, closed forms, and furnaces.
+
+use glam::DVec3;
+use pathlab_testkit::render::assert_mean;
+use std::path::PathBuf;
+
+mod pbrt_common;
+use pbrt_common::{load_text, render_film};
+
+#[test]
+fn textures_scale_mix_invert_and_checker_as_pbrt_defines_them() {
+    use glam::{Vec2, Vec3};
+    use pathlab_render::desc::{MaterialDesc, TextureDesc};
+    use pathlab_render::texture::{Tex, TexPoint};
+    // A 2 x 1 image: 0.2 on its left half, 0.6 on its right.
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-textures");
+    std::fs::create_dir_all(&dir).unwrap();
+    let texels = [Vec3::splat(0.2), Vec3::splat(0.6)];
+    pathlab_render::image_io::write_exr(&dir.join("two.exr"), 2, 1, &texels, &[]).unwrap();
+    let scene = r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 4 "integer yresolution" 4
+WorldBegin
+Texture "img" "spectrum" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear"
+Texture "amount" "float" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear"
+Texture "doubled" "spectrum" "scale" "texture tex" "img" "float scale" 2
+Texture "inverted" "spectrum" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear" "float scale" 2 "bool invert" true
+Texture "mixed" "spectrum" "mix" "rgb tex1" [ 1 0 0 ] "rgb tex2" [ 0 0 1 ] "texture amount" "amount"
+Texture "checks" "spectrum" "checkerboard" "float uscale" 4 "float vscale" 4 "rgb tex1" [ 1 0 0 ]
+Texture "checked" "spectrum" "checkerboard" "float uscale" 4 "float vscale" 4 "texture tex2" "img"
+MakeNamedMaterial "m0" "string type" "diffuse" "texture reflectance" "doubled"
+MakeNamedMaterial "m1" "string type" "diffuse" "texture reflectance" "inverted"
+MakeNamedMaterial "m2" "string type" "diffuse" "texture reflectance" "mixed"
+MakeNamedMaterial "m3" "string type" "diffuse" "texture reflectance" "checks"
+MakeNamedMaterial "m4" "string type" "diffuse" "texture reflectance" "checked"
+MakeNamedMaterial "m5" "string type" "diffusetransmission" "rgb reflectance" [ 0.8 0.6 0.4 ] "texture transmittance" "img" "float scale" 0.5
+NamedMaterial "m5"
+Shape "sphere"
+"#;
+    std::fs::write(dir.join("textures.pbrt"), scene).unwrap();
+    let desc = pathlab_scene::load(dir.join("textures.pbrt").to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let texture = |m: &MaterialDesc| match m {
+        MaterialDesc::TexturedDiffuse { texture, .. } => Tex::from_desc(texture),
+        other => panic!("not a textured diffuse material: {other:?}"),
+    };
+    let at = |t: &Tex, u: f32, v: f32| t.eval(&TexPoint::uv(Vec2::new(u, v)));
+    let close = |a: Vec3, b: Vec3| (a - b).abs().max_element() < 1e-5;
+    let m = &desc.materials;
+    // scale: the image times 2.
+    let t = texture(&m[0]);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::splat(0.4)));
+    assert!(close(at(&t, 0.75, 0.5), Vec3::splat(1.2)));
+    // An image's scale, then invert, clamped at zero: max(0, 1 - 2 x).
+    let t = texture(&m[1]);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::splat(0.6)));
+    assert!(close(at(&t, 0.75, 0.5), Vec3::ZERO));
+    // mix: (1 - a) red + a blue, a read from the image.
+    let t = texture(&m[2]);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::new(0.8, 0.0, 0.2)));
+    assert!(close(at(&t, 0.75, 0.5), Vec3::new(0.4, 0.0, 0.6)));
+    // checkerboard: tex1 where ⌊4u⌋ + ⌊4v⌋ is even, tex2 (default 0) elsewhere.
+    let t = texture(&m[3]);
+    assert!(close(at(&t, 0.1, 0.1), Vec3::X));
+    assert!(close(at(&t, 0.3, 0.1), Vec3::ZERO));
+    assert!(close(at(&t, 0.3, 0.3), Vec3::X));
+    assert!(close(at(&t, 0.6, 0.1), Vec3::X));
+    // A textured square: tex2 is the image, read at the point's own (u, v).
+    let t = texture(&m[4]);
+    assert!(close(at(&t, 0.1, 0.1), Vec3::ONE));
+    assert!(close(at(&t, 0.3, 0.1), Vec3::splat(0.2)));
+    assert!(close(at(&t, 0.8, 0.1), Vec3::splat(0.6)));
+    // diffusetransmission: both albedos times scale.
+    let MaterialDesc::DiffuseTransmission {
+        reflectance,
+        transmittance,
+    } = &m[5]
+    else {
+        panic!("{:?}", m[5]);
+    };
+    assert!(close(
+        reflectance.as_constant().unwrap(),
+        Vec3::new(0.4, 0.3, 0.2)
+    ));
+    assert!(matches!(transmittance, TextureDesc::Product(_)));
+    let t = Tex::from_desc(transmittance);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::splat(0.1)));
+    render_film(&desc, 1, 0);
+}
+
+#[test]
+fn a_sphere_that_reflects_and_transmits_everything_vanishes_in_a_furnace() {
+    // Under a uniform sky of radiance 1, a closed sphere whose diffuse reflectance and
+    // transmittance add up to one returns all the light it receives, on both its sides: the
+    // expected radiance of every pixel is 1 (light sampling and MIS leave some noise).
+    let scene = r#"LookAt 0 0 4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+Integrator "path" "integer maxdepth" [ 1000 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+Material "diffusetransmission" "rgb reflectance" [ 0.3 0.3 0.3 ] "rgb transmittance" [ 0.7 0.7 0.7 ]
+Shape "sphere" "float radius" 1
+"#;
+    let desc = load_text("furnace", &[("furnace.pbrt", scene)]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let film = render_film(&desc, 64, 5);
+    assert!(film.image_mean_std_error().x < 0.01);
+    assert_mean("diffuse transmission furnace", &film, DVec3::ONE);
+}
+
+#[test]
+fn area_light_power_is_per_pbrt_shape_as_in_pbrt_v4() {
+    // pbrt-v4 makes one light of each triangle of a mesh, a sphere or a disk, and scales each
+    // to emit `power` watts: radiance Φ / (π A × sides) for white L.
+    use std::f64::consts::PI;
+    let scene = r#"LookAt 0 0 10  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 6 ]
+  # Two triangles of areas 2 and 1.
+  Shape "trianglemesh" "point3 P" [ 0 0 0  2 0 0  0 2 0   5 0 0  6 0 0  5 2 0 ] "integer indices" [ 0 1 2  3 4 5 ]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 8 ] "bool twosided" true "rgb L" [ 1 0.5 0.25 ]
+  # A unit square: two triangles of area 1/2, each its own light.
+  Shape "bilinearmesh" "point3 P" [ 0 0 3  1 0 3  0 1 3  1 1 3 ] "integer indices" [ 0 1 2 3 ]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 100 ]
+  Shape "sphere" "float radius" 2
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 10 ] "float scale" 2
+  Translate 0 0 -3
+  Shape "disk" "float radius" 1
+AttributeEnd
+"#;
+    let desc = load_text("power", &[("power.pbrt", scene)]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let radiance = |i: usize| desc.meshes[i].emission.unwrap().radiance.as_dvec3();
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-5 * b;
+    // The triangle mesh: two lights, one per triangle (smaller area first).
+    assert_eq!(
+        desc.meshes.len(),
+        4,
+        "{:?}",
+        desc.meshes.iter().map(|m| &m.name).collect::<Vec<_>>()
+    );
+    assert_eq!(desc.meshes[0].indices.len(), 3);
+    assert_eq!(desc.meshes[0].positions.len(), 3);
+    assert!(close(radiance(0).x, 6.0 / (PI * 1.0)), "{}", radiance(0));
+    assert!(close(radiance(1).x, 6.0 / (PI * 2.0)), "{}", radiance(1));
+    // The patch: one light of area 1, two-sided, its colour kept.
+    let l = radiance(2);
+    assert!(close(l.x, 8.0 / (PI * 1.0 * 2.0)), "{l}");
+    assert!(close(l.y, 0.5 * l.x) && close(l.z, 0.25 * l.x), "{l}");
+    // The disk: one light over its whole (tessellated) area, times scale.
+    let disk = &desc.meshes[3];
+    let area: f64 = disk
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            let p = |k: usize| disk.positions[t[k] as usize].as_dvec3();
+            0.5 * (p(1) - p(0)).cross(p(2) - p(0)).length()
+        })
+        .sum();
+    assert!((area - PI).abs() < 1e-3 * PI);
+    assert!(
+        close(radiance(3).x, 2.0 * 10.0 / (PI * area)),
+        "{}",
+        radiance(3)
+    );
+    // The sphere: 4π r².
+    let s = desc.spheres[0].emission.unwrap().radiance.x as f64;
+    assert!(close(s, 100.0 / (PI * 4.0 * PI * 4.0)), "{s}");
+}
+
+#[test]
+fn coated_materials_read_their_layers_and_a_lossless_coat_vanishes_in_a_furnace() {
+    use pathlab_render::desc::{CoatedBase, MaterialDesc};
+    let scene = r#"LookAt 0 0 4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+Integrator "path" "integer maxdepth" [ 1000 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+MakeNamedMaterial "plastic" "string type" "coateddiffuse" "rgb reflectance" [ 0.2 0.4 0.6 ]
+  "float roughness" 0.04 "float thickness" 0.2 "rgb albedo" [ 0.5 0.5 0.5 ] "float g" 0.3
+  "integer maxdepth" 20 "integer nsamples" 2 "float eta" 1.4
+MakeNamedMaterial "gold" "string type" "coatedconductor" "float interface.roughness" 0.01
+  "spectrum conductor.eta" "metal-Au-eta" "spectrum conductor.k" "metal-Au-k"
+  "float conductor.uroughness" 0.09 "float conductor.vroughness" 0.16 "bool remaproughness" false
+Material "coateddiffuse" "rgb reflectance" [ 1 1 1 ] "integer maxdepth" 1000 "float thickness" 1e-30
+Shape "sphere" "float radius" 1
+"#;
+    let desc = load_text("coated", &[("coated.pbrt", scene)]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let MaterialDesc::Coated(plastic) = &desc.materials[0] else {
+        panic!("{:?}", desc.materials[0]);
+    };
+    assert_eq!(plastic.coat_alpha, [0.2, 0.2]);
+    assert_eq!(
+        (plastic.coat_eta, plastic.thickness, plastic.g),
+        (1.4, 0.2, 0.3)
+    );
+    assert_eq!((plastic.max_depth, plastic.samples), (20, 2));
+    assert_eq!(plastic.albedo, glam::Vec3::splat(0.5));
+    assert!(
+        matches!(&plastic.base, CoatedBase::Diffuse(t) if t.as_constant() == Some(glam::Vec3::new(0.2, 0.4, 0.6)))
+    );
+    let MaterialDesc::Coated(gold) = &desc.materials[1] else {
+        panic!("{:?}", desc.materials[1]);
+    };
+    // remaproughness false: the coat's roughness is its α.
+    assert_eq!(gold.coat_alpha, [0.01, 0.01]);
+    assert_eq!(
+        (gold.coat_eta, gold.thickness, gold.max_depth, gold.samples),
+        (1.5, 0.01, 10, 1)
+    );
+    let CoatedBase::Conductor { eta, alpha, .. } = &gold.base else {
+        panic!("{:?}", gold.base);
+    };
+    assert_eq!(*alpha, [0.09, 0.16]);
+    assert!(eta.x < 0.5 && eta.z > 1.0, "gold's η {eta}");
+    // A white Lambertian under a smooth coat, with no medium and no thickness to absorb in,
+    // returns all the light it receives: under a uniform sky the sphere's radiance is the
+    // sky's, 1. (pbrt-v4's default thickness 0.01 absorbs a little at each crossing.)
+    let film = render_film(&desc, 64, 5);
+    assert!(film.image_mean_std_error().y < 0.01);
+    assert_mean("coated furnace", &film, DVec3::ONE);
+}
+
+#[test]
+fn loop_subdivision_surfaces_are_subdivided_at_load() {
+    let scene = |levels: &str| {
+        format!(
+            r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+WorldBegin
+Shape "loopsubdiv" {levels} "integer indices" [ 0 1 2  0 2 3  0 3 1  1 3 2 ]
+  "point3 P" [ 0 0 1  0.943 0 -0.333  -0.471 0.816 -0.333  -0.471 -0.816 -0.333 ]
+"#
+        )
+    };
+    let desc = load_text("loop", &[("loop.pbrt", &scene("\"integer levels\" 2"))]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let m = &desc.meshes[0];
+    assert_eq!(m.indices.len(), 4 * 16 * 3);
+    assert_eq!(m.normals.len(), m.positions.len());
+    // The limit surface shrinks inside the control tetrahedron (circumradius 1).
+    assert!(m.positions.iter().all(|p| p.length() < 0.9));
+    // pbrt-v4's default is 3 levels.
+    let desc = load_text("loop3", &[("loop.pbrt", &scene(""))]).unwrap();
+    assert_eq!(desc.meshes[0].indices.len(), 4 * 64 * 3);
+    let err = load_text(
+        "loop-huge",
+        &[("loop.pbrt", &scene("\"integer levels\" 40"))],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("loop.pbrt") && err.contains("levels"), "{err}");
+}
+
+#[test]
+fn a_screen_window_shows_that_part_of_the_screen() {
+    use pathlab_render::camera::Camera;
+    // The full view at 200 x 100 (screen window [-2, 2, -1, 1]), and its right half alone at
+    // 100 x 100 (window [0, 2, -1, 1]): a world point lands 100 pixels further left there.
+    // Likewise the top-left quarter at 100 x 50, and an orthographic camera.
+    let scene = |projection: &str, window: &str, (w, h): (u32, u32)| {
+        format!(
+            r#"LookAt 0.3 0.2 5  0 0 0  0 1 0
+Camera "{projection}" {window}
+Film "rgb" "integer xresolution" {w} "integer yresolution" {h}
+WorldBegin
+Shape "sphere"
+"#
+        )
+    };
+    let points = [
+        glam::Vec3::new(0.5, 0.2, 0.1),
+        glam::Vec3::new(1.2, -0.4, -0.3),
+        glam::Vec3::new(-0.8, 0.6, 0.2),
+    ];
+    for projection in ["perspective", "orthographic"] {
+        let camera = |tag: &str, window: &str, size: (u32, u32)| {
+            let text = scene(projection, window, size);
+            let desc = load_text(tag, &[("window.pbrt", &text)]).unwrap();
+            assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+            Camera::new(&desc.camera, desc.resolution)
+        };
+        let full = camera("full", "", (200, 100));
+        let right = camera("right", "\"float screenwindow\" [ 0 2 -1 1 ]", (100, 100));
+        let corner = camera("corner", "\"float screenwindow\" [ -2 0 0 1 ]", (100, 50));
+        for p in points {
+            let f = full.raster_position(p).unwrap();
+            let r = right.raster_position(p).unwrap();
+            let c = corner.raster_position(p).unwrap();
+            assert!(
+                (r - (f - glam::Vec2::new(100.0, 0.0))).length() < 1e-3,
+                "{projection}: {f} {r}"
+            );
+            assert!((c - f).length() < 1e-3, "{projection}: {f} {c}");
+        }
+    }
+    // A window of another shape than the film: warned.
+    let text = scene(
+        "perspective",
+        "\"float screenwindow\" [ -1 1 -1 1 ]",
+        (200, 100),
+    );
+    let desc = load_text("stretched", &[("window.pbrt", &text)]).unwrap();
+    assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
+}
+
+#[test]
+fn mitchell_and_sinc_filters_are_read_and_render() {
+    use pathlab_render::desc::PixelFilter;
+    let scene = |filter: &str| {
+        format!(
+            r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+PixelFilter {filter}
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+"#
+        )
+    };
+    for (filter, expected) in [
+        (
+            "\"mitchell\"",
+            PixelFilter::Mitchell {
+                radius: 2.0,
+                b: 1.0 / 3.0,
+                c: 1.0 / 3.0,
+            },
+        ),
+        (
+            "\"mitchell\" \"float xradius\" 1.5 \"float B\" 0 \"float C\" 0.5",
+            PixelFilter::Mitchell {
+                radius: 1.5,
+                b: 0.0,
+                c: 0.5,
+            },
+        ),
+        (
+            "\"sinc\"",
+            PixelFilter::LanczosSinc {
+                radius: 4.0,
+                tau: 3.0,
+            },
+        ),
+    ] {
+        let desc = load_text("filters", &[("filter.pbrt", &scene(filter))]).unwrap();
+        assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+        assert_eq!(desc.filter, expected);
+        // Under a sky of radiance 1 every pixel's expected value is 1; the signed weights
+        // make noise, whose standard error gives the tolerance.
+        let film = render_film(&desc, 256, 1);
+        assert!(
+            film.image_mean_std_error().x > 0.0,
+            "{filter}: no noise from negative lobes?"
+        );
+        assert_mean(filter, &film, DVec3::ONE);
+    }
+}
+
+#[test]
+fn area_lights_emit_their_image_and_name_a_missing_one() {
+    use glam::Vec3;
+    use std::f64::consts::PI;
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-area-image");
+    std::fs::create_dir_all(&dir).unwrap();
+    // Mean luminance 0.5: one black texel, one white.
+    pathlab_render::image_io::write_exr(&dir.join("glow.exr"), 2, 1, &[Vec3::ZERO, Vec3::ONE], &[])
+        .unwrap();
+    let scene = |file: &str, extra: &str| {
+        format!(
+            r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+WorldBegin
+AreaLightSource "diffuse" "string filename" "{file}" "float scale" 2 {extra}
+Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  1 1 0  0 1 0 ] "integer indices" [ 0 1 2  0 2 3 ]
+  "point2 uv" [ 0 0  1 0  1 1  0 1 ]
+"#
+        )
+    };
+    std::fs::write(dir.join("image.pbrt"), scene("glow.exr", "")).unwrap();
+    let desc = pathlab_scene::load(dir.join("image.pbrt").to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let mesh = &desc.meshes[0];
+    assert_eq!(mesh.emission.unwrap().radiance, Vec3::splat(2.0));
+    let t = pathlab_render::texture::Tex::from_desc(mesh.emission_texture.as_ref().unwrap());
+    let at = |u: f32| {
+        t.eval(&pathlab_render::texture::TexPoint::uv(glam::Vec2::new(
+            u, 0.5,
+        )))
+    };
+    assert_eq!((at(0.25), at(0.75)), (Vec3::ZERO, Vec3::ONE));
+    // With a power, each triangle (area ½) emits it: L = scale Φ / (π A × mean luminance).
+    std::fs::write(
+        dir.join("power.pbrt"),
+        scene("glow.exr", "\"float power\" 3"),
+    )
+    .unwrap();
+    let desc = pathlab_scene::load(dir.join("power.pbrt").to_str().unwrap()).unwrap();
+    let l = desc.meshes[0].emission.unwrap().radiance.x as f64;
+    let expected = 2.0 * 3.0 / (PI * 0.5 * 0.5);
+    assert!((l - expected).abs() < 1e-4 * expected, "{l} vs {expected}");
+    // A missing image: one warning naming it, and the light still emits.
+    std::fs::write(dir.join("missing.pbrt"), scene("gone.exr", "")).unwrap();
+    let desc = pathlab_scene::load(dir.join("missing.pbrt").to_str().unwrap()).unwrap();
+    assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
+    assert!(
+        desc.warnings[0].contains("gone.exr"),
+        "{}",
+        desc.warnings[0]
+    );
+    assert!(desc.meshes[0].emission.is_some());
+    // L and an image together are an error, as in pbrt-v4.
+    std::fs::write(
+        dir.join("both.pbrt"),
+        scene("glow.exr", "\"rgb L\" [ 1 1 1 ]"),
+    )
+    .unwrap();
+    let err = pathlab_scene::load(dir.join("both.pbrt").to_str().unwrap()).unwrap_err();
+    assert!(err.to_string().contains("both.pbrt"), "{err}");
+}
+
+#[test]
+fn a_film_clamp_is_warned_about_not_ignored() {
+    let scene = r#"Film "rgb" "integer xresolution" 8 "integer yresolution" 8 "float maxcomponentvalue" 10
+Camera "perspective"
+WorldBegin
+"#;
+    let desc = load_text("clamp", &[("clamp.pbrt", scene)]).unwrap();
+    assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
+    assert!(desc.warnings[0].contains("maxcomponentvalue"));
+}
