@@ -8,6 +8,16 @@ use std::path::PathBuf;
 mod pbrt_common;
 use pbrt_common::{load_text, render_film};
 
+/// A furnace: a camera looking at the origin under a uniform sky of radiance 1, with paths as
+/// long as they need; the scene's shapes follow.
+const FURNACE: &str = r#"LookAt 0 0 4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+Integrator "path" "integer maxdepth" [ 1000 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+"#;
+
 #[test]
 fn textures_scale_mix_invert_and_checker_as_pbrt_defines_them() {
     use glam::{Vec2, Vec3};
@@ -94,16 +104,11 @@ fn a_sphere_that_reflects_and_transmits_everything_vanishes_in_a_furnace() {
     // Under a uniform sky of radiance 1, a closed sphere whose diffuse reflectance and
     // transmittance add up to one returns all the light it receives, on both its sides: the
     // expected radiance of every pixel is 1 (light sampling and MIS leave some noise).
-    let scene = r#"LookAt 0 0 4  0 0 0  0 1 0
-Camera "perspective" "float fov" 40
-Film "rgb" "integer xresolution" 16 "integer yresolution" 16
-Integrator "path" "integer maxdepth" [ 1000 ]
-WorldBegin
-LightSource "infinite" "rgb L" [ 1 1 1 ]
-Material "diffusetransmission" "rgb reflectance" [ 0.3 0.3 0.3 ] "rgb transmittance" [ 0.7 0.7 0.7 ]
+    let scene = FURNACE.to_string()
+        + r#"Material "diffusetransmission" "rgb reflectance" [ 0.3 0.3 0.3 ] "rgb transmittance" [ 0.7 0.7 0.7 ]
 Shape "sphere" "float radius" 1
 "#;
-    let desc = load_text("furnace", &[("furnace.pbrt", scene)]).unwrap();
+    let desc = load_text("furnace", &[("furnace.pbrt", &scene)]).unwrap();
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
     let film = render_film(&desc, 64, 5);
     assert!(film.image_mean_std_error().x < 0.01);
@@ -181,13 +186,8 @@ AttributeEnd
 #[test]
 fn coated_materials_read_their_layers_and_a_lossless_coat_vanishes_in_a_furnace() {
     use pathlab_render::desc::{CoatedBase, MaterialDesc};
-    let scene = r#"LookAt 0 0 4  0 0 0  0 1 0
-Camera "perspective" "float fov" 40
-Film "rgb" "integer xresolution" 16 "integer yresolution" 16
-Integrator "path" "integer maxdepth" [ 1000 ]
-WorldBegin
-LightSource "infinite" "rgb L" [ 1 1 1 ]
-MakeNamedMaterial "plastic" "string type" "coateddiffuse" "rgb reflectance" [ 0.2 0.4 0.6 ]
+    let scene = FURNACE.to_string()
+        + r#"MakeNamedMaterial "plastic" "string type" "coateddiffuse" "rgb reflectance" [ 0.2 0.4 0.6 ]
   "float roughness" 0.04 "float thickness" 0.2 "rgb albedo" [ 0.5 0.5 0.5 ] "float g" 0.3
   "integer maxdepth" 20 "integer nsamples" 2 "float eta" 1.4
 MakeNamedMaterial "gold" "string type" "coatedconductor" "float interface.roughness" 0.01
@@ -196,7 +196,7 @@ MakeNamedMaterial "gold" "string type" "coatedconductor" "float interface.roughn
 Material "coateddiffuse" "rgb reflectance" [ 1 1 1 ] "integer maxdepth" 1000 "float thickness" 1e-30
 Shape "sphere" "float radius" 1
 "#;
-    let desc = load_text("coated", &[("coated.pbrt", scene)]).unwrap();
+    let desc = load_text("coated", &[("coated.pbrt", &scene)]).unwrap();
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
     let MaterialDesc::Coated(plastic) = &desc.materials[0] else {
         panic!("{:?}", desc.materials[0]);
