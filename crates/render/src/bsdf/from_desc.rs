@@ -123,10 +123,7 @@ impl Material {
 
 /// A coated material: a fixed layered model where nothing is textured or anisotropic.
 fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material {
-    let roughness = |[au, av]: [f32; 2]| {
-        (au.max(av) > SMOOTH_ALPHA)
-            .then(|| Microfacet::anisotropic(NormalDistribution::Ggx, au, av))
-    };
+    let roughness = |[au, av]: [f32; 2]| Microfacet::unless_smooth(NormalDistribution::Ggx, au, av);
     let (base, reflectance, base_texture, base_anisotropic) = match &c.base {
         CoatedBase::Diffuse(t) => {
             let reflectance = t
@@ -148,14 +145,9 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
             alpha[0] != alpha[1],
         ),
     };
-    let eta = if c.coat_eta > 0.0 && c.coat_eta.is_finite() {
-        c.coat_eta
-    } else {
-        1.5
-    };
     let stack = LayerStack {
         coat: Coat {
-            eta,
+            eta: usable_ior(c.coat_eta),
             roughness: roughness(c.coat_alpha),
         },
         base,

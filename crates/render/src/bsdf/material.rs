@@ -437,8 +437,7 @@ impl Model {
                 kind,
             } => {
                 let (au, av) = (alpha_u.eval_float(p), alpha_v.eval_float(p));
-                let distribution =
-                    (au.max(av) > SMOOTH_ALPHA).then(|| Microfacet::anisotropic(*kind, au, av));
+                let distribution = Microfacet::unless_smooth(*kind, au, av);
                 (
                     Bxdf::Conductor(Conductor {
                         eta: *eta,

@@ -75,6 +75,13 @@ impl Microfacet {
         }
     }
 
+    /// The anisotropic distribution of roughness (`alpha_x`, `alpha_y`), or `None` where both
+    /// are at most [`super::bxdf::SMOOTH_ALPHA`]: a surface drawn as its smooth limit.
+    pub fn unless_smooth(kind: NormalDistribution, alpha_x: f32, alpha_y: f32) -> Option<Self> {
+        (alpha_x.max(alpha_y) > super::bxdf::SMOOTH_ALPHA)
+            .then(|| Microfacet::anisotropic(kind, alpha_x, alpha_y))
+    }
+
     /// Whether both roughnesses are the same.
     #[inline]
     pub fn is_isotropic(&self) -> bool {

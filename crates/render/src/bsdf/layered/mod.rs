@@ -312,6 +312,8 @@ impl Layered {
     /// layer (pbrt-v4's `LayeredBxDF::f` loop, for the coat as entrance and exit).
     fn walk_estimate(&self, wo: Vec3, wi: Vec3, rng: &mut Pcg32) -> Rgb {
         let (top, bottom) = (self.top(), self.bottom());
+        // Fixed for the material: asked once, not at every event.
+        let (top_specular, bottom_specular) = (top.specular(), bottom.specular());
         let thickness = self.stack.thickness;
         let exit_z = thickness;
         let mut r = || next(rng);
@@ -348,7 +350,7 @@ impl Layered {
                 }
                 if 0.0 < zp && zp < thickness {
                     // Scattered inside: connect to wis, then walk on by the phase function.
-                    let wt = if top.specular() {
+                    let wt = if top_specular {
                         1.0
                     } else {
                         power_heuristic(1, wis.pdf, 1, phase.p(-w, -wis.wi))
@@ -367,7 +369,7 @@ impl Layered {
                     beta *= self.stack.albedo; // p / pdf = 1
                     w = ps.wi;
                     z = zp;
-                    if (z < exit_z && w.z > 0.0 || z > exit_z && w.z < 0.0) && !top.specular() {
+                    if (z < exit_z && w.z > 0.0 || z > exit_z && w.z < 0.0) && !top_specular {
                         let f_exit = top.f(-w, wi, Mode::Radiance);
                         if f_exit.max_element() > 0.0 {
                             let wt = power_heuristic(1, ps.p, 1, refracted_pdf(top, wi, w));
@@ -388,8 +390,8 @@ impl Layered {
                 w = bs.wi;
             } else {
                 // At the base: connect to wis, then reflect.
-                if !bottom.specular() {
-                    let wt = if top.specular() {
+                if !bottom_specular {
+                    let wt = if top_specular {
                         1.0
                     } else {
                         power_heuristic(1, wis.pdf, 1, bottom.pdf(-w, -wis.wi, Lobes::All))
@@ -408,10 +410,10 @@ impl Layered {
                 };
                 beta *= bs.f * bs.wi.z.abs() / bs.pdf;
                 w = bs.wi;
-                if !top.specular() {
+                if !top_specular {
                     let f_exit = top.f(-w, wi, Mode::Radiance);
                     if f_exit.max_element() > 0.0 {
-                        let wt = if bottom.specular() {
+                        let wt = if bottom_specular {
                             1.0
                         } else {
                             power_heuristic(1, bs.pdf, 1, refracted_pdf(top, wi, w))
@@ -522,6 +524,8 @@ impl Layered {
             (wo, wi) = (-wo, -wi);
         }
         let (top, bottom) = (self.top(), self.bottom());
+        // Fixed for the material: asked once, not at every event.
+        let (top_specular, bottom_specular) = (top.specular(), bottom.specular());
         let n = self.stack.samples.max(1);
         let mut sum = 0.0;
         if wo.z * wi.z > 0.0 {
@@ -546,7 +550,7 @@ impl Layered {
                 let (Some(wos), Some(wis)) = (wos, wis) else {
                     continue;
                 };
-                if top.specular() {
+                if top_specular {
                     sum += bottom.pdf(-wos.wi, -wis.wi, Lobes::All);
                     continue;
                 }
@@ -559,7 +563,7 @@ impl Layered {
                 ) else {
                     continue;
                 };
-                if bottom.specular() {
+                if bottom_specular {
                     sum += top.pdf(-rs.wi, wi, Lobes::All);
                 } else {
                     let r_pdf = bottom.pdf(-wos.wi, -wis.wi, Lobes::All);
