@@ -30,8 +30,123 @@ pub struct DiscreteSample {
     pub u_remapped: f32,
 }
 
-/// CDF entries per block of [`PiecewiseConstant1D`]'s coarse search level (one cache line).
+/// CDF entries per block of the coarse search level.
 const CDF_BLOCK: usize = 16;
+
+/// Entry `i` of a tabulated distribution: the CDF at the start of piece `i` and the piece's
+/// value (0 for the entry after the last piece). Kept side by side so that the search's block
+/// of the CDF brings the found piece's value with it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Entry {
+    cdf: f32,
+    func: f32,
+}
+
+/// The tables of one 1D distribution, borrowed: what sampling and evaluation read. A
+/// [`PiecewiseConstant1D`] lends its own; a [`PiecewiseConstant2D`] lends one row of its flat
+/// tables. One implementation of the search and the inversion serves both.
+#[derive(Clone, Copy)]
+struct Pieces<'a> {
+    /// `n + 1` entries.
+    entries: &'a [Entry],
+    /// Every [`CDF_BLOCK`]th CDF entry (`cdf[0]`, `cdf[16]`, ...).
+    coarse: &'a [f32],
+    min: f32,
+    max: f32,
+    func_int: f32,
+}
+
+impl Pieces<'_> {
+    /// The number of pieces.
+    #[inline]
+    fn len(&self) -> usize {
+        self.entries.len() - 1
+    }
+
+    /// The piece `o` with `cdf[o] <= u < cdf[o + 1]` (pieces of zero probability are skipped).
+    #[inline]
+    fn find_piece(&self, u: f32) -> usize {
+        // Number of CDF entries <= u, minus one, kept within 0..n.
+        self.cdf_entries_at_most(u)
+            .saturating_sub(1)
+            .min(self.len() - 1)
+    }
+
+    /// The number of CDF entries `<= u` (the CDF does not decrease, so they are its first
+    /// ones): the blocks whose first entry is `<= u` from the coarse level, then the entries
+    /// of the last of them. The same count as a binary search over the whole CDF.
+    #[inline]
+    fn cdf_entries_at_most(&self, u: f32) -> usize {
+        // Counted rather than bisected: every comparison is independent of the others, so a
+        // row of a large table costs one wait for memory, not one per halving.
+        let blocks = self.coarse.iter().filter(|&&c| c <= u).count();
+        if blocks == 0 {
+            return 0;
+        }
+        // Entry `CDF_BLOCK * (blocks - 1)` is <= u and entry `CDF_BLOCK * blocks` (if any)
+        // is not: count the ones between.
+        let first = CDF_BLOCK * (blocks - 1) + 1;
+        let end = (CDF_BLOCK * blocks).min(self.entries.len());
+        first
+            + self.entries[first..end]
+                .iter()
+                .filter(|e| e.cdf <= u)
+                .count()
+    }
+
+    /// Density of piece `o` with respect to x.
+    #[inline]
+    fn piece_pdf(&self, o: usize) -> f32 {
+        if self.func_int > 0.0 {
+            self.entries[o].func / self.func_int
+        } else {
+            1.0 / (self.max - self.min)
+        }
+    }
+
+    /// The index of the piece containing `x` (clamped to the domain).
+    #[inline]
+    fn offset_of(&self, x: f32) -> usize {
+        let n = self.len();
+        let t = (x - self.min) / (self.max - self.min);
+        ((t * n as f32) as isize).clamp(0, n as isize - 1) as usize
+    }
+
+    #[inline]
+    fn sample(&self, u: f32) -> PiecewiseSample {
+        let o = self.find_piece(u);
+        let (c0, c1) = (self.entries[o].cdf, self.entries[o + 1].cdf);
+        let mut du = u - c0;
+        if c1 - c0 > 0.0 {
+            du /= c1 - c0;
+        }
+        let t = ((o as f32 + du.clamp(0.0, 1.0)) / self.len() as f32).min(1.0);
+        let mut x = (self.min + t * (self.max - self.min)).min(self.max.next_down());
+        // Rounding can put a point at a piece's edge into the neighbouring piece, whose density
+        // differs (or is zero); step to the nearest float inside piece `o`.
+        for _ in 0..8 {
+            match self.offset_of(x).cmp(&o) {
+                std::cmp::Ordering::Less => x = x.next_up(),
+                std::cmp::Ordering::Greater => x = x.next_down(),
+                std::cmp::Ordering::Equal => break,
+            }
+        }
+        PiecewiseSample {
+            x,
+            pdf: self.piece_pdf(o),
+            offset: o,
+        }
+    }
+
+    fn invert_sample(&self, x: f32) -> f32 {
+        let n = self.len();
+        let t = ((x - self.min) / (self.max - self.min)).clamp(0.0, 1.0) * n as f32;
+        let o = (t as usize).min(n - 1);
+        let frac = t - o as f32;
+        let (c0, c1) = (self.entries[o].cdf, self.entries[o + 1].cdf);
+        c0 + frac * (c1 - c0)
+    }
+}
 
 /// A piecewise-constant density on `[min, max]`: `n` equal pieces with values `f[i]`,
 /// normalised so that it integrates to one.
@@ -50,11 +165,11 @@ const CDF_BLOCK: usize = 16;
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct PiecewiseConstant1D {
-    func: Vec<f32>,
-    cdf: Vec<f32>,
-    /// Every [`CDF_BLOCK`]th CDF entry (`cdf[0]`, `cdf[16]`, ...): the search finds the block
-    /// here, then the entry within one block, so that it touches two or three cache lines of
-    /// a long CDF rather than one per halving.
+    /// `n + 1` entries: the CDF at the piece boundaries and the pieces' values.
+    entries: Vec<Entry>,
+    /// Every [`CDF_BLOCK`]th CDF entry: the search finds the block here, then the entry
+    /// within one block, so that it touches two or three cache lines of a long CDF rather
+    /// than one per halving.
     coarse: Vec<f32>,
     min: f32,
     max: f32,
@@ -82,31 +197,45 @@ impl PiecewiseConstant1D {
             sums.push(acc);
         }
         let func_int = acc;
-        let cdf = if func_int > 0.0 {
+        let mut cdf: Vec<f32> = if func_int > 0.0 {
             sums.iter().map(|&c| (c / func_int) as f32).collect()
         } else {
             (0..=n).map(|i| (i as f64 / n as f64) as f32).collect()
         };
-        let mut cdf: Vec<f32> = cdf;
         cdf[n] = 1.0;
+        let entries = cdf
+            .iter()
+            .zip(func.iter().chain([&0.0]))
+            .map(|(&cdf, &func)| Entry { cdf, func })
+            .collect();
         Ok(PiecewiseConstant1D {
-            func: func.to_vec(),
+            entries,
             coarse: cdf.iter().step_by(CDF_BLOCK).copied().collect(),
-            cdf,
             min,
             max,
             func_int: func_int as f32,
         })
     }
 
+    #[inline]
+    fn pieces(&self) -> Pieces<'_> {
+        Pieces {
+            entries: &self.entries,
+            coarse: &self.coarse,
+            min: self.min,
+            max: self.max,
+            func_int: self.func_int,
+        }
+    }
+
     /// The number of pieces.
     pub fn len(&self) -> usize {
-        self.func.len()
+        self.entries.len() - 1
     }
 
     /// Always false: a distribution has at least one piece.
     pub fn is_empty(&self) -> bool {
-        self.func.is_empty()
+        self.len() == 0
     }
 
     /// ∫ f(x) dx over the domain (before normalisation).
@@ -119,75 +248,19 @@ impl PiecewiseConstant1D {
         (self.min, self.max)
     }
 
-    /// The piece values as given.
-    pub fn func(&self) -> &[f32] {
-        &self.func
+    /// The value of piece `i` as given.
+    pub fn value(&self, i: usize) -> f32 {
+        self.entries[..self.len()].get(i).map_or(0.0, |e| e.func)
     }
 
     /// The CDF at the piece boundaries (`len() + 1` values from 0 to 1).
-    pub fn cdf(&self) -> &[f32] {
-        &self.cdf
-    }
-
-    /// The piece `o` with `cdf[o] <= u < cdf[o + 1]` (pieces of zero probability are skipped).
-    #[inline]
-    fn find_piece(&self, u: f32) -> usize {
-        // Number of CDF entries <= u, minus one, kept within 0..n.
-        self.cdf_entries_at_most(u)
-            .saturating_sub(1)
-            .min(self.func.len() - 1)
-    }
-
-    /// The number of CDF entries `<= u` (the CDF does not decrease, so they are its first
-    /// ones): the blocks whose first entry is `<= u` from the coarse level, then the entries
-    /// of the last of them. The same count as a binary search over the whole CDF.
-    #[inline]
-    fn cdf_entries_at_most(&self, u: f32) -> usize {
-        let blocks = self.coarse.partition_point(|&c| c <= u);
-        if blocks == 0 {
-            return 0;
-        }
-        // Entry `CDF_BLOCK * (blocks - 1)` is <= u and entry `CDF_BLOCK * blocks` (if any)
-        // is not: count the ones between.
-        let first = CDF_BLOCK * (blocks - 1) + 1;
-        let end = (CDF_BLOCK * blocks).min(self.cdf.len());
-        first + self.cdf[first..end].iter().filter(|&&c| c <= u).count()
-    }
-
-    /// Density of piece `o` with respect to x.
-    #[inline]
-    fn piece_pdf(&self, o: usize) -> f32 {
-        if self.func_int > 0.0 {
-            self.func[o] / self.func_int
-        } else {
-            1.0 / (self.max - self.min)
-        }
+    pub fn cdf(&self) -> impl ExactSizeIterator<Item = f32> + '_ {
+        self.entries.iter().map(|e| e.cdf)
     }
 
     /// A point with density `pdf(x)`, by inverting the CDF at `u` in [0, 1).
     pub fn sample(&self, u: f32) -> PiecewiseSample {
-        let o = self.find_piece(u);
-        let (c0, c1) = (self.cdf[o], self.cdf[o + 1]);
-        let mut du = u - c0;
-        if c1 - c0 > 0.0 {
-            du /= c1 - c0;
-        }
-        let t = ((o as f32 + du.clamp(0.0, 1.0)) / self.func.len() as f32).min(1.0);
-        let mut x = (self.min + t * (self.max - self.min)).min(self.max.next_down());
-        // Rounding can put a point at a piece's edge into the neighbouring piece, whose density
-        // differs (or is zero); step to the nearest float inside piece `o`.
-        for _ in 0..8 {
-            match self.offset_of(x).cmp(&o) {
-                std::cmp::Ordering::Less => x = x.next_up(),
-                std::cmp::Ordering::Greater => x = x.next_down(),
-                std::cmp::Ordering::Equal => break,
-            }
-        }
-        PiecewiseSample {
-            x,
-            pdf: self.piece_pdf(o),
-            offset: o,
-        }
+        self.pieces().sample(u)
     }
 
     /// The density at `x` (0 outside the domain).
@@ -195,30 +268,25 @@ impl PiecewiseConstant1D {
         if !(self.min..=self.max).contains(&x) {
             return 0.0;
         }
-        self.piece_pdf(self.offset_of(x))
+        let p = self.pieces();
+        p.piece_pdf(p.offset_of(x))
     }
 
     /// The index of the piece containing `x` (clamped to the domain).
     #[inline]
     pub fn offset_of(&self, x: f32) -> usize {
-        let n = self.func.len();
-        let t = (x - self.min) / (self.max - self.min);
-        ((t * n as f32) as isize).clamp(0, n as isize - 1) as usize
+        self.pieces().offset_of(x)
     }
 
     /// The `u` that [`PiecewiseConstant1D::sample`] maps to `x`: the CDF at `x`.
     pub fn invert_sample(&self, x: f32) -> f32 {
-        let n = self.func.len();
-        let t = ((x - self.min) / (self.max - self.min)).clamp(0.0, 1.0) * n as f32;
-        let o = (t as usize).min(n - 1);
-        let frac = t - o as f32;
-        self.cdf[o] + frac * (self.cdf[o + 1] - self.cdf[o])
+        self.pieces().invert_sample(x)
     }
 
     /// A piece chosen with probability proportional to its value (uniform if all are zero).
     pub fn sample_discrete(&self, u: f32) -> DiscreteSample {
-        let o = self.find_piece(u);
-        let (c0, c1) = (self.cdf[o], self.cdf[o + 1]);
+        let o = self.pieces().find_piece(u);
+        let (c0, c1) = (self.entries[o].cdf, self.entries[o + 1].cdf);
         let pmf = c1 - c0;
         let u_remapped = if pmf > 0.0 {
             ((u - c0) / pmf).clamp(0.0, 1.0f32.next_down())
@@ -234,8 +302,8 @@ impl PiecewiseConstant1D {
 
     /// The probability [`PiecewiseConstant1D::sample_discrete`] gives piece `index`.
     pub fn discrete_pmf(&self, index: usize) -> f32 {
-        match (self.cdf.get(index), self.cdf.get(index + 1)) {
-            (Some(c0), Some(c1)) => c1 - c0,
+        match (self.entries.get(index), self.entries.get(index + 1)) {
+            (Some(e0), Some(e1)) => e1.cdf - e0.cdf,
             _ => 0.0,
         }
     }
@@ -248,9 +316,21 @@ impl PiecewiseConstant1D {
 /// within that row; the joint density is their product, f(u, v) / ∫∫ f. For environment maps
 /// the values are luminance × sin θ so that the density is uniform in solid angle where the map
 /// is constant.
+///
+/// The rows' tables are held in two flat arrays, every row's coarse search level in one
+/// (a few tens of kilobytes for an environment map, which stay in cache) and every row's CDF
+/// and values in the other, so that sampling a row of a large table waits on memory once.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PiecewiseConstant2D {
-    conditional: Vec<PiecewiseConstant1D>,
+    /// Pieces per row.
+    nu: usize,
+    /// `nu + 1` entries per row.
+    entries: Vec<Entry>,
+    /// Coarse levels, `coarse_len` per row.
+    coarse: Vec<f32>,
+    coarse_len: usize,
+    /// ∫ f(u, v) du of each row.
+    row_integrals: Vec<f32>,
     marginal: PiecewiseConstant1D,
     min: Vec2,
     max: Vec2,
@@ -272,18 +352,40 @@ impl PiecewiseConstant2D {
             });
         }
         check_weights(WHAT, func)?;
-        let conditional = func
-            .chunks_exact(nu)
-            .map(|row| PiecewiseConstant1D::new(row, min.x, max.x))
-            .collect::<Result<Vec<_>>>()?;
-        let row_integrals: Vec<f32> = conditional.iter().map(|c| c.integral()).collect();
+        let coarse_len = (nu + 1).div_ceil(CDF_BLOCK);
+        let mut entries = Vec::with_capacity((nu + 1) * nv);
+        let mut coarse = Vec::with_capacity(coarse_len * nv);
+        let mut row_integrals = Vec::with_capacity(nv);
+        for row in func.chunks_exact(nu) {
+            let d = PiecewiseConstant1D::new(row, min.x, max.x)?;
+            entries.extend_from_slice(&d.entries);
+            coarse.extend_from_slice(&d.coarse);
+            row_integrals.push(d.func_int);
+        }
         let marginal = PiecewiseConstant1D::new(&row_integrals, min.y, max.y)?;
         Ok(PiecewiseConstant2D {
-            conditional,
+            nu,
+            entries,
+            coarse,
+            coarse_len,
+            row_integrals,
             marginal,
             min,
             max,
         })
+    }
+
+    /// Row `v`'s conditional distribution in u.
+    #[inline]
+    fn row(&self, v: usize) -> Pieces<'_> {
+        let n = self.nu + 1;
+        Pieces {
+            entries: &self.entries[v * n..(v + 1) * n],
+            coarse: &self.coarse[v * self.coarse_len..(v + 1) * self.coarse_len],
+            min: self.min.x,
+            max: self.max.x,
+            func_int: self.row_integrals[v],
+        }
     }
 
     /// ∫∫ f over the rectangle.
@@ -299,7 +401,7 @@ impl PiecewiseConstant2D {
     /// A point of the rectangle and its density (per unit area of the rectangle).
     pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
         let row = self.marginal.sample(u.y);
-        let col = self.conditional[row.offset].sample(u.x);
+        let col = self.row(row.offset).sample(u.x);
         (Vec2::new(col.x, row.x), col.pdf * row.pdf)
     }
 
@@ -308,10 +410,9 @@ impl PiecewiseConstant2D {
         if !(self.min.x..=self.max.x).contains(&p.x) || !(self.min.y..=self.max.y).contains(&p.y) {
             return 0.0;
         }
-        let v = self.marginal.offset_of(p.y);
-        let row = &self.conditional[v];
+        let row = self.row(self.marginal.offset_of(p.y));
         if self.marginal.integral() > 0.0 {
-            row.func()[row.offset_of(p.x)] / self.marginal.integral()
+            row.entries[row.offset_of(p.x)].func / self.marginal.integral()
         } else {
             let size = self.max - self.min;
             1.0 / (size.x * size.y)
@@ -322,7 +423,7 @@ impl PiecewiseConstant2D {
     pub fn invert_sample(&self, p: Vec2) -> Vec2 {
         let v = self.marginal.offset_of(p.y);
         Vec2::new(
-            self.conditional[v].invert_sample(p.x),
+            self.row(v).invert_sample(p.x),
             self.marginal.invert_sample(p.y),
         )
     }
@@ -346,17 +447,45 @@ mod tests {
                 })
                 .collect();
             let d = PiecewiseConstant1D::new(&func, 0.0, 1.0).unwrap();
+            let cdf: Vec<f32> = d.cdf().collect();
             let mut us: Vec<f32> = vec![0.0, 1.0, 1.0f32.next_down(), -0.0, f32::NAN];
-            for &c in d.cdf() {
+            for &c in &cdf {
                 us.extend([c, c.next_up(), c.next_down()]);
             }
             us.extend((0..2000).map(|_| rng.uniform_f32()));
             for u in us {
                 assert_eq!(
-                    d.cdf_entries_at_most(u),
-                    d.cdf().partition_point(|&c| c <= u),
+                    d.pieces().cdf_entries_at_most(u),
+                    cdf.partition_point(|&c| c <= u),
                     "n = {n}, u = {u}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn a_row_of_the_flat_2d_tables_samples_as_its_own_1d_distribution() {
+        let mut rng = Pcg32::new(5, 11);
+        let (nu, nv) = (37, 9);
+        let func: Vec<f32> = (0..nu * nv)
+            .map(|i| {
+                if i % 5 == 0 {
+                    0.0
+                } else {
+                    rng.uniform_f32() * (i % 13) as f32
+                }
+            })
+            .collect();
+        let (min, max) = (Vec2::new(-1.0, 2.0), Vec2::new(3.0, 2.5));
+        let d = PiecewiseConstant2D::new(&func, nu, nv, min, max).unwrap();
+        for (v, row) in func.chunks_exact(nu).enumerate() {
+            let alone = PiecewiseConstant1D::new(row, min.x, max.x).unwrap();
+            for _ in 0..200 {
+                let u = rng.uniform_f32();
+                assert_eq!(d.row(v).sample(u), alone.sample(u), "row {v}, u = {u}");
+                let x = min.x + (max.x - min.x) * rng.uniform_f32();
+                assert_eq!(d.row(v).invert_sample(x), alone.invert_sample(x));
+                assert_eq!(d.row(v).piece_pdf(d.row(v).offset_of(x)), alone.pdf(x));
             }
         }
     }
