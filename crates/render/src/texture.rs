@@ -53,17 +53,21 @@ impl Texture {
             return self.texels[0];
         }
         let (w, h) = (self.width as i64, self.height as i64);
-        let fix = |i: i64, n: i64| -> usize {
+        let fix = |i: i64, n: i64| -> Option<usize> {
             match wrap {
-                WrapMode::Repeat => i.rem_euclid(n) as usize,
-                WrapMode::Clamp => i.clamp(0, n - 1) as usize,
+                WrapMode::Repeat => Some(i.rem_euclid(n) as usize),
+                WrapMode::Clamp => Some(i.clamp(0, n - 1) as usize),
                 WrapMode::Mirror => {
                     let m = i.rem_euclid(2 * n);
-                    (if m < n { m } else { 2 * n - 1 - m }) as usize
+                    Some((if m < n { m } else { 2 * n - 1 - m }) as usize)
                 }
+                WrapMode::Black => (0..n).contains(&i).then_some(i as usize),
             }
         };
-        let at = |x: i64, y: i64| self.texels[fix(y, h) * self.width + fix(x, w)];
+        let at = |x: i64, y: i64| match (fix(x, w), fix(y, h)) {
+            (Some(x), Some(y)) => self.texels[y * self.width + x],
+            _ => Rgb::ZERO,
+        };
         // Row 0 is the top of the image: v = 1.
         let x = uv.x * self.width as f32;
         let y = (1.0 - uv.y) * self.height as f32;
@@ -152,6 +156,14 @@ pub enum Tex {
         /// Surface (u, v) to checkerboard coordinates.
         to_uv: Affine2,
     },
+    /// Four values at the corners of the mapped unit square, interpolated bilinearly.
+    Bilerp {
+        /// The values at (s, t) = (0, 0), (1, 0), (0, 1) and (1, 1) (boxed: a texture stays
+        /// as small as an image's reference and mapping).
+        corners: Box<[Rgb; 4]>,
+        /// Surface (u, v) to (s, t).
+        to_uv: Affine2,
+    },
     /// Attribute table `index` of the scene (zero where the point is not on a triangle).
     Attribute(u32),
     /// The product of two textures.
@@ -185,6 +197,10 @@ impl Tex {
             } => Tex::Checkerboard {
                 color0: *color0,
                 color1: *color1,
+                to_uv: *to_uv,
+            },
+            TextureDesc::Bilerp { corners, to_uv } => Tex::Bilerp {
+                corners: Box::new(*corners),
                 to_uv: *to_uv,
             },
             TextureDesc::MeshAttribute { name } => Tex::Attribute(attribute(name)),
@@ -237,6 +253,9 @@ impl Tex {
                 } else {
                     *color1
                 }
+            }
+            Tex::Bilerp { corners, to_uv } => {
+                crate::desc::bilerp(corners, to_uv.transform_point2(p.uv))
             }
             Tex::Attribute(table) => {
                 let (Some((tri, b)), Some(t)) = (p.triangle, p.attributes.get(*table as usize))

@@ -100,6 +100,71 @@ Shape "sphere"
 }
 
 #[test]
+fn bilerp_textures_and_black_wrapping_as_pbrt_defines_them() {
+    use glam::{Vec2, Vec3};
+    use pathlab_render::desc::MaterialDesc;
+    use pathlab_render::texture::{Tex, TexPoint};
+    // A 2 x 1 image: 0.2 on its left half, 0.6 on its right.
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-bilerp");
+    std::fs::create_dir_all(&dir).unwrap();
+    let texels = [Vec3::splat(0.2), Vec3::splat(0.6)];
+    pathlab_render::image_io::write_exr(&dir.join("two.exr"), 2, 1, &texels, &[]).unwrap();
+    let scene = r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 4 "integer yresolution" 4
+WorldBegin
+Texture "corners" "spectrum" "bilerp" "rgb v00" [ 1 0 0 ] "rgb v10" [ 0 1 0 ] "rgb v01" [ 0 0 1 ] "rgb v11" [ 1 1 1 ]
+Texture "ramp" "float" "bilerp"
+Texture "wide" "float" "bilerp" "float v10" 1 "float v11" 0 "float v01" 0 "float uscale" 2
+Texture "black" "spectrum" "imagemap" "string filename" "two.exr" "string encoding" "linear" "string wrap" "black"
+Texture "clamped" "spectrum" "imagemap" "string filename" "two.exr" "string encoding" "linear" "string wrap" "clamp"
+MakeNamedMaterial "m0" "string type" "diffuse" "texture reflectance" "corners"
+MakeNamedMaterial "m1" "string type" "diffuse" "texture reflectance" "black"
+MakeNamedMaterial "m2" "string type" "diffuse" "texture reflectance" "clamped"
+Texture "by-ramp" "spectrum" "mix" "rgb tex1" [ 0 0 0 ] "rgb tex2" [ 1 1 1 ] "texture amount" "ramp"
+Texture "by-wide" "spectrum" "mix" "rgb tex1" [ 0 0 0 ] "rgb tex2" [ 1 1 1 ] "texture amount" "wide"
+MakeNamedMaterial "m3" "string type" "diffuse" "texture reflectance" "by-ramp"
+MakeNamedMaterial "m4" "string type" "diffuse" "texture reflectance" "by-wide"
+NamedMaterial "m0"
+Shape "sphere"
+"#;
+    std::fs::write(dir.join("bilerp.pbrt"), scene).unwrap();
+    let desc = pathlab_scene::load(dir.join("bilerp.pbrt").to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let at = |t: &Tex, u: f32, v: f32| t.eval(&TexPoint::uv(Vec2::new(u, v)));
+    let close = |a: Vec3, b: Vec3| (a - b).abs().max_element() < 1e-5;
+    let texture = |m: &MaterialDesc| match m {
+        MaterialDesc::TexturedDiffuse { texture, .. } => Tex::from_desc(texture),
+        other => panic!("not a textured diffuse material: {other:?}"),
+    };
+    let m = &desc.materials;
+    // The corners at the corners, their mean at the centre, linear along the edges.
+    let t = texture(&m[0]);
+    assert!(close(at(&t, 0.0, 0.0), Vec3::X));
+    assert!(close(at(&t, 1.0, 0.0), Vec3::Y));
+    assert!(close(at(&t, 0.0, 1.0), Vec3::Z));
+    assert!(close(at(&t, 1.0, 1.0), Vec3::ONE));
+    assert!(close(at(&t, 0.5, 0.5), Vec3::splat(0.5)));
+    assert!(close(at(&t, 0.25, 0.0), Vec3::new(0.75, 0.25, 0.0)));
+    // Black wrapping: a bilinear read at the image's left edge is half its first texel and
+    // half the black beyond; clamped, it is the first texel.
+    let t = texture(&m[1]);
+    assert!(close(at(&t, 0.25, 0.5), Vec3::splat(0.2)));
+    assert!(close(at(&t, 0.0, 0.5), Vec3::splat(0.1)));
+    assert!(close(at(&t, 1.0, 0.5), Vec3::splat(0.3)));
+    assert!(close(at(&t, 1.5, 0.5), Vec3::ZERO));
+    let t = texture(&m[2]);
+    assert!(close(at(&t, 0.0, 0.5), Vec3::splat(0.2)));
+    // Float bilerps (as mix amounts between black and white): the defaults give t; a scaled
+    // mapping extrapolates, s (1 - t) at s = 1.5.
+    let t = texture(&m[3]);
+    assert!(close(at(&t, 0.3, 0.7), Vec3::splat(0.7)));
+    let t = texture(&m[4]);
+    assert!(close(at(&t, 0.75, 0.0), Vec3::splat(1.5)));
+    assert!(close(at(&t, 0.25, 0.5), Vec3::splat(0.25)));
+}
+
+#[test]
 fn a_sphere_that_reflects_and_transmits_everything_vanishes_in_a_furnace() {
     // Under a uniform sky of radiance 1, a closed sphere whose diffuse reflectance and
     // transmittance add up to one returns all the light it receives, on both its sides: the

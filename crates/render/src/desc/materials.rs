@@ -22,6 +22,8 @@ pub enum WrapMode {
     Mirror,
     /// The border texels extend.
     Clamp,
+    /// Black outside the image (pbrt-v4's `black`): texels beyond the border read as zero.
+    Black,
 }
 
 /// A quantity that varies over a surface: a colour, or a number (read as the luminance of the
@@ -53,6 +55,14 @@ pub enum TextureDesc {
         /// The second colour.
         color1: Rgb,
         /// Surface (u, v) to checkerboard coordinates.
+        to_uv: Affine2,
+    },
+    /// Bilinear interpolation between four values at the corners of the unit square of the
+    /// mapped coordinates (s, t), extrapolated beyond it (pbrt-v4's `bilerp`).
+    Bilerp {
+        /// The values at (s, t) = (0, 0), (1, 0), (0, 1) and (1, 1).
+        corners: [Rgb; 4],
+        /// Surface (u, v) to (s, t).
         to_uv: Affine2,
     },
     /// A per-vertex (interpolated) or per-face attribute of the mesh, by name.
@@ -137,6 +147,11 @@ impl TextureDesc {
             TextureDesc::Constant(c) => *c,
             TextureDesc::Image { image, .. } => image.mean(),
             TextureDesc::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
+            // Bilinear in s and t apart, so its mean over the unit uv square is its value at
+            // the square's centre (for the uv mappings, which scale and shift).
+            TextureDesc::Bilerp { corners, to_uv } => {
+                bilerp(corners, to_uv.transform_point2(glam::Vec2::splat(0.5)))
+            }
             TextureDesc::MeshAttribute { .. } => Rgb::splat(0.5),
             TextureDesc::Product(ab) => ab[0].mean() * ab[1].mean(),
             TextureDesc::Mix(m) => {
@@ -146,6 +161,17 @@ impl TextureDesc {
             TextureDesc::Invert(t) => (Rgb::ONE - t.mean()).max(Rgb::ZERO),
         }
     }
+}
+
+/// The bilinear interpolation of `corners` (at (0, 0), (1, 0), (0, 1), (1, 1)) at `st`, as
+/// pbrt-v4 orders its terms.
+#[inline]
+pub fn bilerp(corners: &[Rgb; 4], st: glam::Vec2) -> Rgb {
+    let (s, t) = (st.x, st.y);
+    (1.0 - s) * (1.0 - t) * corners[0]
+        + s * (1.0 - t) * corners[1]
+        + (1.0 - s) * t * corners[2]
+        + s * t * corners[3]
 }
 
 /// A material.

@@ -1,6 +1,6 @@
 //! pbrt-v4's `Texture` directive: `constant`, `imagemap` (with its encoding, filter, wrap, uv
-//! mapping, scale and invert), `scale`, `mix` and 2D `checkerboard` textures, each kept by name
-//! for the materials that use it.
+//! mapping, scale and invert), `scale`, `mix`, `bilerp` and 2D `checkerboard` textures, each
+//! kept by name for the materials that use it.
 
 use super::materials::Use;
 use super::params::ParamList;
@@ -43,6 +43,25 @@ impl Builder {
                 TextureDesc::mix(amount, first, second)
             }
             "checkerboard" => self.checkerboard(&name, ty, &params)?,
+            "bilerp" => {
+                // pbrt-v4's defaults: 0 along t = 0 and 1 along t = 1.
+                let mut corner = |key: &str, default: f32| -> Result<Rgb, Error> {
+                    Ok(if ty == "float" {
+                        Rgb::splat(self.float(&params, key, default as f64)? as f32)
+                    } else {
+                        self.spectrum(&params, key, Use::Albedo)?
+                            .unwrap_or(Rgb::splat(default))
+                    })
+                };
+                let corners = [
+                    corner("v00", 0.0)?,
+                    corner("v10", 0.0)?,
+                    corner("v01", 1.0)?,
+                    corner("v11", 1.0)?,
+                ];
+                let to_uv = self.uv_mapping(&name, &params)?;
+                TextureDesc::Bilerp { corners, to_uv }
+            }
             other => {
                 self.warn(format!(
                     "Texture \"{name}\": \"{other}\" textures are not supported; a constant 0.5 is used"
@@ -88,10 +107,7 @@ impl Builder {
         };
         let wrap = match self.string(params, "wrap")?.as_deref() {
             Some("clamp") => WrapMode::Clamp,
-            Some("black") => {
-                self.warn(format!("Texture \"{name}\": wrap \"black\" read as clamp"));
-                WrapMode::Clamp
-            }
+            Some("black") => WrapMode::Black,
             _ => WrapMode::Repeat,
         };
         let to_uv = self.uv_mapping(name, params)?;
