@@ -1,6 +1,7 @@
 //! Shapes: triangles and spheres, their intersection with rays and their uniform area sampling.
 
 use crate::geometry::{Aabb, Ray};
+use crate::simd::lanes::{F8, V8, W};
 use glam::{Vec2, Vec3};
 use pathlab_mc::warp::sample_uniform_sphere;
 use std::f32::consts::PI;
@@ -104,35 +105,55 @@ impl Sphere {
         4.0 * PI * self.radius * self.radius
     }
 
-    /// The nearest intersection distance within `(0, ray.t_max)`, from either side.
+    /// The nearest intersection distance within `(ray.t_min, ray.t_max)`, from either side.
     ///
     /// Solves a t² + 2b t + c = 0 in `f64` relative to the centre, with the discriminant
     /// written as a (r² - |o - (b/a) d|²) to avoid cancellation for distant origins, and the
     /// roots as q/a and c/q to avoid it for near-tangent ones.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
-        let o = (ray.o - self.center).as_dvec3();
-        let d = ray.d.as_dvec3();
+        let t = self.nearest_root(ray.o, ray.d, ray.t_min, ray.t_max);
+        (!t.is_nan()).then_some(t)
+    }
+
+    /// [`Sphere::intersect`] of eight rays (origins `o`, directions `d`, extents from `t_min`
+    /// to `t_max`): each lane's distance, NaN where there is none. The same function as the
+    /// one-ray test for every lane (so the same bits); without branches, so that a caller
+    /// compiled for wide registers computes the eight lanes together.
+    #[inline(always)]
+    pub fn intersect_lanes(&self, o: &V8, d: &V8, t_min: &F8, t_max: &F8) -> [f32; W] {
+        std::array::from_fn(|i| self.nearest_root(o.get(i), d.get(i), t_min.0[i], t_max.0[i]))
+    }
+
+    /// The root of [`Sphere::intersect`]'s quadratic nearest `o` within `(t_min, t_max)`, or
+    /// NaN: every case a select rather than a branch.
+    #[inline(always)]
+    fn nearest_root(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> f32 {
+        let o = (o - self.center).as_dvec3();
+        let d = d.as_dvec3();
         let r = self.radius as f64;
         let a = d.length_squared();
-        if a == 0.0 {
-            return None;
-        }
         let b = o.dot(d);
         let c = o.length_squared() - r * r;
         let l = o - (b / a) * d;
         let disc = a * (r * r - l.length_squared());
-        if disc < 0.0 {
-            return None;
-        }
         let q = -(b + disc.sqrt().copysign(b));
         let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
         let (t0, t1) = (t0.min(t1), t0.max(t1));
-        let (t_min, t_max) = (ray.t_min as f64, ray.t_max as f64);
-        [t0, t1]
-            .into_iter()
-            .find(|&t| t > t_min && t < t_max)
-            .map(|t| t as f32)
+        let (t_min, t_max) = (t_min as f64, t_max as f64);
+        let t = if t0 > t_min && t0 < t_max {
+            t0
+        } else if t1 > t_min && t1 < t_max {
+            t1
+        } else {
+            f64::NAN
+        };
+        // No direction, or no real root (a NaN discriminant gives NaN roots, found nowhere).
+        if a == 0.0 || disc < 0.0 {
+            f32::NAN
+        } else {
+            t as f32
+        }
     }
 
     /// A point uniform over the surface.

@@ -1,7 +1,7 @@
 //! Path tracing eight paths at a time: each lane follows one pixel sample, and a lane whose
 //! path ends takes the next sample at once, so the lanes stay busy. Rays are traced one lane
 //! after another through the BVH (its own SIMD traversal), or, in scenes of a few dozen
-//! triangles, all eight against every triangle at once.
+//! triangles and a few spheres, all eight against every primitive at once.
 //!
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
 //! for every lane and bounce, except where a lane's surface is Lambertian and its light an
@@ -162,7 +162,7 @@ impl PathIntegrator {
         let mut a = ScatterIn::default();
         let mut b = ScatterOut::default();
         let mut more = true;
-        let all_triangles = scene.tests_all_triangles();
+        let every_primitive = scene.tests_every_primitive();
         let mut rays = RayLanes::default();
         loop {
             if more {
@@ -171,8 +171,8 @@ impl PathIntegrator {
             if lanes.iter().all(Option::is_none) {
                 break;
             }
-            // Small scenes: every lane's ray against every triangle at once.
-            let nearest = all_triangles.then(|| nearest_of_lanes(scene, &lanes, &mut rays));
+            // Small scenes: every lane's ray against every primitive at once.
+            let nearest = every_primitive.then(|| nearest_of_lanes(scene, &lanes, &mut rays));
             // Trace every lane; scatter the ones at other materials now, and gather the
             // Lambertian ones' inputs.
             let mut lambert_lanes = 0u32;
@@ -317,7 +317,7 @@ fn start_paths(
     true
 }
 
-/// Every busy lane's ray against every triangle at once (the small scenes' trace); idle lanes
+/// Every busy lane's ray against every primitive at once (the small scenes' trace); idle lanes
 /// get an empty interval.
 fn nearest_of_lanes(
     scene: &Scene,
