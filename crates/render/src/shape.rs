@@ -82,6 +82,44 @@ impl Triangle {
     }
 }
 
+/// A ray's quadratic a t² + 2b t + c = 0 against a sphere, and its discriminant written as
+/// a (r² - |o - (b/a) d|²) (see [`Sphere::intersect`]).
+#[derive(Clone, Copy)]
+struct SphereQuadratic {
+    a: f64,
+    b: f64,
+    c: f64,
+    disc: f64,
+}
+
+impl SphereQuadratic {
+    /// Whether there is a direction and real roots (a NaN discriminant passes: its roots are
+    /// NaN, found nowhere).
+    #[inline(always)]
+    fn has_roots(&self) -> bool {
+        !(self.a == 0.0 || self.disc < 0.0)
+    }
+
+    /// The root nearest the ray's origin within `(t_min, t_max)`, or NaN: every case a select
+    /// rather than a branch. Meaningful where [`SphereQuadratic::has_roots`].
+    #[inline(always)]
+    fn nearest_root(&self, t_min: f32, t_max: f32) -> f32 {
+        let SphereQuadratic { a, b, c, disc } = *self;
+        let q = -(b + disc.sqrt().copysign(b));
+        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
+        let (t0, t1) = (t0.min(t1), t0.max(t1));
+        let (t_min, t_max) = (t_min as f64, t_max as f64);
+        let t = if t0 > t_min && t0 < t_max {
+            t0
+        } else if t1 > t_min && t1 < t_max {
+            t1
+        } else {
+            f64::NAN
+        };
+        t as f32
+    }
+}
+
 /// A sphere.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
@@ -112,23 +150,35 @@ impl Sphere {
     /// roots as q/a and c/q to avoid it for near-tangent ones.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
-        let t = self.nearest_root(ray.o, ray.d, ray.t_min, ray.t_max);
+        let q = self.quadratic(ray.o, ray.d);
+        // Most rays that reach a sphere's test miss it: they end here.
+        if !q.has_roots() {
+            return None;
+        }
+        let t = q.nearest_root(ray.t_min, ray.t_max);
         (!t.is_nan()).then_some(t)
     }
 
     /// [`Sphere::intersect`] of eight rays (origins `o`, directions `d`, extents from `t_min`
-    /// to `t_max`): each lane's distance, NaN where there is none. The same function as the
+    /// to `t_max`): each lane's distance, NaN where there is none. The same functions as the
     /// one-ray test for every lane (so the same bits); without branches, so that a caller
     /// compiled for wide registers computes the eight lanes together.
     #[inline(always)]
     pub fn intersect_lanes(&self, o: &V8, d: &V8, t_min: &F8, t_max: &F8) -> [f32; W] {
-        std::array::from_fn(|i| self.nearest_root(o.get(i), d.get(i), t_min.0[i], t_max.0[i]))
+        std::array::from_fn(|i| {
+            let q = self.quadratic(o.get(i), d.get(i));
+            let t = q.nearest_root(t_min.0[i], t_max.0[i]);
+            if q.has_roots() {
+                t
+            } else {
+                f32::NAN
+            }
+        })
     }
 
-    /// The root of [`Sphere::intersect`]'s quadratic nearest `o` within `(t_min, t_max)`, or
-    /// NaN: every case a select rather than a branch.
+    /// The quadratic of a ray from `o` along `d`, relative to the centre in `f64`.
     #[inline(always)]
-    fn nearest_root(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> f32 {
+    fn quadratic(&self, o: Vec3, d: Vec3) -> SphereQuadratic {
         let o = (o - self.center).as_dvec3();
         let d = d.as_dvec3();
         let r = self.radius as f64;
@@ -137,23 +187,7 @@ impl Sphere {
         let c = o.length_squared() - r * r;
         let l = o - (b / a) * d;
         let disc = a * (r * r - l.length_squared());
-        let q = -(b + disc.sqrt().copysign(b));
-        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
-        let (t0, t1) = (t0.min(t1), t0.max(t1));
-        let (t_min, t_max) = (t_min as f64, t_max as f64);
-        let t = if t0 > t_min && t0 < t_max {
-            t0
-        } else if t1 > t_min && t1 < t_max {
-            t1
-        } else {
-            f64::NAN
-        };
-        // No direction, or no real root (a NaN discriminant gives NaN roots, found nowhere).
-        if a == 0.0 || disc < 0.0 {
-            f32::NAN
-        } else {
-            t as f32
-        }
+        SphereQuadratic { a, b, c, disc }
     }
 
     /// A point uniform over the surface.
