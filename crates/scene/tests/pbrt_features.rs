@@ -165,6 +165,66 @@ Shape "sphere"
 }
 
 #[test]
+fn spectra_read_from_files_as_pbrt_reads_them() {
+    use pathlab_render::desc::MaterialDesc;
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-spd");
+    std::fs::create_dir_all(dir.join("spds")).unwrap();
+    // The same reddish reflectance inline and in a file with comments and commas; a file of
+    // an odd count of numbers; no file at all.
+    std::fs::write(
+        dir.join("spds/red.spd"),
+        "# a reddish reflectance\n400 0.1\n550, 0.1 # green\n600 0.9\n700 0.9\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("odd.spd"), "400 0.5 500\n").unwrap();
+    let scene = r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 4 "integer yresolution" 4
+WorldBegin
+MakeNamedMaterial "inline" "string type" "diffuse" "spectrum reflectance" [ 400 0.1 550 0.1 600 0.9 700 0.9 ]
+MakeNamedMaterial "file" "string type" "diffuse" "spectrum reflectance" "spds/red.spd"
+MakeNamedMaterial "odd" "string type" "diffuse" "spectrum reflectance" "odd.spd"
+MakeNamedMaterial "missing" "string type" "diffuse" "spectrum reflectance" "spds/none.spd"
+NamedMaterial "inline"
+Shape "sphere"
+"#;
+    std::fs::write(dir.join("spd.pbrt"), scene).unwrap();
+    let desc = pathlab_scene::load(dir.join("spd.pbrt").to_str().unwrap()).unwrap();
+    let reflectance = |m: &MaterialDesc| match m {
+        MaterialDesc::Diffuse { reflectance, .. } => *reflectance,
+        other => panic!("not a diffuse material: {other:?}"),
+    };
+    let m = &desc.materials;
+    let (inline, file) = (reflectance(&m[0]), reflectance(&m[1]));
+    assert_eq!(inline, file);
+    assert!(inline.x > 2.0 * inline.y, "reddish: {inline}");
+    // The unreadable files: one warning each, naming the file and why, and grey.
+    assert_eq!(desc.warnings.len(), 2, "{:?}", desc.warnings);
+    assert!(
+        desc.warnings[0].contains("odd.spd") && desc.warnings[0].contains("3 numbers"),
+        "{}",
+        desc.warnings[0]
+    );
+    assert!(
+        desc.warnings[1].contains("none.spd"),
+        "{}",
+        desc.warnings[1]
+    );
+    assert_eq!(reflectance(&m[2]), glam::Vec3::splat(0.5));
+    assert_eq!(reflectance(&m[3]), glam::Vec3::splat(0.5));
+    // A name that is no file and no spectrum pathlab knows stays an error.
+    let bad = load_text(
+        "spd-unknown",
+        &[(
+            "s.pbrt",
+            "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"glass-XYZ\"\nShape \"sphere\"\n",
+        )],
+    );
+    let e = bad.expect_err("an unknown spectrum name").to_string();
+    assert!(e.contains("glass-XYZ") && e.contains("s.pbrt:2"), "{e}");
+}
+
+#[test]
 fn a_sphere_that_reflects_and_transmits_everything_vanishes_in_a_furnace() {
     // Under a uniform sky of radiance 1, a closed sphere whose diffuse reflectance and
     // transmittance add up to one returns all the light it receives, on both its sides: the

@@ -88,20 +88,8 @@ impl Builder {
                     )));
                 }
                 let pairs: Vec<(f64, f64)> = v.chunks(2).map(|c| (c[0], c[1])).collect();
-                if pairs.windows(2).any(|w| w[1].0 <= w[0].0) {
-                    return Err(self.error(format!("{decl}: wavelengths must increase")));
-                }
-                let kind = match usage {
-                    Use::Illuminant => SpectrumKind::Emission,
-                    Use::Albedo => SpectrumKind::Reflectance,
-                    Use::Unbounded => SpectrumKind::Unbounded,
-                };
-                let c = sampled_to_rgb(&pairs, kind);
-                if usage == Use::Illuminant {
-                    c / luminance(c).max(f64::MIN_POSITIVE)
-                } else {
-                    c
-                }
+                sampled_spectrum(&pairs, usage)
+                    .ok_or_else(|| self.error(format!("{decl}: wavelengths must increase")))?
             }
             ("spectrum", _, Some(names)) => {
                 let [name] = names else {
@@ -110,13 +98,45 @@ impl Builder {
                         names.len()
                     )));
                 };
-                self.named_spectrum(name, &decl)?
+                match self.named_spectrum(name, &decl) {
+                    Ok(c) => c,
+                    // Not a name pathlab knows: pbrt-v4 reads it as a file of wavelength and
+                    // value pairs; a name that looks like no file stays an error.
+                    Err(e) if !(name.contains('.') || name.contains('/')) => return Err(e),
+                    Err(_) => self.spectrum_file(name, usage, &decl),
+                }
             }
             (ty, _, _) => {
                 return Err(self.error(format!("{decl}: a '{ty}' where a spectrum was expected")))
             }
         };
         Ok(rgb.as_vec3())
+    }
+
+    /// The spectrum in file `name` (relative to the scene file): numbers separated by
+    /// whitespace or commas, `#` starting a comment, read as wavelength (nm) and value pairs,
+    /// as pbrt-v4 reads `.spd` files. A file that cannot be read is one warning naming it,
+    /// and a neutral value stands in: white light, grey 0.5 albedo, or 1.
+    fn spectrum_file(&mut self, name: &str, usage: Use, decl: &str) -> DVec3 {
+        let path = self.resolve(name);
+        let read = std::fs::read_to_string(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|text| parse_spectrum_file(&text))
+            .and_then(|pairs| {
+                sampled_spectrum(&pairs, usage).ok_or_else(|| "wavelengths must increase".into())
+            });
+        read.unwrap_or_else(|why| {
+            let (value, what) = match usage {
+                Use::Illuminant => (DVec3::ONE, "white light"),
+                Use::Albedo => (DVec3::splat(0.5), "grey 0.5"),
+                Use::Unbounded => (DVec3::ONE, "1"),
+            };
+            self.warn(format!(
+                "{decl}: cannot read the spectrum file {}: {why}; {what} is used",
+                path.display()
+            ));
+            value
+        })
     }
 
     /// pbrt-v4's named spectra that pathlab knows.
@@ -600,4 +620,51 @@ fn two_sided(m: MaterialDesc) -> MaterialDesc {
         front: Box::new(m.clone()),
         back: Box::new(m),
     }
+}
+
+/// RGB of a spectrum given as (wavelength in nm, value) pairs, as `usage` reads it (an
+/// illuminant normalised to luminance one, as pbrt-v4 normalises its lights' spectra); `None`
+/// where the wavelengths do not increase.
+fn sampled_spectrum(pairs: &[(f64, f64)], usage: Use) -> Option<DVec3> {
+    if pairs.windows(2).any(|w| w[1].0 <= w[0].0) {
+        return None;
+    }
+    let kind = match usage {
+        Use::Illuminant => SpectrumKind::Emission,
+        Use::Albedo => SpectrumKind::Reflectance,
+        Use::Unbounded => SpectrumKind::Unbounded,
+    };
+    let c = sampled_to_rgb(pairs, kind);
+    Some(if usage == Use::Illuminant {
+        c / luminance(c).max(f64::MIN_POSITIVE)
+    } else {
+        c
+    })
+}
+
+/// The (wavelength, value) pairs of a spectrum file's text.
+fn parse_spectrum_file(text: &str) -> Result<Vec<(f64, f64)>, String> {
+    let mut numbers = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("");
+        for token in line.split(|c: char| c.is_whitespace() || c == ',') {
+            if token.is_empty() {
+                continue;
+            }
+            let x: f64 = token
+                .parse()
+                .map_err(|_| format!("line {}: '{token}' is not a number", i + 1))?;
+            if !x.is_finite() {
+                return Err(format!("line {}: '{token}' is not finite", i + 1));
+            }
+            numbers.push(x);
+        }
+    }
+    if numbers.len() < 2 || numbers.len() % 2 != 0 {
+        return Err(format!(
+            "expected wavelength and value pairs, found {} numbers",
+            numbers.len()
+        ));
+    }
+    Ok(numbers.chunks(2).map(|c| (c[0], c[1])).collect())
 }

@@ -1,0 +1,345 @@
+//! Tests of the scene's ray tracing: the BVH against testing every primitive, at every SIMD
+//! level.
+
+use super::*;
+use crate::desc::{MeshDesc, SceneDesc};
+use crate::scene::diffuse;
+use crate::shape::Sphere;
+
+/// Nearest distance along `ray` by testing every shape the ray kind sees.
+fn brute_force(desc: &SceneDesc, ray: &Ray, kind: RayKind) -> Option<f32> {
+    let mut best: Option<f32> = None;
+    let mut r = *ray;
+    for m in &desc.meshes {
+        if !m.visibility.seen_by(kind) {
+            continue;
+        }
+        for f in m.indices.chunks(3) {
+            let tri = Triangle {
+                p: [0, 1, 2].map(|k| m.positions[f[k] as usize]),
+            };
+            if let Some(h) = tri.intersect(&r) {
+                r.t_max = h.t;
+                best = Some(h.t);
+            }
+        }
+    }
+    for s in &desc.spheres {
+        let sphere = Sphere {
+            center: s.center,
+            radius: s.radius,
+        };
+        if let Some(t) = sphere.intersect(&r) {
+            r.t_max = t;
+            best = Some(t);
+        }
+    }
+    for g in &desc.sdf_grids {
+        let grid = crate::sdf_grid::SdfGrid::new(g).unwrap();
+        for (corner, _) in grid.occupied_voxels(&g.to_world) {
+            if let Some(t) = grid.intersect_voxel(corner, &r) {
+                r.t_max = t;
+                best = Some(t);
+            }
+        }
+    }
+    best
+}
+
+/// A torus's signed distance sampled on an `n`³ grid over the unit cube.
+fn torus_grid(n: u32, to_world: glam::Affine3A) -> crate::desc::SdfGridDesc {
+    let mut values = Vec::new();
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let p = Vec3::new(x as f32, y as f32, z as f32) / (n - 1) as f32 - 0.5;
+                let ring = glam::Vec2::new(glam::Vec2::new(p.x, p.z).length() - 0.3, p.y);
+                values.push(ring.length() - 0.1);
+            }
+        }
+    }
+    crate::desc::SdfGridDesc {
+        values,
+        resolution: [n; 3],
+        to_world,
+        smooth_normals: true,
+        material: 0,
+    }
+}
+
+#[test]
+fn simd_traversal_finds_what_testing_every_shape_finds() {
+    // Two triangle soups (one hidden from camera rays), spheres and SDF grids among them,
+    // so that blocks mix triangles, other shapes and visibilities.
+    let mut rng = pathlab_mc::rng::Pcg32::new(21, 3);
+    let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+    let soup = |point: &mut dyn FnMut() -> Vec3, n: usize, visibility| {
+        let mut positions = Vec::new();
+        for _ in 0..n {
+            let c = point() * 10.0;
+            positions.extend([c, c + point() - 0.5, c + point() - 0.5]);
+        }
+        MeshDesc {
+            name: "soup".into(),
+            indices: (0..positions.len() as u32).collect(),
+            positions,
+            visibility,
+            ..Default::default()
+        }
+    };
+    let hidden = Visibility {
+        camera: false,
+        indirect: true,
+    };
+    let desc = SceneDesc {
+        meshes: vec![
+            soup(&mut point, 300, Visibility::ALL),
+            soup(&mut point, 100, hidden),
+        ],
+        spheres: (0..20)
+            .map(|_| crate::desc::SphereDesc {
+                center: point() * 10.0,
+                radius: 0.2,
+                material: 0,
+                emission: None,
+                ..Default::default()
+            })
+            .collect(),
+        sdf_grids: vec![
+            torus_grid(
+                24,
+                glam::Affine3A::from_scale_rotation_translation(
+                    Vec3::new(3.0, 2.0, 2.5),
+                    glam::Quat::from_rotation_y(0.7),
+                    Vec3::new(4.0, 5.0, 3.0),
+                ),
+            ),
+            torus_grid(16, glam::Affine3A::from_translation(Vec3::splat(6.0))),
+        ],
+        materials: vec![diffuse(Vec3::ONE, false)],
+        resolution: [4, 4],
+        ..Default::default()
+    };
+    let scene = Scene::build(&desc).unwrap();
+    let mut hits = 0;
+    for k in 0..3000 {
+        let o = point() * 14.0 - 2.0;
+        let ray = Ray::new(o, point() * 10.0 - o);
+        let kind = if k % 2 == 0 {
+            RayKind::Camera
+        } else {
+            RayKind::Indirect
+        };
+        let expected = brute_force(&desc, &ray, kind);
+        let mut r = ray;
+        let portable = scene.closest_hit_with(Portable, &mut r, kind);
+        assert_eq!(portable.found().then_some(r.t_max), expected);
+        let found = match kind {
+            RayKind::Camera => scene.intersect_camera(&ray).0,
+            RayKind::Indirect => scene.intersect(&ray).0,
+        };
+        assert_eq!(found.map(|si| si.t), expected);
+        if kind == RayKind::Indirect {
+            assert_eq!(scene.occluded(&ray), expected.is_some());
+            assert_eq!(
+                scene.any_hit_with(Portable, &ray, RayKind::Indirect),
+                expected.is_some()
+            );
+        }
+        hits += usize::from(expected.is_some());
+    }
+    assert!(hits > 300, "{hits} rays hit");
+}
+
+/// A closed box of two-triangle quads with a smaller box inside: few enough triangles to
+/// test them all, with shared edges and corners for rays to hit.
+fn boxes() -> SceneDesc {
+    let cube = |lo: Vec3, hi: Vec3| {
+        let c = |i: u32| {
+            Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        };
+        let quads = [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ];
+        MeshDesc {
+            name: "cube".into(),
+            positions: (0..8).map(c).collect(),
+            indices: quads
+                .iter()
+                .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+                .collect(),
+            ..Default::default()
+        }
+    };
+    SceneDesc {
+        meshes: vec![
+            cube(Vec3::splat(-1.0), Vec3::splat(1.0)),
+            cube(Vec3::new(-0.5, -1.0, -0.3), Vec3::new(0.2, 0.1, 0.4)),
+        ],
+        materials: vec![diffuse(Vec3::ONE, true)],
+        resolution: [4, 4],
+        ..Default::default()
+    }
+}
+
+/// Rays from inside and outside the boxes against `scene` by testing every primitive (at
+/// every SIMD level) and by the BVH: the same distances, and the same primitive but for
+/// ties (another triangle at exactly the same distance). Returns (hits, ties, sphere
+/// hits), each counted once per ray.
+fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usize, usize) {
+    assert!(scene.tests_every_primitive());
+    let mut rng = pathlab_mc::rng::Pcg32::new(seed, 1);
+    let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+    let (mut hits, mut ties, mut spheres) = (0, 0, 0);
+    for k in 0..2000 {
+        let mut rays = RayLanes::default();
+        let mut t_max = F8::splat(f32::INFINITY);
+        let mut each = [Ray::new(Vec3::ZERO, Vec3::X); 8];
+        for (i, ray) in each.iter_mut().enumerate() {
+            // Origins inside and outside the boxes, some rays aimed at corners and edges
+            // (where triangles meet), some with a finite extent.
+            let o = point() * 3.0 - 1.5;
+            let target = match (k + i) % 3 {
+                0 => point() * 2.0 - 1.0,
+                1 => point().round() * 2.0 - 1.0,
+                _ => Vec3::new(point().x * 2.0 - 1.0, 1.0, -1.0),
+            };
+            *ray = Ray::new(o, target - o);
+            if i % 4 == 3 {
+                ray.t_max = 0.5;
+            }
+            rays.o.set(i, ray.o);
+            rays.d.set(i, ray.d);
+            rays.t_min.0[i] = ray.t_min;
+            t_max.0[i] = ray.t_max;
+        }
+        let levels = scene.nearest_of_rays_each_level(&rays, t_max);
+        let dispatched = scene.nearest_of_rays(&rays, t_max);
+        for (i, ray) in each.iter().enumerate() {
+            let mut r = *ray;
+            let bvh = scene.closest_hit(&mut r, RayKind::Indirect);
+            hits += usize::from(bvh.found());
+            let lane = dispatched.lane(i);
+            for (name, nearest) in &levels {
+                assert_eq!(nearest.lane(i), lane, "{name} against the dispatched test");
+            }
+            assert_eq!(lane.map(|(_, t, _, _)| t), bvh.found().then_some(r.t_max));
+            let Some((slot, t, b1, b2)) = lane else {
+                continue;
+            };
+            spheres += usize::from(matches!(scene.prims[slot as usize], Prim::Sphere(_)));
+            if slot == bvh.slot() {
+                assert_eq!((b1, b2), bvh.barycentrics());
+            } else {
+                // Another triangle at exactly the same distance (a shared edge).
+                let Prim::Triangle(i) = scene.prims[slot as usize] else {
+                    panic!("a shape other than the BVH's at lane {i}")
+                };
+                assert_eq!(
+                    scene.triangles[i as usize].intersect(ray).map(|h| h.t),
+                    Some(t)
+                );
+                ties += 1;
+            }
+        }
+    }
+    (hits, ties, spheres)
+}
+
+#[test]
+fn testing_every_triangle_finds_what_the_bvh_finds() {
+    let scene = Scene::build(&boxes()).unwrap();
+    let (hits, ties, _) = every_primitive_agrees_with_the_bvh(&scene, 8);
+    // Rays through shared edges happen to find the same triangle here; `ties` counts
+    // where they would not.
+    assert!(
+        hits > 10_000 && ties < hits / 100,
+        "{hits} hits, {ties} ties"
+    );
+}
+
+#[test]
+fn testing_every_primitive_finds_the_spheres_the_bvh_finds() {
+    // The boxes with two spheres, one inside the large box and one cutting its wall.
+    let mut desc = boxes();
+    desc.spheres = vec![
+        crate::desc::SphereDesc {
+            center: Vec3::new(0.5, 0.4, -0.2),
+            radius: 0.3,
+            ..Default::default()
+        },
+        crate::desc::SphereDesc {
+            center: Vec3::new(-1.0, -0.6, 0.7),
+            radius: 0.45,
+            ..Default::default()
+        },
+    ];
+    let scene = Scene::build(&desc).unwrap();
+    assert!(!scene.only_triangles);
+    let (hits, ties, spheres) = every_primitive_agrees_with_the_bvh(&scene, 9);
+    assert!(
+        hits > 10_000 && ties < hits / 100 && spheres > 500,
+        "{hits} hits, {ties} ties, {spheres} on spheres"
+    );
+}
+
+#[test]
+fn every_simd_level_finds_the_same_triangles_to_the_bit() {
+    // Each box twice (every triangle has a twin at exactly its distance, so which of
+    // the two a ray keeps shows the order of the tests) and one triangle more, so that
+    // the AVX-512 pairs end with an odd triangle.
+    let mut desc = boxes();
+    let twins: Vec<MeshDesc> = desc.meshes.clone();
+    desc.meshes.extend(twins);
+    desc.meshes.push(MeshDesc {
+        name: "odd".into(),
+        positions: vec![
+            Vec3::new(-0.9, -0.9, 0.5),
+            Vec3::new(0.9, -0.9, 0.5),
+            Vec3::new(0.0, 0.9, 0.5),
+        ],
+        indices: vec![0, 1, 2],
+        ..Default::default()
+    });
+    let scene = Scene::build(&desc).unwrap();
+    assert!(scene.tests_every_primitive());
+    assert_eq!(scene.triangles.len() % 2, 1);
+    let mut rng = pathlab_mc::rng::Pcg32::new(11, 3);
+    let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+    let bits = |n: &Nearest| [n.t, n.b1, n.b2, n.slot].map(|f| f.0.map(f32::to_bits));
+    let mut hits = 0;
+    for k in 0..3000 {
+        let mut rays = RayLanes::default();
+        let mut t_max = F8::splat(f32::INFINITY);
+        for i in 0..8 {
+            let o = point() * 3.0 - 1.5;
+            let target = if (k + i) % 2 == 0 {
+                point() * 2.0 - 1.0
+            } else {
+                point().round() * 2.0 - 1.0
+            };
+            rays.o.set(i, o);
+            rays.d.set(i, target - o);
+            rays.t_min.0[i] = if i % 3 == 0 { 1e-3 } else { 0.0 };
+            if i % 4 == 3 {
+                t_max.0[i] = 0.7;
+            }
+        }
+        let all = scene.nearest_of_rays_each_level(&rays, t_max);
+        let (_, portable) = &all[0];
+        for (name, n) in &all[1..] {
+            assert_eq!(bits(n), bits(portable), "{name} against the portable lanes");
+        }
+        hits += (0..8).filter(|&i| portable.lane(i).is_some()).count();
+    }
+    assert!(hits > 15_000, "{hits} hits");
+}
