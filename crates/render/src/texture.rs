@@ -172,6 +172,8 @@ pub enum Tex {
     Mix(Box<[Tex; 3]>),
     /// max(0, 1 - t) per channel.
     Invert(Box<Tex>),
+    /// √max(0, t) per channel.
+    Sqrt(Box<Tex>),
 }
 
 impl Tex {
@@ -214,6 +216,7 @@ impl Tex {
                 Tex::new(&m[2], attribute),
             ])),
             TextureDesc::Invert(t) => Tex::Invert(Box::new(Tex::new(t, attribute))),
+            TextureDesc::Sqrt(t) => Tex::Sqrt(Box::new(Tex::new(t, attribute))),
         }
     }
 
@@ -274,6 +277,7 @@ impl Tex {
                 (1.0 - a) * m[1].eval(p) + a * m[2].eval(p)
             }
             Tex::Invert(t) => (Rgb::ONE - t.eval(p)).max(Rgb::ZERO),
+            Tex::Sqrt(t) => t.eval(p).max(Rgb::ZERO).map(f32::sqrt),
         }
     }
 

@@ -165,6 +165,56 @@ Shape "sphere"
 }
 
 #[test]
+fn conductors_take_textured_roughness_remapped_as_pbrt_remaps_it() {
+    use glam::{Vec2, Vec3};
+    use pathlab_render::desc::MaterialDesc;
+    use pathlab_render::texture::{Tex, TexPoint};
+    let desc = load_text(
+        "textured-roughness",
+        &[(
+            "r.pbrt",
+            r#"WorldBegin
+Texture "ramp" "float" "bilerp"
+Texture "flat" "float" "constant" "float value" 0.09
+MakeNamedMaterial "remapped" "string type" "conductor" "texture roughness" "ramp"
+MakeNamedMaterial "raw" "string type" "conductor" "texture uroughness" "ramp" "float vroughness" 0.2 "bool remaproughness" false
+MakeNamedMaterial "constant" "string type" "conductor" "texture roughness" "flat"
+NamedMaterial "remapped"
+Shape "sphere"
+"#,
+        )],
+    )
+    .unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    // Two-sided conductors: the material inside.
+    let inner = |m: &MaterialDesc| -> MaterialDesc {
+        match m {
+            MaterialDesc::TwoSided { front, .. } => (**front).clone(),
+            other => other.clone(),
+        }
+    };
+    let alphas = |m: &MaterialDesc| match inner(m) {
+        MaterialDesc::RoughConductor {
+            alpha_u, alpha_v, ..
+        } => (Tex::from_desc(&alpha_u), Tex::from_desc(&alpha_v)),
+        other => panic!("not a textured conductor: {other:?}"),
+    };
+    let at = |t: &Tex, v: f32| t.eval(&TexPoint::uv(Vec2::new(0.3, v)));
+    let close = |a: Vec3, b: f32| (a - Vec3::splat(b)).abs().max_element() < 1e-6;
+    // α = √roughness, the roughness being t along the bilerp's v.
+    let (u, v) = alphas(&desc.materials[0]);
+    assert!(close(at(&u, 0.25), 0.5) && close(at(&v, 0.64), 0.8));
+    // Not remapped, and v given as a number.
+    let (u, v) = alphas(&desc.materials[1]);
+    assert!(close(at(&u, 0.25), 0.25) && close(at(&v, 0.7), 0.2));
+    // A constant texture is a number: the plain conductor, α = √0.09.
+    match inner(&desc.materials[2]) {
+        MaterialDesc::Conductor { alpha, .. } => assert!((alpha - 0.3).abs() < 1e-6),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
 fn spectra_read_from_files_as_pbrt_reads_them() {
     use pathlab_render::desc::MaterialDesc;
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-spd");

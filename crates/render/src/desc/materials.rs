@@ -76,6 +76,8 @@ pub enum TextureDesc {
     Mix(Box<[TextureDesc; 3]>),
     /// max(0, 1 - t) per channel (pbrt-v4's image textures' `invert`).
     Invert(Box<TextureDesc>),
+    /// √max(0, t) per channel (pbrt-v4's remapping of a textured roughness to α).
+    Sqrt(Box<TextureDesc>),
 }
 
 impl TextureDesc {
@@ -140,6 +142,14 @@ impl TextureDesc {
         }
     }
 
+    /// √max(0, self) per channel.
+    pub fn sqrt(self) -> Self {
+        match self.as_constant() {
+            Some(c) => TextureDesc::Constant(c.max(Rgb::ZERO).map(f32::sqrt)),
+            None => TextureDesc::Sqrt(Box::new(self)),
+        }
+    }
+
     /// A summary value: the constant, the image's mean, the checkerboard's average colour,
     /// and the combinations' values of those.
     pub fn mean(&self) -> Rgb {
@@ -159,6 +169,7 @@ impl TextureDesc {
                 (1.0 - a) * m[1].mean() + a * m[2].mean()
             }
             TextureDesc::Invert(t) => (Rgb::ONE - t.mean()).max(Rgb::ZERO),
+            TextureDesc::Sqrt(t) => t.mean().max(Rgb::ZERO).map(f32::sqrt),
         }
     }
 }

@@ -298,6 +298,41 @@ impl Builder {
         self.roughness_of(params, "")
     }
 
+    /// `roughness`, `uroughness` and `vroughness` as α along u and v, each a texture, where
+    /// one of them is a texture that varies (`None` where all are numbers): `uroughness` and
+    /// `vroughness` default to `roughness`, and the remapping √ is a texture node.
+    fn textured_roughness(
+        &mut self,
+        params: &ParamList,
+    ) -> Result<Option<[TextureDesc; 2]>, Error> {
+        let mut varies = false;
+        let mut get = |b: &mut Self, name: &str| -> Result<Option<TextureDesc>, Error> {
+            Ok(match b.texture_param(params, name)? {
+                Some(t) => {
+                    varies |= t.as_constant().is_none();
+                    Some(t)
+                }
+                None if params.has(name) => {
+                    Some(TextureDesc::value(b.float(params, name, 0.0)? as f32))
+                }
+                None => None,
+            })
+        };
+        let r = get(self, "roughness")?;
+        let u = get(self, "uroughness")?;
+        let v = get(self, "vroughness")?;
+        if !varies {
+            return Ok(None);
+        }
+        let r = r.unwrap_or(TextureDesc::value(0.0));
+        let remap = self.bool(params, "remaproughness", true)?;
+        let alpha = |t: TextureDesc| if remap { t.sqrt() } else { t };
+        Ok(Some([
+            alpha(u.unwrap_or_else(|| r.clone())),
+            alpha(v.unwrap_or(r)),
+        ]))
+    }
+
     /// `{prefix}roughness`, `{prefix}uroughness` and `{prefix}vroughness` as α along u and v,
     /// remapped as `remaproughness` says (pbrt-v4's default: remapped).
     fn roughness_of(&mut self, params: &ParamList, prefix: &str) -> Result<(f32, f32), Error> {
@@ -432,6 +467,17 @@ impl Builder {
 
     /// pbrt-v4's `conductor`: by its `reflectance`, or `eta` and `k` (copper by default), smooth or rough (anisotropic where `uroughness` and `vroughness` differ).
     fn conductor(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
+        if let Some([alpha_u, alpha_v]) = self.textured_roughness(params)? {
+            let (eta, k) = self.conductor_optics(params, "eta", "k")?;
+            return Ok(two_sided(MaterialDesc::RoughConductor {
+                alpha_u,
+                alpha_v,
+                eta,
+                k,
+                specular: TextureDesc::value(1.0),
+                distribution: NormalDistribution::Ggx,
+            }));
+        }
         let (au, av) = self.roughness(params)?;
         let (eta, k) = self.conductor_optics(params, "eta", "k")?;
         let m = if au == av {
