@@ -1,7 +1,7 @@
 //! Renders that survive and scale: shards of a render, stopping on signals, and
 //! `pathlab merge` (a render's identity and checkpoints are [`pathlab_lab::job`]'s).
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 use pathlab_render::film_file;
 use std::path::PathBuf;
@@ -14,14 +14,7 @@ pub fn shard_range(text: &str, spp: u32) -> Result<[u32; 2]> {
         .split_once('/')
         .and_then(|(a, b)| Some((a.trim().parse::<u64>().ok()?, b.trim().parse::<u64>().ok()?)))
         .with_context(|| format!("--shard {text}: expected I/N, such as 0/4"))?;
-    if n == 0 || i >= n {
-        bail!("--shard {text}: need 0 <= I < N");
-    }
-    if n > spp as u64 {
-        bail!("--shard {text}: {n} shards of {spp} samples per pixel would leave some empty");
-    }
-    let at = |k: u64| (k * spp as u64 / n) as u32;
-    Ok([at(i), at(i + 1)])
+    pathlab_lab::job::shard_samples(i, n, spp).with_context(|| format!("--shard {text}"))
 }
 
 /// The signals that stop a render: SIGINT and SIGTERM set `cancel`; SIGTERM also sets

@@ -4,7 +4,7 @@ use crate::render_cmd::ToneMapName;
 use anyhow::{bail, Result};
 use clap::Args;
 use glam::Vec3;
-use pathlab_lab::images::{relative_mse, rmse, write_difference_heat_map};
+use pathlab_lab::images::{write_difference_heat_map, ImageDifference};
 use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, ToneMap};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -100,15 +100,8 @@ pub fn run_diff(args: &DiffArgs) -> Result<()> {
             args.b.display()
         );
     }
-    let e = rmse(&a, &b);
-    let rel = relative_mse(&a, &b);
-    let mean = |img: &[Vec3]| img.iter().sum::<Vec3>() / img.len().max(1) as f32;
-    let (ma, mb) = (mean(&a), mean(&b));
-    let largest = a
-        .iter()
-        .zip(&b)
-        .map(|(p, q)| (*p - *q).abs().max_element())
-        .fold(0.0f32, f32::max);
+    let d = ImageDifference::of(&a, &b);
+    let (e, rel, largest, ma, mb) = (d.rmse, d.relative_mse, d.max_abs, d.mean_a, d.mean_b);
     if let (Some(out), Some(ext)) = (&args.output, &ext) {
         let diff: Vec<Vec3> = a.iter().zip(&b).map(|(p, q)| *p - *q).collect();
         if ext == "exr" {

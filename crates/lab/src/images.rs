@@ -33,6 +33,39 @@ pub fn relative_mse(a: &[Vec3], b: &[Vec3]) -> f64 {
     sum / n
 }
 
+/// How two images of one size differ: the numbers `pathlab diff` reports.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageDifference {
+    /// [`rmse`] of the first against the second.
+    pub rmse: f64,
+    /// [`relative_mse`] of the first against the second.
+    pub relative_mse: f64,
+    /// The largest |a - b| of any pixel's channel.
+    pub max_abs: f32,
+    /// Mean colour of the first image.
+    pub mean_a: Vec3,
+    /// Mean colour of the second image.
+    pub mean_b: Vec3,
+}
+
+impl ImageDifference {
+    /// The difference of images `a` and `b` (pixels in the same order).
+    pub fn of(a: &[Vec3], b: &[Vec3]) -> ImageDifference {
+        let mean = |img: &[Vec3]| img.iter().sum::<Vec3>() / img.len().max(1) as f32;
+        ImageDifference {
+            rmse: rmse(a, b),
+            relative_mse: relative_mse(a, b),
+            max_abs: a
+                .iter()
+                .zip(b)
+                .map(|(p, q)| (*p - *q).abs().max_element())
+                .fold(0.0f32, f32::max),
+            mean_a: mean(a),
+            mean_b: mean(b),
+        }
+    }
+}
+
 /// The render's RMSE against `reference`.
 pub fn film_rmse(film: &Film, reference: &[Vec3]) -> f64 {
     rmse(&film.mean_image(), reference)
@@ -137,5 +170,11 @@ mod tests {
         assert_eq!(rmse(&a, &a), 0.0);
         assert!((rmse(&a, &b) - 0.5).abs() < 1e-9);
         assert!((relative_mse(&b, &a) - 0.25 / 1.01).abs() < 1e-9);
+        let d = ImageDifference::of(&b, &a);
+        assert_eq!((d.max_abs, d.mean_a, d.mean_b), (0.5, b[0], a[0]));
+        assert_eq!(
+            (d.rmse, d.relative_mse),
+            (rmse(&b, &a), relative_mse(&b, &a))
+        );
     }
 }

@@ -17,6 +17,19 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+/// The samples of shard `i` (from 0) of `n` of a render of `spp` samples per pixel: the
+/// range `[i spp / n, (i + 1) spp / n)`, so that the shards together take every sample once.
+pub fn shard_samples(i: u64, n: u64, spp: u32) -> Result<[u32; 2]> {
+    if n == 0 || i >= n {
+        bail!("need 0 <= I < N");
+    }
+    if n > spp as u64 {
+        bail!("{n} shards of {spp} samples per pixel would leave some empty");
+    }
+    let at = |k: u64| (k * spp as u64 / n) as u32;
+    Ok([at(i), at(i + 1)])
+}
+
 /// A streaming FNV-1a hash of formatted text.
 struct Hasher(u64);
 
@@ -241,5 +254,24 @@ impl RenderJob<'_> {
             stats,
             progressive,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shard_samples;
+
+    #[test]
+    fn shards_take_every_sample_once() {
+        for (n, spp) in [(1, 1), (3, 7), (4, 64), (7, 7), (5, 1000)] {
+            let ranges: Vec<[u32; 2]> = (0..n).map(|i| shard_samples(i, n, spp).unwrap()).collect();
+            assert_eq!(ranges[0][0], 0);
+            assert_eq!(ranges[n as usize - 1][1], spp);
+            assert!(ranges.windows(2).all(|w| w[0][1] == w[1][0]));
+            assert!(ranges.iter().all(|r| r[1] > r[0]), "{ranges:?}");
+        }
+        assert!(shard_samples(4, 4, 64).is_err());
+        assert!(shard_samples(0, 0, 64).is_err());
+        assert!(shard_samples(0, 65, 64).is_err());
     }
 }
