@@ -18,21 +18,53 @@ WorldBegin
 LightSource "infinite" "rgb L" [ 1 1 1 ]
 "#;
 
+/// The world block `world` under a small camera, loaded from a folder of its own (`tag`) that
+/// also holds `two.exr`, a 2 x 1 image: 0.2 on its left half, 0.6 on its right; no warnings.
+fn load_with_two_texels(tag: &str, world: &str) -> pathlab_render::desc::SceneDesc {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(tag);
+    std::fs::create_dir_all(&dir).unwrap();
+    let texels = [glam::Vec3::splat(0.2), glam::Vec3::splat(0.6)];
+    pathlab_render::image_io::write_exr(&dir.join("two.exr"), 2, 1, &texels, &[]).unwrap();
+    let scene = format!(
+        "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\n\
+         Film \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 4\nWorldBegin\n{world}"
+    );
+    std::fs::write(dir.join("scene.pbrt"), scene).unwrap();
+    let desc = pathlab_scene::load(dir.join("scene.pbrt").to_str().unwrap()).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    desc
+}
+
+/// The reflectance texture of a textured diffuse material.
+fn reflectance_texture(m: &pathlab_render::desc::MaterialDesc) -> pathlab_render::texture::Tex {
+    match m {
+        pathlab_render::desc::MaterialDesc::TexturedDiffuse { texture, .. } => {
+            pathlab_render::texture::Tex::from_desc(texture)
+        }
+        other => panic!("not a textured diffuse material: {other:?}"),
+    }
+}
+
+/// Texture `t` at (u, v).
+fn tex_at(t: &pathlab_render::texture::Tex, u: f32, v: f32) -> glam::Vec3 {
+    t.eval(&pathlab_render::texture::TexPoint::uv(glam::Vec2::new(
+        u, v,
+    )))
+}
+
+/// Whether two colours agree to 1e-5.
+fn close(a: glam::Vec3, b: glam::Vec3) -> bool {
+    (a - b).abs().max_element() < 1e-5
+}
+
 #[test]
 fn textures_scale_mix_invert_and_checker_as_pbrt_defines_them() {
-    use glam::{Vec2, Vec3};
+    use glam::Vec3;
     use pathlab_render::desc::{MaterialDesc, TextureDesc};
-    use pathlab_render::texture::{Tex, TexPoint};
-    // A 2 x 1 image: 0.2 on its left half, 0.6 on its right.
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-textures");
-    std::fs::create_dir_all(&dir).unwrap();
-    let texels = [Vec3::splat(0.2), Vec3::splat(0.6)];
-    pathlab_render::image_io::write_exr(&dir.join("two.exr"), 2, 1, &texels, &[]).unwrap();
-    let scene = r#"LookAt 0 0 5  0 0 0  0 1 0
-Camera "perspective" "float fov" 30
-Film "rgb" "integer xresolution" 4 "integer yresolution" 4
-WorldBegin
-Texture "img" "spectrum" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear"
+    use pathlab_render::texture::Tex;
+    let desc = load_with_two_texels(
+        "pbrt-textures",
+        r#"Texture "img" "spectrum" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear"
 Texture "amount" "float" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear"
 Texture "doubled" "spectrum" "scale" "texture tex" "img" "float scale" 2
 Texture "inverted" "spectrum" "imagemap" "string filename" "two.exr" "string filter" "point" "string encoding" "linear" "float scale" 2 "bool invert" true
@@ -47,16 +79,9 @@ MakeNamedMaterial "m4" "string type" "diffuse" "texture reflectance" "checked"
 MakeNamedMaterial "m5" "string type" "diffusetransmission" "rgb reflectance" [ 0.8 0.6 0.4 ] "texture transmittance" "img" "float scale" 0.5
 NamedMaterial "m5"
 Shape "sphere"
-"#;
-    std::fs::write(dir.join("textures.pbrt"), scene).unwrap();
-    let desc = pathlab_scene::load(dir.join("textures.pbrt").to_str().unwrap()).unwrap();
-    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
-    let texture = |m: &MaterialDesc| match m {
-        MaterialDesc::TexturedDiffuse { texture, .. } => Tex::from_desc(texture),
-        other => panic!("not a textured diffuse material: {other:?}"),
-    };
-    let at = |t: &Tex, u: f32, v: f32| t.eval(&TexPoint::uv(Vec2::new(u, v)));
-    let close = |a: Vec3, b: Vec3| (a - b).abs().max_element() < 1e-5;
+"#,
+    );
+    let (texture, at) = (reflectance_texture, tex_at);
     let m = &desc.materials;
     // scale: the image times 2.
     let t = texture(&m[0]);
@@ -101,19 +126,10 @@ Shape "sphere"
 
 #[test]
 fn bilerp_textures_and_black_wrapping_as_pbrt_defines_them() {
-    use glam::{Vec2, Vec3};
-    use pathlab_render::desc::MaterialDesc;
-    use pathlab_render::texture::{Tex, TexPoint};
-    // A 2 x 1 image: 0.2 on its left half, 0.6 on its right.
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pbrt-bilerp");
-    std::fs::create_dir_all(&dir).unwrap();
-    let texels = [Vec3::splat(0.2), Vec3::splat(0.6)];
-    pathlab_render::image_io::write_exr(&dir.join("two.exr"), 2, 1, &texels, &[]).unwrap();
-    let scene = r#"LookAt 0 0 5  0 0 0  0 1 0
-Camera "perspective" "float fov" 30
-Film "rgb" "integer xresolution" 4 "integer yresolution" 4
-WorldBegin
-Texture "corners" "spectrum" "bilerp" "rgb v00" [ 1 0 0 ] "rgb v10" [ 0 1 0 ] "rgb v01" [ 0 0 1 ] "rgb v11" [ 1 1 1 ]
+    use glam::Vec3;
+    let desc = load_with_two_texels(
+        "pbrt-bilerp",
+        r#"Texture "corners" "spectrum" "bilerp" "rgb v00" [ 1 0 0 ] "rgb v10" [ 0 1 0 ] "rgb v01" [ 0 0 1 ] "rgb v11" [ 1 1 1 ]
 Texture "ramp" "float" "bilerp"
 Texture "wide" "float" "bilerp" "float v10" 1 "float v11" 0 "float v01" 0 "float uscale" 2
 Texture "black" "spectrum" "imagemap" "string filename" "two.exr" "string encoding" "linear" "string wrap" "black"
@@ -127,16 +143,9 @@ MakeNamedMaterial "m3" "string type" "diffuse" "texture reflectance" "by-ramp"
 MakeNamedMaterial "m4" "string type" "diffuse" "texture reflectance" "by-wide"
 NamedMaterial "m0"
 Shape "sphere"
-"#;
-    std::fs::write(dir.join("bilerp.pbrt"), scene).unwrap();
-    let desc = pathlab_scene::load(dir.join("bilerp.pbrt").to_str().unwrap()).unwrap();
-    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
-    let at = |t: &Tex, u: f32, v: f32| t.eval(&TexPoint::uv(Vec2::new(u, v)));
-    let close = |a: Vec3, b: Vec3| (a - b).abs().max_element() < 1e-5;
-    let texture = |m: &MaterialDesc| match m {
-        MaterialDesc::TexturedDiffuse { texture, .. } => Tex::from_desc(texture),
-        other => panic!("not a textured diffuse material: {other:?}"),
-    };
+"#,
+    );
+    let (texture, at) = (reflectance_texture, tex_at);
     let m = &desc.materials;
     // The corners at the corners, their mean at the centre, linear along the edges.
     let t = texture(&m[0]);
