@@ -5,8 +5,9 @@
 mod common;
 
 use common::*;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::desc::{MeshDesc, SceneDesc};
 use pathlab_render::film::Film;
 use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
@@ -101,16 +102,39 @@ fn bad_scenes_are_errors() {
     assert!(Scene::build(&desc).is_err());
 }
 
+/// `desc` with a hundred small triangles far to the side: too many primitives to test every
+/// one, so that rays walk the BVH.
+fn crowded(mut desc: SceneDesc) -> SceneDesc {
+    let positions: Vec<Vec3> = (0..100)
+        .flat_map(|i| {
+            let o = Vec3::new(40.0 + i as f32, 0.0, 0.0);
+            [o, o + Vec3::X * 0.5, o + Vec3::Y * 0.5]
+        })
+        .collect();
+    desc.meshes.push(MeshDesc {
+        name: "crowd".into(),
+        indices: (0..positions.len() as u32).collect(),
+        positions,
+        ..Default::default()
+    });
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
     // Lambertian surfaces lit by emitting triangles in SIMD lanes and everything else with
     // the scalar code: every sample's radiance must be the scalar `li`'s to the bit, and the
-    // rays and nodes counted the same. In a scene of a few triangles the lanes' rays are
-    // tested against every triangle at once instead of walking the BVH (the same distances;
-    // of triangles at exactly the same distance, possibly another, which these rays do not
-    // meet), and no nodes are counted.
-    for (desc, bvh) in [(mixed_scene(), true), (big_light(), false)] {
+    // rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
+    // rays are tested against every primitive at once instead of walking the BVH (the same
+    // distances; of primitives at exactly the same distance, possibly another, which these
+    // rays do not meet), and no nodes are counted; with a hundred triangles more, the lanes
+    // walk the BVH.
+    for (desc, bvh) in [
+        (mixed_scene(), false),
+        (crowded(mixed_scene()), true),
+        (big_light(), false),
+    ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);
     }
