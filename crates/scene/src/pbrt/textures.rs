@@ -23,12 +23,7 @@ impl Builder {
             )));
         }
         let tex = match class {
-            "constant" => TextureDesc::Constant(if ty == "float" {
-                Rgb::splat(self.float(&params, "value", 1.0)? as f32)
-            } else {
-                self.spectrum(&params, "value", Use::Albedo)?
-                    .unwrap_or(Rgb::ONE)
-            }),
+            "constant" => TextureDesc::Constant(self.value_of_type(&params, "value", ty, 1.0)?),
             "imagemap" => self.image_texture(&name, ty, &params)?,
             "scale" => {
                 let tex = self.texture_or_value(&params, "tex", ty, 1.0)?;
@@ -45,14 +40,8 @@ impl Builder {
             "checkerboard" => self.checkerboard(&name, ty, &params)?,
             "bilerp" => {
                 // pbrt-v4's defaults: 0 along t = 0 and 1 along t = 1.
-                let mut corner = |key: &str, default: f32| -> Result<Rgb, Error> {
-                    Ok(if ty == "float" {
-                        Rgb::splat(self.float(&params, key, default as f64)? as f32)
-                    } else {
-                        self.spectrum(&params, key, Use::Albedo)?
-                            .unwrap_or(Rgb::splat(default))
-                    })
-                };
+                let mut corner =
+                    |key: &str, default: f32| self.value_of_type(&params, key, ty, default);
                 let corners = [
                     corner("v00", 0.0)?,
                     corner("v10", 0.0)?,
@@ -149,12 +138,26 @@ impl Builder {
         {
             return self.color_texture(params, name, Rgb::splat(default));
         }
-        Ok(TextureDesc::Constant(if ty == "float" {
+        Ok(TextureDesc::Constant(
+            self.value_of_type(params, name, ty, default)?,
+        ))
+    }
+
+    /// Parameter `name` as a value of the texture's type: a number (grey) for a `float`
+    /// texture, a spectrum otherwise; `default` where absent.
+    fn value_of_type(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        ty: &str,
+        default: f32,
+    ) -> Result<Rgb, Error> {
+        Ok(if ty == "float" {
             Rgb::splat(self.float(params, name, default as f64)? as f32)
         } else {
             self.spectrum(params, name, Use::Albedo)?
                 .unwrap_or(Rgb::splat(default))
-        }))
+        })
     }
 
     /// pbrt-v4's 2D `checkerboard`: `tex1` (default 1) where ⌊s⌋ + ⌊t⌋ is even, `tex2` (default
