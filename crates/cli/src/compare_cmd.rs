@@ -3,9 +3,9 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use pathlab_lab::compare::{compare, strategy, write_side_by_side};
+use pathlab_lab::compare::{compare, rows_json, rows_table, strategy, write_side_by_side};
+use pathlab_lab::images::{depth_text, read_reference};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::image_io::read_exr_rgb;
 use pathlab_render::render::RenderSettings;
 use pathlab_render::scene::Scene;
 use serde_json::json;
@@ -72,21 +72,16 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         })
         .collect::<Result<Vec<_>>>()?;
     let mut desc = pathlab_scene::load(&args.scene)?;
-    crate::render_cmd::apply_resolution(&mut desc, args.resolution.as_deref())?;
+    pathlab_lab::render::apply_resolution(
+        &mut desc,
+        args.resolution.as_deref().map(|r| [r[0], r[1]]),
+    )?;
     let [w, h] = desc.resolution;
-    let reference = match &args.reference {
-        Some(p) => {
-            let (rw, rh, px) = read_exr_rgb(p)?;
-            if (rw, rh) != (w, h) {
-                bail!(
-                    "{}: the reference is {rw}x{rh}, the render {w}x{h}",
-                    p.display()
-                );
-            }
-            Some(px)
-        }
-        None => None,
-    };
+    let reference = args
+        .reference
+        .as_deref()
+        .map(|p| read_reference(p, desc.resolution))
+        .transpose()?;
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let settings = RenderSettings::new(args.spp, args.seed, args.sampler);
     let rows = compare(&scene, &strategies, &settings, reference.as_deref());
@@ -97,11 +92,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     ) {
         // Direct-lighting strategies stop at the first bounce; path strategies at -m.
         let path = args.strategies.iter().any(|s| s.trim().starts_with("path"));
-        let depth = match (path, args.max_depth) {
-            (false, _) => "1".to_string(),
-            (true, u32::MAX) => "inf".to_string(),
-            (true, d) => d.to_string(),
-        };
+        let depth = depth_text(if path { args.max_depth } else { 1 });
         if let Some(w) = pathlab_lab::images::reference_mismatch(&best.film, r, p, &depth) {
             eprintln!("warning: {w}");
         }
@@ -113,13 +104,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             "spp": args.spp,
             "sampler": args.sampler.name(),
             "image": args.output,
-            "strategies": rows.iter().map(|r| json!({
-                "name": r.name,
-                "seconds": r.seconds,
-                "mean_pixel_variance": r.variance,
-                "rmse": r.rmse,
-                "efficiency": r.efficiency(args.spp),
-            })).collect::<Vec<_>>(),
+            "strategies": rows_json(&rows, args.spp),
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
@@ -130,23 +115,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         args.spp,
         args.sampler.name()
     );
-    println!(
-        "  {:<12} {:>9} {:>16} {:>12} {:>14}",
-        "strategy", "seconds", "mean variance", "RMSE", "efficiency"
-    );
-    for r in &rows {
-        let rmse = r.rmse.map_or("-".to_string(), |e| format!("{e:.5}"));
-        let efficiency = r
-            .efficiency(args.spp)
-            .map_or("-".to_string(), |e| format!("{e:.4e}"));
-        println!(
-            "  {:<12} {:>9.3} {:>16.6} {:>12} {:>14}",
-            r.name, r.seconds, r.variance, rmse, efficiency
-        );
-    }
-    println!(
-        "  (variance: per sample, averaged over pixels; efficiency = 1 / (variance x seconds))"
-    );
+    println!("{}", rows_table(&rows, args.spp));
     println!("  side-by-side image written to {}", args.output.display());
     Ok(())
 }

@@ -4,8 +4,8 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use pathlab_lab::images::{depth_text, read_reference};
 use pathlab_lab::plot;
-use pathlab_render::image_io::read_exr_rgb;
 use pathlab_render::integrator::{IntegratorKind, PathIntegrator};
 use pathlab_render::scene::Scene;
 use serde_json::json;
@@ -52,16 +52,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
     let format = plot::Format::from_path(&args.output)?;
     let mut desc = pathlab_scene::load(&args.scene)?;
-    crate::render_cmd::apply_resolution(&mut desc, args.resolution.as_deref())?;
-    let (rw, rh, reference) = read_exr_rgb(&args.reference)?;
-    if [rw, rh] != desc.resolution {
-        bail!(
-            "{}: the reference is {rw}x{rh} but the scene renders at {}x{}",
-            args.reference.display(),
-            desc.resolution[0],
-            desc.resolution[1]
-        );
-    }
+    pathlab_lab::render::apply_resolution(
+        &mut desc,
+        args.resolution.as_deref().map(|r| [r[0], r[1]]),
+    )?;
+    let reference = read_reference(&args.reference, desc.resolution)?;
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let integrator = IntegratorKind::Path(PathIntegrator {
         max_depth: args.max_depth,
@@ -69,11 +64,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     });
     let study =
         pathlab_lab::converge::converge(&scene, &integrator, &reference, args.max_spp, args.seed);
-    let depth = if args.max_depth == u32::MAX {
-        "inf".to_string()
-    } else {
-        args.max_depth.to_string()
-    };
+    let depth = depth_text(args.max_depth);
     if let Some(w) = pathlab_lab::images::reference_mismatch(
         &study.top_independent,
         &reference,
@@ -82,7 +73,6 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     ) {
         eprintln!("warning: {w}");
     }
-    let curves = study.curves;
     let name = |p: &std::path::Path| {
         p.file_name().map_or_else(
             || p.display().to_string(),
@@ -95,31 +85,19 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         args.max_depth,
         name(&args.reference)
     );
-    plot::rmse_curves(&args.output, format, &title, &curves)?;
+    plot::rmse_curves(&args.output, format, &title, &study.curves)?;
     if args.json {
         let out = json!({
             "scene": args.scene,
             "reference": args.reference,
             "plot": args.output,
-            "curves": curves.iter().map(|c| json!({
-                "name": c.name,
-                "fitted_slope": c.slope,
-                "spp": c.points.iter().map(|p| p.0).collect::<Vec<_>>(),
-                "seconds": c.points.iter().map(|p| p.1).collect::<Vec<_>>(),
-                "rmse": c.points.iter().map(|p| p.2).collect::<Vec<_>>(),
-            })).collect::<Vec<_>>(),
+            "curves": study.curves_json(),
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
     println!("{} against {}", args.scene, args.reference.display());
-    for c in &curves {
-        let last = c.points.last().map_or(f64::NAN, |p| p.2);
-        println!(
-            "  {:<13} RMSE ∝ N^{:.2}; at the most samples {last:.5}",
-            c.name, c.slope
-        );
-    }
+    println!("{}", study.curves_text());
     println!("  plot written to {}", args.output.display());
     Ok(())
 }

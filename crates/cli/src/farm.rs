@@ -1,21 +1,12 @@
 //! Renders that survive and scale: shards of a render, stopping on signals, and
 //! `pathlab merge` (a render's identity and checkpoints are [`pathlab_lab::job`]'s).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use pathlab_render::film_file;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
-
-/// `--shard I/N` as the sample range of shard I (from 0) of N over `spp` samples.
-pub fn shard_range(text: &str, spp: u32) -> Result<[u32; 2]> {
-    let (i, n) = text
-        .split_once('/')
-        .and_then(|(a, b)| Some((a.trim().parse::<u64>().ok()?, b.trim().parse::<u64>().ok()?)))
-        .with_context(|| format!("--shard {text}: expected I/N, such as 0/4"))?;
-    pathlab_lab::job::shard_samples(i, n, spp).with_context(|| format!("--shard {text}"))
-}
 
 /// The signals that stop a render: SIGINT and SIGTERM set `cancel`; SIGTERM also sets
 /// `terminated` (exit status 143 instead of 130).

@@ -3,8 +3,7 @@
 use crate::render_cmd::ToneMapName;
 use anyhow::{bail, Result};
 use clap::Args;
-use glam::Vec3;
-use pathlab_lab::images::{write_difference_heat_map, ImageDifference};
+use pathlab_lab::images::{diff_files, FileDifference};
 use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, ToneMap};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -86,32 +85,19 @@ pub fn run_convert(args: &ConvertArgs) -> Result<()> {
 
 /// Runs `pathlab diff`.
 pub fn run_diff(args: &DiffArgs) -> Result<()> {
-    let ext = args
-        .output
-        .as_deref()
-        .map(|o| check_extension(o, &["png", "exr"]))
-        .transpose()?;
-    let (wa, ha, a) = read_rgb(&args.a, true)?;
-    let (wb, hb, b) = read_rgb(&args.b, true)?;
-    if (wa, ha) != (wb, hb) {
-        bail!(
-            "{} is {wa}x{ha} but {} is {wb}x{hb}: images of one size are compared",
-            args.a.display(),
-            args.b.display()
-        );
+    if let Some(o) = &args.output {
+        check_extension(o, &["png", "exr"])?;
     }
-    let d = ImageDifference::of(&a, &b);
+    let FileDifference {
+        resolution: [wa, ha],
+        difference: d,
+        heat_top,
+    } = diff_files(&args.a, &args.b, args.output.as_deref())?;
     let (e, rel, largest, ma, mb) = (d.rmse, d.relative_mse, d.max_abs, d.mean_a, d.mean_b);
-    if let (Some(out), Some(ext)) = (&args.output, &ext) {
-        let diff: Vec<Vec3> = a.iter().zip(&b).map(|(p, q)| *p - *q).collect();
-        if ext == "exr" {
-            write_exr(out, wa, ha, &diff, &[])?;
-        } else {
-            let top = write_difference_heat_map(out, wa, ha, &diff)?;
-            eprintln!(
-                "difference image: black 0 to white {top:.4} (the 99th percentile of |A - B|, luminance)"
-            );
-        }
+    if let Some(top) = heat_top {
+        eprintln!(
+            "difference image: black 0 to white {top:.4} (the 99th percentile of |A - B|, luminance)"
+        );
     }
     if args.json {
         let out = json!({

@@ -4,11 +4,10 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use pathlab_lab::expr::parse_constant;
-use pathlab_lab::integrate::{convergence, Integral, IntegralRun};
+use pathlab_lab::integrate::{convergence, Integral, IntegrateReport};
 use pathlab_lab::plot;
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_mc::stats::z_test;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::path::PathBuf;
 
 /// Raw command-line arguments of `pathlab integrate`.
@@ -77,14 +76,6 @@ fn parse_domain(text: &str) -> Result<(f64, f64)> {
     Ok((a, b))
 }
 
-fn percent(v: f64) -> String {
-    if v >= 1e-3 || v == 0.0 {
-        format!("{:.3}%", 100.0 * v)
-    } else {
-        format!("{:.2e}%", 100.0 * v)
-    }
-}
-
 /// Runs `pathlab integrate`.
 pub fn run(args: &IntegrateArgs) -> Result<()> {
     if args.samples == 0 || args.samples > u32::MAX as u64 {
@@ -146,98 +137,29 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
         )?),
         None => None,
     };
-    if args.json {
-        print_json(args, &problem, &run, exact, convergence)
-    } else {
-        print_text(args, &problem, &run, exact);
-        Ok(())
-    }
-}
-
-/// The `--json` report.
-fn print_json(
-    args: &IntegrateArgs,
-    problem: &Integral,
-    run: &IntegralRun,
-    exact: Option<f64>,
-    convergence: Option<Value>,
-) -> Result<()> {
-    let est = &run.estimate;
-    let mut out = json!({
-        "expression": args.expression,
-        "domain": problem.domains.iter().map(|d| [d.0, d.1]).collect::<Vec<_>>(),
-        "importance": args.importance,
-        "sampler": args.sampler.name(),
-        "samples": est.n,
-        "seed": args.seed,
-        "estimate": est.mean,
-        "std_error": est.std_error,
-        "ci95": [est.ci95.0, est.ci95.1],
-        "relative_error": est.relative_error(),
-        "variance_per_sample": est.variance,
-        "seconds": run.seconds,
-        "samples_per_second": est.n as f64 / run.seconds.max(1e-9),
-        "largest_sample_share": run.largest_share,
-        "heavy_tailed": run.heavy_tailed,
-        "warnings": run.warnings,
-    });
-    if let Some(x) = exact {
-        let z = z_test(est.mean, est.std_error, x);
-        out["exact"] = json!(x);
-        out["error"] = json!(est.mean - x);
-        out["z"] = json!(z.z);
-    }
-    if let Some(c) = convergence {
-        out["convergence"] = c;
-    }
-    println!("{}", serde_json::to_string_pretty(&out)?);
-    Ok(())
-}
-
-/// The text report.
-fn print_text(args: &IntegrateArgs, problem: &Integral, run: &IntegralRun, exact: Option<f64>) {
-    let est = &run.estimate;
-    println!(
-        "integral of {} over {}",
-        args.expression,
-        problem.domain_text()
-    );
-    let how = match &args.importance {
-        Some(g) => format!("importance sampling from a density proportional to {g}"),
-        None => "uniform sampling".to_string(),
+    let report = IntegrateReport {
+        expression: &args.expression,
+        importance: args.importance.as_deref(),
+        problem: &problem,
+        run: &run,
+        sampler: args.sampler,
+        reps: args.reps,
+        seed: args.seed,
+        exact,
     };
-    println!(
-        "  {how}, {} sampler, {} samples, seed {}",
-        args.sampler.name(),
-        est.n,
-        args.seed
-    );
-    println!(
-        "  estimate        {:.8} ± {:.2e} (standard error)",
-        est.mean, est.std_error
-    );
-    println!("  95% CI          [{:.8}, {:.8}]", est.ci95.0, est.ci95.1);
-    println!("  relative error  {}", percent(est.relative_error()));
-    if args.sampler != SamplerKind::Independent && args.reps > 1 {
-        println!(
-            "  (error from {} independent randomisations of {} samples each)",
-            args.reps,
-            est.n / args.reps as u64
-        );
+    if args.json {
+        let mut out = report.json();
+        if let Some(c) = convergence {
+            out["convergence"] = c;
+        }
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        println!("{}", report.text());
+        if let Some(path) = &args.convergence {
+            println!("  convergence plot written to {}", path.display());
+        }
     }
-    if let Some(x) = exact {
-        let z = z_test(est.mean, est.std_error, x);
-        println!(
-            "  exact           {x:.8}: error {:+.2e}, {:.2} standard errors",
-            est.mean - x,
-            z.z
-        );
-    }
-    let rate = est.n as f64 / run.seconds.max(1e-9);
-    println!("  {:.3} s, {:.3e} samples/s", run.seconds, rate);
-    if let Some(path) = &args.convergence {
-        println!("  convergence plot written to {}", path.display());
-    }
+    Ok(())
 }
 
 /// The convergence study of the three samplers, plotted to `path`, as JSON.
@@ -253,17 +175,5 @@ fn convergence_report(
     let study = convergence(problem, n, reps, seed, exact);
     let title = format!("∫ {} over {}", problem.f.text(), problem.domain_text());
     plot::convergence(path, format, &title, &study.series, exact, exact.is_some())?;
-    Ok(json!({
-        "reference": study.reference,
-        "reference_is_exact": exact.is_some(),
-        "replications": reps,
-        "series": study.series.iter().map(|s| json!({
-            "sampler": s.name,
-            "fitted_slope": s.slope,
-            "n": s.points.iter().map(|p| p.n).collect::<Vec<_>>(),
-            "estimate": s.points.iter().map(|p| p.estimate).collect::<Vec<_>>(),
-            "ci95_half_width": s.points.iter().map(|p| p.ci_half).collect::<Vec<_>>(),
-            "rmse": s.points.iter().map(|p| p.rmse).collect::<Vec<_>>(),
-        })).collect::<Vec<_>>(),
-    }))
+    Ok(study.json(reps, exact.is_some()))
 }

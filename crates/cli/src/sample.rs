@@ -4,7 +4,7 @@
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use pathlab_lab::plot;
-use pathlab_lab::sample::{verdict, Distribution};
+use pathlab_lab::sample::Distribution;
 use pathlab_mc::sampler::SamplerKind;
 use serde_json::json;
 use std::path::PathBuf;
@@ -136,7 +136,6 @@ pub fn run(args: &SampleArgs) -> Result<()> {
         .transpose()?;
     let dist = distribution(args)?;
     let report = pathlab_lab::sample::run(&dist, args.sampler, n, args.seed, format.is_some());
-    let (rows, fit, seconds) = (&report.components, &report.chi_square, report.seconds);
     if let (Some(path), Some(format), Some(p)) = (&args.plot, format, &report.plot) {
         let title = format!(
             "{} ({} samples, {})",
@@ -148,73 +147,13 @@ pub fn run(args: &SampleArgs) -> Result<()> {
     }
 
     if args.json {
-        let out = json!({
-            "distribution": format!("{:?}", args.distribution).to_lowercase(),
-            "description": report.description,
-            "samples": n,
-            "seed": args.seed,
-            "sampler": args.sampler.name(),
-            "components": rows.iter().map(|(m, s, z)| json!({
-                "name": m.name,
-                "mean": s.mean(),
-                "std_error": s.std_error(),
-                "exact_mean": m.mean,
-                "z": if n >= 2 { json!(z.z) } else { json!(null) },
-                "variance": s.variance(),
-                "exact_variance": m.variance,
-            })).collect::<Vec<_>>(),
-            "chi_square": {
-                "statistic": fit.statistic,
-                "dof": fit.dof,
-                "p_value": fit.p_value,
-            },
-            "verdict": verdict(n, fit),
-            "seconds": seconds,
-            "samples_per_second": n as f64 / seconds.max(1e-9),
-            "plot": args.plot,
-        });
+        let mut out = report.json();
+        out["distribution"] = json!(format!("{:?}", args.distribution).to_lowercase());
+        out["plot"] = json!(args.plot);
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
-
-    println!("{}", report.description);
-    println!(
-        "  {n} samples, {} sampler, seed {}",
-        args.sampler.name(),
-        args.seed
-    );
-    println!(
-        "  {:<6} {:>12} {:>12} {:>8} {:>12} {:>12}",
-        "", "mean", "exact mean", "z", "variance", "exact var"
-    );
-    for (m, s, z) in rows {
-        let z = if n >= 2 {
-            format!("{:.2}", z.z)
-        } else {
-            "-".to_string()
-        };
-        println!(
-            "  {:<6} {:>12.6} {:>12.6} {:>8} {:>12.6} {:>12.6}",
-            m.name,
-            s.mean(),
-            m.mean,
-            z,
-            s.variance(),
-            m.variance
-        );
-    }
-    println!(
-        "  chi-square fit against the pdf: statistic {:.1}, {} dof, p = {:.3}",
-        fit.statistic, fit.dof, fit.p_value
-    );
-    println!("  {}", verdict(n, fit));
-    if args.sampler != SamplerKind::Independent {
-        println!(
-            "  (z and p assume independent samples; a {} sampler is more even than that)",
-            args.sampler.name()
-        );
-    }
-    println!("  {:.3e} samples/s", n as f64 / seconds.max(1e-9));
+    println!("{}", report.text());
     if let Some(path) = &args.plot {
         println!("  plot written to {}", path.display());
     }

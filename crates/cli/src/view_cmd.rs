@@ -36,7 +36,10 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     for w in &desc.warnings {
         eprintln!("warning: {w}");
     }
-    crate::render_cmd::apply_resolution(&mut desc, args.resolution.as_deref())?;
+    pathlab_lab::render::apply_resolution(
+        &mut desc,
+        args.resolution.as_deref().map(|r| [r[0], r[1]]),
+    )?;
     let signals = crate::farm::Signals::install();
     let options = ViewOptions {
         host: args.host.clone(),

@@ -13,6 +13,7 @@ use pathlab_render::integrator::{
 use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
 use plotters::prelude::*;
+use serde_json::{json, Value};
 use std::path::Path;
 
 /// The strategy names [`strategy`] knows.
@@ -130,4 +131,41 @@ pub fn write_side_by_side(rows: &[Row], path: &Path) -> Result<()> {
     }
     write_rgb8(path, tw, th, &buf)?;
     Ok(())
+}
+
+/// The rows as the JSON list of `pathlab compare --json`.
+pub fn rows_json(rows: &[Row], spp: u32) -> Value {
+    json!(rows
+        .iter()
+        .map(|r| json!({
+            "name": r.name,
+            "seconds": r.seconds,
+            "mean_pixel_variance": r.variance,
+            "rmse": r.rmse,
+            "efficiency": r.efficiency(spp),
+        }))
+        .collect::<Vec<_>>())
+}
+
+/// The rows as a table of text, with a line saying what the columns mean.
+pub fn rows_table(rows: &[Row], spp: u32) -> String {
+    let mut lines = vec![format!(
+        "  {:<12} {:>9} {:>16} {:>12} {:>14}",
+        "strategy", "seconds", "mean variance", "RMSE", "efficiency"
+    )];
+    for r in rows {
+        let rmse = r.rmse.map_or("-".to_string(), |e| format!("{e:.5}"));
+        let efficiency = r
+            .efficiency(spp)
+            .map_or("-".to_string(), |e| format!("{e:.4e}"));
+        lines.push(format!(
+            "  {:<12} {:>9.3} {:>16.6} {:>12} {:>14}",
+            r.name, r.seconds, r.variance, rmse, efficiency
+        ));
+    }
+    lines.push(
+        "  (variance: per sample, averaged over pixels; efficiency = 1 / (variance x seconds))"
+            .to_string(),
+    );
+    lines.join("\n")
 }

@@ -13,6 +13,7 @@ use pathlab_render::integrator::IntegratorKind;
 use pathlab_render::progressive::{render_progressive, StopRule};
 use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
+use serde_json::{json, Value};
 
 /// What a convergence study found.
 pub struct Study {
@@ -20,6 +21,39 @@ pub struct Study {
     pub curves: Vec<RmseCurve>,
     /// The independent render at the most samples (to check that the reference belongs to it).
     pub top_independent: Film,
+}
+
+impl Study {
+    /// The curves as the JSON list of `pathlab converge --json`.
+    pub fn curves_json(&self) -> Value {
+        json!(self
+            .curves
+            .iter()
+            .map(|c| json!({
+                "name": c.name,
+                "fitted_slope": c.slope,
+                "spp": c.points.iter().map(|p| p.0).collect::<Vec<_>>(),
+                "seconds": c.points.iter().map(|p| p.1).collect::<Vec<_>>(),
+                "rmse": c.points.iter().map(|p| p.2).collect::<Vec<_>>(),
+            }))
+            .collect::<Vec<_>>())
+    }
+
+    /// A line per curve: its fitted order and its error at the most samples.
+    pub fn curves_text(&self) -> String {
+        let lines: Vec<String> = self
+            .curves
+            .iter()
+            .map(|c| {
+                let last = c.points.last().map_or(f64::NAN, |p| p.2);
+                format!(
+                    "  {:<13} RMSE ∝ N^{:.2}; at the most samples {last:.5}",
+                    c.name, c.slope
+                )
+            })
+            .collect();
+        lines.join("\n")
+    }
 }
 
 /// A curve through `points` of (samples per pixel, seconds, RMSE), with its fitted slope.

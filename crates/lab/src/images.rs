@@ -1,9 +1,32 @@
 //! Comparing images: RMSE and relative MSE, and the check that a reference belongs to the
 //! render it is compared with.
 
+use anyhow::{bail, Result};
 use glam::Vec3;
 use pathlab_render::film::Film;
+use pathlab_render::image_io::{read_exr_rgb, read_rgb, write_exr};
 use std::path::Path;
+
+/// The reference image at `path` (a linear EXR), checked to be of `resolution`.
+pub fn read_reference(path: &Path, resolution: [u32; 2]) -> Result<Vec<Vec3>> {
+    let (rw, rh, pixels) = read_exr_rgb(path)?;
+    let [w, h] = resolution;
+    if [rw, rh] != resolution {
+        bail!(
+            "{}: the reference is {rw}x{rh} but the scene renders at {w}x{h}",
+            path.display()
+        );
+    }
+    Ok(pixels)
+}
+
+/// A largest bounce as the command line writes it: a number, or `inf` for unbounded.
+pub fn depth_text(max_depth: u32) -> String {
+    match max_depth {
+        u32::MAX => "inf".to_string(),
+        d => d.to_string(),
+    }
+}
 
 /// Root mean squared error over pixels and channels.
 pub fn rmse(a: &[Vec3], b: &[Vec3]) -> f64 {
@@ -119,6 +142,48 @@ pub fn reference_mismatch(
         reference_path.display(),
         z.abs()
     ))
+}
+
+/// Two image files of one size compared.
+pub struct FileDifference {
+    /// Their size.
+    pub resolution: [u32; 2],
+    /// How they differ.
+    pub difference: ImageDifference,
+    /// The heat map's white level, when the difference was written as a PNG.
+    pub heat_top: Option<f32>,
+}
+
+/// Reads images `a` and `b` (any format [`read_rgb`] reads; of one size) and measures how they
+/// differ; with `output`, writes the difference there: an `.exr` holds a - b per channel,
+/// anything else is a PNG heat map of |a - b| ([`write_difference_heat_map`]).
+pub fn diff_files(a: &Path, b: &Path, output: Option<&Path>) -> Result<FileDifference> {
+    let (wa, ha, pa) = read_rgb(a, true)?;
+    let (wb, hb, pb) = read_rgb(b, true)?;
+    if (wa, ha) != (wb, hb) {
+        bail!(
+            "{} is {wa}x{ha} but {} is {wb}x{hb}: images of one size are compared",
+            a.display(),
+            b.display()
+        );
+    }
+    let mut heat_top = None;
+    if let Some(out) = output {
+        let diff: Vec<Vec3> = pa.iter().zip(&pb).map(|(p, q)| *p - *q).collect();
+        let exr = out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        if exr {
+            write_exr(out, wa, ha, &diff, &[])?;
+        } else {
+            heat_top = Some(write_difference_heat_map(out, wa, ha, &diff)?);
+        }
+    }
+    Ok(FileDifference {
+        resolution: [wa, ha],
+        difference: ImageDifference::of(&pa, &pb),
+        heat_top,
+    })
 }
 
 /// |difference| in luminance as grey levels: black at zero, white at the 99th percentile (the

@@ -2,8 +2,9 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
+use pathlab_lab::render::{ProgressiveStop, RenderRequest, SceneEdits, Shard};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::integrator::DirectStrategy;
+use pathlab_render::integrator::{DirectStrategy, IntegratorChoice, PathLighting};
 use pathlab_render::render::{Adaptive, AdaptiveRule};
 use std::path::PathBuf;
 
@@ -324,24 +325,19 @@ fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>>
     Ok(warnings)
 }
 
-/// The flags as checked values: everything that can be checked before the scene is loaded.
+/// The flags as a checked request, and warnings about flags the chosen integrator does not
+/// read.
 pub(super) struct Checked {
-    /// `-m` as given (the scene's hint, or unbounded, otherwise).
-    pub cli_depth: Option<u32>,
-    /// Warnings about flags the chosen integrator does not read.
+    pub request: RenderRequest,
     pub warnings: Vec<String>,
-    /// `-D NAME=VALUE` pairs.
-    pub params: Vec<(String, String)>,
-    /// Whether the render is progressive (`--target-error` or `--time`).
-    pub progressive: bool,
-    /// `-a`, parsed (the Neyman rule's luminance comes from its pilot, after loading).
-    pub adaptive: Option<Adaptive>,
 }
 
-/// Checks every flag that needs no scene: an error names the flag and what was expected.
+/// Checks every flag that needs no scene (an error names the flag and what was expected),
+/// and makes the request of them.
 pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
     let cli_depth = args.max_depth.as_deref().map(parse_max_depth).transpose()?;
     let warnings = check_flags(args, cli_depth)?;
+    check_view(args)?;
     if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
         bail!(
             "--checkpoint-every {}: must be a number of seconds >= 0",
@@ -359,8 +355,12 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
             bail!("--time {t}: must be a positive number of seconds");
         }
     }
-    let progressive = args.target_error.is_some() || args.time.is_some();
-    if progressive && args.adaptive.is_some() {
+    let progressive =
+        (args.target_error.is_some() || args.time.is_some()).then_some(ProgressiveStop {
+            target_error: args.target_error,
+            time: args.time,
+        });
+    if progressive.is_some() && args.adaptive.is_some() {
         bail!(
             "--adaptive and --target-error/--time are different ways to place samples; choose one"
         );
@@ -370,7 +370,7 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
         .as_deref()
         .map(|a| parse_adaptive(a, args.adaptive_rule))
         .transpose()?;
-    if args.shard.is_some() && (progressive || adaptive.is_some()) {
+    if args.shard.is_some() && (progressive.is_some() || adaptive.is_some()) {
         bail!("--shard splits a render of fixed samples per pixel; it cannot be combined with -a, --target-error or --time");
     }
     let stopping_rule = adaptive.is_some()
@@ -381,13 +381,88 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
     if (args.checkpoint.is_some() || args.resume.is_some()) && stopping_rule {
         bail!("--checkpoint and --resume: the course and neyman adaptive rules decide on every sample a pixel has drawn, which a film does not keep; use the default two-stage rule");
     }
-    Ok(Checked {
-        cli_depth,
-        warnings,
+    let request = RenderRequest {
+        scene: args.scene.clone(),
         params,
-        progressive,
+        edits: SceneEdits {
+            lens_radius: args.lens_radius,
+            focal_distance: args.focal_distance,
+            envmap: args.envmap.clone().map(|e| (e, args.envmap_scale)),
+            schlick_fresnel: args.fresnel == FresnelName::Schlick,
+            resolution: args.resolution.as_deref().map(|r| [r[0], r[1]]),
+            scale: args.scale,
+            fov: args.fov,
+        },
+        spp: args.spp,
+        seed: args.seed,
+        sampler: args.sampler,
+        integrator: IntegratorChoice {
+            name: args.integrator,
+            max_depth: cli_depth,
+            rr_depth: args.rr_depth,
+            only_bounce: args.only_bounce,
+            light_samples: args.light_samples,
+            lighting: match args.lighting.unwrap_or(LightingName::Mis) {
+                LightingName::Mis => PathLighting::Mis,
+                LightingName::Bsdf => PathLighting::Bsdf,
+                LightingName::Light => PathLighting::Light,
+            },
+            direct: args.direct,
+        },
+        neyman: adaptive.is_some() && args.adaptive_rule == Some(RuleName::Neyman),
         adaptive,
-    })
+        progressive,
+        crop: args.crop.as_deref().map(|c| [c[0], c[1], c[2], c[3]]),
+        shard: args.shard.as_deref().map(parse_shard).transpose()?,
+        film_files: false,
+    };
+    Ok(Checked { request, warnings })
+}
+
+/// The camera's and the environment's flags: values no scene could take.
+fn check_view(args: &RenderArgs) -> Result<()> {
+    if let Some(b) = args.lens_radius.filter(|b| !(b.is_finite() && *b >= 0.0)) {
+        bail!("--lens-radius {b}: must be a finite number >= 0");
+    }
+    if let Some(d) = args.focal_distance.filter(|d| !(d.is_finite() && *d > 0.0)) {
+        bail!("--focal-distance {d}: must be a positive distance");
+    }
+    let scale = args.envmap_scale;
+    if args.envmap.is_some() && !(scale.is_finite() && scale >= 0.0) {
+        bail!("--envmap-scale {scale}: must be a number >= 0");
+    }
+    if let Some(c) = args
+        .crop
+        .as_deref()
+        .filter(|c| c[0] >= c[2] || c[1] >= c[3])
+    {
+        bail!(
+            "--crop {} {} {} {}: need x0 < x1 and y0 < y1",
+            c[0],
+            c[1],
+            c[2],
+            c[3]
+        );
+    }
+    if let Some(f) = args.scale.filter(|f| !(f.is_finite() && *f > 0.0)) {
+        bail!("--scale {f}: must be a positive factor such as 0.5 or 2");
+    }
+    if let Some(deg) = args
+        .fov
+        .filter(|d| !(d.is_finite() && *d > 0.0 && *d < 180.0))
+    {
+        bail!("--fov {deg}: must be an angle between 0 and 180 degrees");
+    }
+    Ok(())
+}
+
+/// `--shard I/N`.
+fn parse_shard(text: &str) -> Result<Shard> {
+    let (index, count) = text
+        .split_once('/')
+        .and_then(|(a, b)| Some((a.trim().parse::<u64>().ok()?, b.trim().parse::<u64>().ok()?)))
+        .with_context(|| format!("--shard {text}: expected I/N, such as 0/4"))?;
+    Ok(Shard { index, count })
 }
 
 /// `-D NAME=VALUE` scene parameters.

@@ -4,6 +4,10 @@
 //! randomisations for stratified and Sobol ones); and the convergence study of the three
 //! samplers. The experiment of `pathlab integrate`.
 
+mod report;
+
+pub use report::IntegrateReport;
+
 use crate::expr::{Expression, MAX_DIMS};
 use crate::plot::{fitted_slope, ConvergencePoint, ConvergenceSeries};
 use anyhow::{bail, Result};

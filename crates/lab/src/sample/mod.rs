@@ -2,6 +2,8 @@
 //! z-scores, a chi-square goodness-of-fit test in a parameterisation where the pdf is a density
 //! per unit area, and what a plot of them needs. The experiment of `pathlab sample`.
 
+mod report;
+
 use crate::plot;
 use anyhow::{bail, Result};
 use glam::{Vec2, Vec3};
@@ -407,6 +409,12 @@ pub struct SampleReport {
     pub seconds: f64,
     /// The plot's data, when asked for.
     pub plot: Option<plot::SamplePlot>,
+    /// Samples drawn.
+    pub samples: u32,
+    /// Where the uniform numbers came from.
+    pub sampler: SamplerKind,
+    /// Their seed.
+    pub seed: u64,
 }
 
 /// Draws `n` samples of `dist` (timed, accumulating each component's moments), then the same
@@ -442,6 +450,9 @@ pub fn run(
         chi_square: fit.test,
         seconds,
         plot: fit.plot,
+        samples: n,
+        sampler,
+        seed,
     }
 }
 
