@@ -4,7 +4,7 @@ use crate::render_cmd::ToneMapName;
 use anyhow::{bail, Result};
 use clap::Args;
 use pathlab_lab::images::{diff_files, FileDifference};
-use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, ToneMap};
+use pathlab_render::image_io::{read_rgb, write_exr, write_png_with};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -69,11 +69,7 @@ pub fn run_convert(args: &ConvertArgs) -> Result<()> {
     if ext == "exr" {
         write_exr(&args.output, w, h, &px, &[])?;
     } else {
-        let tone = match args.tonemap {
-            ToneMapName::Srgb => ToneMap::Srgb,
-            ToneMapName::Cs184 => ToneMap::Cs184,
-        };
-        write_png_with(&args.output, w, h, &px, args.exposure, tone)?;
+        write_png_with(&args.output, w, h, &px, args.exposure, args.tonemap.into())?;
     }
     eprintln!(
         "{}: {w}x{h}; wrote {}",

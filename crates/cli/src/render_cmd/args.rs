@@ -4,6 +4,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use pathlab_lab::render::{ProgressiveStop, RenderRequest, SceneEdits, Shard};
 use pathlab_mc::sampler::SamplerKind;
+use pathlab_render::image_io::ToneMap;
 use pathlab_render::integrator::{DirectStrategy, IntegratorChoice, PathLighting};
 use pathlab_render::render::{Adaptive, AdaptiveRule};
 use std::path::PathBuf;
@@ -30,6 +31,15 @@ pub enum ToneMapName {
     Srgb,
     /// The CS184 course's renderer: clamp((√2 c)^(1/2.2)), √2 being half a stop up.
     Cs184,
+}
+
+impl From<ToneMapName> for ToneMap {
+    fn from(name: ToneMapName) -> ToneMap {
+        match name {
+            ToneMapName::Srgb => ToneMap::Srgb,
+            ToneMapName::Cs184 => ToneMap::Cs184,
+        }
+    }
 }
 
 /// Extra outputs.

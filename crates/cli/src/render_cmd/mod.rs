@@ -19,7 +19,6 @@ use pathlab_lab::outputs::{write_all, ImageOptions, OutputFormat};
 use pathlab_lab::render::summary::Summary;
 use pathlab_lab::render::Plan;
 use pathlab_render::film::Film;
-use pathlab_render::image_io::ToneMap;
 use pathlab_render::render::TileDone;
 use pathlab_render::tev::{Layers, TevDisplay};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -71,10 +70,7 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
     let options = ImageOptions {
         variance: args.aov.contains(&Aov::Variance),
         samples: args.aov.contains(&Aov::Samples),
-        tonemap: match args.tonemap {
-            ToneMapName::Srgb => ToneMap::Srgb,
-            ToneMapName::Cs184 => ToneMap::Cs184,
-        },
+        tonemap: args.tonemap.into(),
         exposure: args.exposure,
     };
     let written = write_all(

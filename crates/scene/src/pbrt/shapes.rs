@@ -6,8 +6,8 @@
 //! lights emit on that side. pathlab takes the front of a triangle from its winding, so the
 //! winding is swapped where the two disagree.
 
-use super::materials::Use;
 use super::params::ParamList;
+use super::spectra::Use;
 use super::{Builder, GraphicsState};
 use crate::Error;
 use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};

@@ -2,8 +2,8 @@
 //! mapping, scale and invert), `scale`, `mix`, `bilerp` and 2D `checkerboard` textures, each
 //! kept by name for the materials that use it.
 
-use super::materials::Use;
 use super::params::ParamList;
+use super::spectra::Use;
 use super::Builder;
 use crate::Error;
 use pathlab_render::desc::{Rgb, TextureDesc, TextureFilter, WrapMode};

@@ -1,8 +1,8 @@
 //! pbrt-v4's scene-wide options (camera, film, sampler, pixel filter, integrator) and its
 //! lights.
 
-use super::materials::Use;
 use super::params::ParamList;
+use super::spectra::Use;
 use super::Builder;
 use crate::Error;
 use glam::{DMat4, DVec3, Mat3, Vec2, Vec3};
