@@ -625,3 +625,63 @@ WorldBegin
     assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
     assert!(desc.warnings[0].contains("maxcomponentvalue"));
 }
+
+#[test]
+fn partial_spheres_are_the_part_pbrt_defines_and_vanish_in_a_furnace() {
+    use std::f64::consts::PI;
+    // The upper half (z from 0.5 up) of a sphere of radius 2 over three quarters of a turn,
+    // centred at (1, 0, 0), emitting 9 W.
+    let scene = r#"LookAt 0 0 10  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "float power" [ 9 ]
+  Translate 1 0 0
+  Shape "sphere" "float radius" 2 "float zmin" 0.5 "float zmax" 5 "float phimax" 270
+AttributeEnd
+"#;
+    let desc = load_text("partial", &[("partial.pbrt", scene)]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    assert!(desc.spheres.is_empty());
+    assert_eq!(desc.meshes.len(), 1);
+    let mesh = &desc.meshes[0];
+    // The loader may mirror the world in x (pbrt's camera space is left-handed): the centre
+    // is at x = 1 or -1. Every vertex is on the sphere, at z >= 0.5.
+    let on_sphere = |c: &DVec3| ((mesh.positions[0].as_dvec3() - *c).length() - 2.0).abs() < 1e-5;
+    let centre = [DVec3::X, -DVec3::X]
+        .into_iter()
+        .find(on_sphere)
+        .expect("a vertex on the sphere");
+    let mut area = 0.0;
+    for t in mesh.indices.chunks_exact(3) {
+        let p = [0, 1, 2].map(|k| mesh.positions[t[k] as usize].as_dvec3());
+        let cross = (p[1] - p[0]).cross(p[2] - p[0]);
+        area += 0.5 * cross.length();
+        let outward = (p[0] + p[1] + p[2]) / 3.0 - centre;
+        assert!(cross.dot(outward) > 0.0, "a triangle faces inwards");
+    }
+    for p in &mesh.positions {
+        let d = p.as_dvec3() - centre;
+        assert!((d.length() - 2.0).abs() < 1e-5, "{p}");
+        assert!(d.z >= 0.5 - 1e-5, "{p}");
+    }
+    // A zone of height h on a sphere of radius r, over φmax: φmax r h.
+    let exact = 1.5 * PI * 2.0 * 1.5;
+    assert!(
+        (area - exact).abs() < 1e-3 * exact,
+        "area {area} vs {exact}"
+    );
+    let l = mesh.emission.unwrap().radiance.x as f64;
+    assert!((l - 9.0 / (PI * area)).abs() < 1e-5 * l, "{l}");
+
+    // A white diffuse hemisphere in a furnace reflects every bit of its sky, inside and out.
+    let furnace = FURNACE.to_string()
+        + r#"Material "diffuse" "rgb reflectance" [ 1 1 1 ]
+Shape "sphere" "float radius" 1 "float zmin" 0
+"#;
+    let desc = load_text("partial-furnace", &[("furnace.pbrt", &furnace)]).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let film = render_film(&desc, 64, 5);
+    assert!(film.image_mean_std_error().x < 0.01);
+    assert_mean("partial sphere furnace", &film, DVec3::ONE);
+}

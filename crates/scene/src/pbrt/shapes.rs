@@ -54,6 +54,54 @@ struct ObjectMesh {
     uvs: Vec<Vec2>,
 }
 
+/// What a `sphere` shape is.
+enum SphereExtent {
+    /// The whole sphere, of this radius.
+    Whole(f64),
+    /// A part of it, tessellated.
+    Partial(ObjectMesh),
+}
+
+/// The part of the sphere of `radius` between heights `z0 < z1` and azimuths 0 to `phi_max`
+/// (radians): [`SEGMENTS`] columns over the azimuths, rows evenly spaced in θ (as many per
+/// radian as the columns of a whole turn), vertices on the sphere with its normals, pbrt-v4's
+/// (u, v), outward-facing triangles; the triangles that a pole would make degenerate are left
+/// out.
+fn partial_sphere(radius: f64, z0: f64, z1: f64, phi_max: f64) -> ObjectMesh {
+    let (theta0, theta1) = ((z0 / radius).acos(), (z1 / radius).acos());
+    let rows = ((theta0 - theta1) / std::f64::consts::TAU * SEGMENTS as f64)
+        .ceil()
+        .max(1.0) as usize;
+    let mut m = ObjectMesh::default();
+    for i in 0..=SEGMENTS {
+        let u = i as f64 / SEGMENTS as f64;
+        let (sin_p, cos_p) = (u * phi_max).sin_cos();
+        // From the bottom (z0) up, as the cylinder's columns run.
+        for j in 0..=rows {
+            let v = j as f64 / rows as f64;
+            let (sin_t, cos_t) = (theta0 + v * (theta1 - theta0)).sin_cos();
+            let n = DVec3::new(sin_t * cos_p, sin_t * sin_p, cos_t);
+            m.positions.push(radius * n);
+            m.normals.push(n);
+            m.uvs.push(Vec2::new(u as f32, v as f32));
+        }
+    }
+    let column = rows as u32 + 1;
+    for i in 0..SEGMENTS as u32 {
+        for j in 0..rows as u32 {
+            let (a, b) = (i * column + j, i * column + j + 1);
+            let (c, d) = (a + column, b + column);
+            for t in [[a, c, d], [a, d, b]] {
+                let p = t.map(|k| m.positions[k as usize]);
+                if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 1e-24 * radius.powi(4) {
+                    m.indices.extend(t);
+                }
+            }
+        }
+    }
+    m
+}
+
 impl Builder {
     /// `Shape "kind" ...` with the graphics state `state`.
     pub(crate) fn shape(
@@ -69,11 +117,14 @@ impl Builder {
         let material = self.shape_material(&params, state)?;
         let emission = self.area_emission(state)?;
         let mesh = match kind {
-            "sphere" => {
-                self.sphere(&params, m, material, emission.as_ref(), state)?;
-                self.warn_unused(&format!("Shape \"{kind}\""), &params);
-                return Ok(());
-            }
+            "sphere" => match self.sphere_extent(&params)? {
+                SphereExtent::Whole(radius) => {
+                    self.sphere(radius, m, material, emission.as_ref(), state)?;
+                    self.warn_unused(&format!("Shape \"{kind}\""), &params);
+                    return Ok(());
+                }
+                SphereExtent::Partial(mesh) => mesh,
+            },
             "trianglemesh" => self.triangle_mesh(&params)?,
             "plymesh" => self.ply_mesh(&params)?,
             "bilinearmesh" => self.bilinear_mesh(&params)?,
@@ -99,7 +150,7 @@ impl Builder {
                 // pbrt-v4 makes a light of each triangle of a mesh (each patch of a bilinear
                 // mesh), each emitting `power`; a disk or cylinder is one light.
                 let per_unit = match kind {
-                    "disk" | "cylinder" => out.indices.len() / 3,
+                    "disk" | "cylinder" | "sphere" => out.indices.len() / 3,
                     "bilinearmesh" => 2,
                     _ => 1,
                 };
@@ -455,14 +506,11 @@ impl Builder {
         Ok(m)
     }
 
-    fn sphere(
-        &mut self,
-        params: &ParamList,
-        m: DMat4,
-        material: usize,
-        emission: Option<&AreaEmission>,
-        state: &GraphicsState,
-    ) -> Result<(), Error> {
+    /// A sphere's `radius`, and its part: the whole sphere (rendered as a sphere), or the part
+    /// between heights `zmin` and `zmax` up to azimuth `phimax`, as pbrt-v4 defines them
+    /// (clamped to the sphere; u = φ / φmax, v from θ at zmin to θ at zmax), tessellated as
+    /// the disk and cylinder are, with the sphere's normals.
+    fn sphere_extent(&mut self, params: &ParamList) -> Result<SphereExtent, Error> {
         let radius = self.float(params, "radius", 1.0)?;
         if radius.is_nan() || radius <= 0.0 {
             return Err(self.error(format!(
@@ -472,9 +520,35 @@ impl Builder {
         let zmin = self.float(params, "zmin", -radius)?;
         let zmax = self.float(params, "zmax", radius)?;
         let phimax = self.float(params, "phimax", 360.0)?;
-        if zmin > -radius || zmax < radius || phimax < 360.0 {
-            self.warn("Shape \"sphere\": partial spheres (zmin, zmax, phimax) are not supported; the whole sphere is rendered");
+        if [zmin, zmax, phimax].iter().any(|v| !v.is_finite()) {
+            return Err(self.error("Shape \"sphere\": zmin, zmax and phimax must be finite"));
         }
+        let (z0, z1) = (
+            zmin.min(zmax).clamp(-radius, radius),
+            zmin.max(zmax).clamp(-radius, radius),
+        );
+        let phi_max = phimax.clamp(0.0, 360.0).to_radians();
+        if z0 <= -radius && z1 >= radius && phimax >= 360.0 {
+            return Ok(SphereExtent::Whole(radius));
+        }
+        if z0 >= z1 || phi_max <= 0.0 {
+            self.warn("Shape \"sphere\": zmin, zmax and phimax leave no surface; skipped");
+            return Ok(SphereExtent::Partial(ObjectMesh::default()));
+        }
+        Ok(SphereExtent::Partial(partial_sphere(
+            radius, z0, z1, phi_max,
+        )))
+    }
+
+    /// A whole sphere of `radius` in object space, placed by `m`.
+    fn sphere(
+        &mut self,
+        radius: f64,
+        m: DMat4,
+        material: usize,
+        emission: Option<&AreaEmission>,
+        state: &GraphicsState,
+    ) -> Result<(), Error> {
         let axes = DMat3::from_mat4(m);
         let scales = [
             axes.x_axis.length(),
