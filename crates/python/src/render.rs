@@ -143,8 +143,11 @@ fn request(
         }
         checked.push((a, aov));
     }
+    let mut settings = RenderSettings::new(spp, seed, sampler);
+    // The file's crop window, at the size the image has.
+    settings.crop = hints.crop.and_then(|c| c.window_for(resolution));
     Ok(Request {
-        settings: RenderSettings::new(spp, seed, sampler),
+        settings,
         choice,
         hints: *hints,
         integrator,

@@ -107,6 +107,45 @@ pub struct RenderHints {
     pub hide_emitters: bool,
     /// The sampler the file names.
     pub sampler: Option<pathlab_mc::sampler::SamplerKind>,
+    /// The part of the image the file asks to render.
+    pub crop: Option<CropHint>,
+}
+
+/// A crop window a scene file names: the pixels `x0 <= x < x1`, `y0 <= y < y1` of an image of
+/// size `of`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CropHint {
+    /// `[x0, y0, x1, y1]`.
+    pub window: [u32; 4],
+    /// The image size the window is of.
+    pub of: [u32; 2],
+}
+
+impl CropHint {
+    /// The window in an image of `resolution`: as given at the file's size; at another size
+    /// the same fraction of the image, each edge at the first pixel whose left (top) edge lies
+    /// at or past it, as pbrt-v4 places a crop window's edges. `None` when nothing is left.
+    pub fn window_for(&self, resolution: [u32; 2]) -> Option<[u32; 4]> {
+        let [w, h] = resolution;
+        let window = if resolution == self.of {
+            self.window
+        } else {
+            let edge = |v: u32, from: u32, to: u32| {
+                let x = (v as f64 * to as f64 / from.max(1) as f64).ceil();
+                x.clamp(0.0, to as f64) as u32
+            };
+            let [x0, y0, x1, y1] = self.window;
+            let [fw, fh] = self.of;
+            [
+                edge(x0, fw, w),
+                edge(y0, fh, h),
+                edge(x1, fw, w),
+                edge(y1, fh, h),
+            ]
+        };
+        let [x0, y0, x1, y1] = window;
+        (x0 < x1.min(w) && y0 < y1.min(h)).then_some([x0, y0, x1.min(w), y1.min(h)])
+    }
 }
 
 /// An integrator a scene file asks for.
@@ -337,4 +376,32 @@ pub struct Emission {
     pub radiance: Rgb,
     /// Whether the back side emits too.
     pub two_sided: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::CropHint;
+
+    #[test]
+    fn a_crop_window_keeps_its_fraction_of_the_image_at_another_size() {
+        let hint = CropHint {
+            window: [10, 20, 30, 40],
+            of: [100, 50],
+        };
+        assert_eq!(hint.window_for([100, 50]), Some([10, 20, 30, 40]));
+        // Twice the size: twice the pixels; a third of it: edges rounded up as pbrt-v4's are.
+        assert_eq!(hint.window_for([200, 100]), Some([20, 40, 60, 80]));
+        assert_eq!(hint.window_for([33, 17]), Some([4, 7, 10, 14]));
+        // A window past the image is cut at its edge; one with nothing left is none.
+        let past = CropHint {
+            window: [90, 0, 150, 50],
+            of: [100, 50],
+        };
+        assert_eq!(past.window_for([100, 50]), Some([90, 0, 100, 50]));
+        let outside = CropHint {
+            window: [100, 0, 150, 50],
+            of: [100, 50],
+        };
+        assert_eq!(outside.window_for([100, 50]), None);
+    }
 }

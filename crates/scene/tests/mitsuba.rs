@@ -332,3 +332,40 @@ fn an_sdf_grid_of_a_plane_renders_as_the_plane_and_a_torus_grid_renders() {
         .fold((f64::INFINITY, 0.0f64), |(a, b), &l| (a.min(l), b.max(l)));
     assert!(hi > 0.0 && hi - lo > 0.1, "luminance range {lo}..{hi}");
 }
+
+#[test]
+fn a_films_crop_window_is_the_part_of_the_image_to_render() {
+    use pathlab_render::desc::CropHint;
+    let film = |crop: &str| {
+        format!(
+            r#"<scene version="3.0.0"><sensor type="perspective"><film type="hdrfilm">
+<integer name="width" value="64"/><integer name="height" value="32"/>{crop}</film></sensor></scene>"#
+        )
+    };
+    let path = write(
+        "crop.xml",
+        &film(
+            r#"<integer name="crop_offset_x" value="8"/><integer name="crop_width" value="16"/><integer name="crop_height" value="4"/>"#,
+        ),
+    );
+    let desc = mitsuba::load(&path).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    assert_eq!(
+        desc.hints.crop,
+        Some(CropHint {
+            window: [8, 0, 24, 4],
+            of: [64, 32]
+        })
+    );
+    let path = write("no-crop.xml", &film(""));
+    assert_eq!(mitsuba::load(&path).unwrap().hints.crop, None);
+    // As Mitsuba: a window that leaves the film is an error.
+    let path = write(
+        "bad-crop.xml",
+        &film(
+            r#"<integer name="crop_offset_y" value="30"/><integer name="crop_height" value="4"/>"#,
+        ),
+    );
+    let e = mitsuba::load(&path).unwrap_err().to_string();
+    assert!(e.contains("does not lie inside the 64 x 32 film"), "{e}");
+}

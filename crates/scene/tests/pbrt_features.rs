@@ -685,3 +685,52 @@ Shape "sphere" "float radius" 1 "float zmin" 0
     assert!(film.image_mean_std_error().x < 0.01);
     assert_mean("partial sphere furnace", &film, DVec3::ONE);
 }
+
+#[test]
+fn a_films_crop_window_and_pixel_bounds_are_placed_as_pbrt_places_them() {
+    use pathlab_render::desc::CropHint;
+    let load = |tag: &str, film: &str| {
+        let scene = format!(
+            "Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 50 {film}\nCamera \"perspective\"\nWorldBegin\n"
+        );
+        load_text(tag, &[("crop.pbrt", &scene)]).unwrap()
+    };
+    let hint = |window| {
+        Some(CropHint {
+            window,
+            of: [100, 50],
+        })
+    };
+    // Fractions x0 x1 y0 y1, in any order, each edge at the first pixel at or past it.
+    let desc = load("cropwindow", r#""float cropwindow" [ 0.25 0.101 0.5 1 ]"#);
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    assert_eq!(desc.hints.crop, hint([11, 25, 25, 50]));
+    // Pixel bounds x0 x1 y0 y1 win over a crop window, with a warning.
+    let desc = load(
+        "pixelbounds",
+        r#""integer pixelbounds" [ 10 20 5 45 ] "float cropwindow" [ 0 1 0 1 ]"#,
+    );
+    assert_eq!(desc.hints.crop, hint([10, 5, 20, 45]));
+    assert_eq!(desc.warnings.len(), 1, "{:?}", desc.warnings);
+    assert!(desc.warnings[0].contains("pixelbounds is used"));
+    // Bounds past the image are cut to it; bounds that hold no pixel render the whole image.
+    let desc = load("past", r#""integer pixelbounds" [ 90 200 -5 10 ]"#);
+    assert_eq!(desc.hints.crop, hint([90, 0, 100, 10]));
+    let desc = load("empty", r#""float cropwindow" [ 0.5 0.5 0 1 ]"#);
+    assert_eq!(desc.hints.crop, None);
+    assert!(
+        desc.warnings[0].contains("holds no pixel"),
+        "{:?}",
+        desc.warnings
+    );
+    let e = load_text(
+        "three",
+        &[(
+            "crop.pbrt",
+            "Film \"rgb\" \"float cropwindow\" [ 0 1 0 ]\nCamera \"perspective\"\nWorldBegin\n",
+        )],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("cropwindow takes four numbers"), "{e}");
+}

@@ -143,7 +143,8 @@ pub struct RenderArgs {
     /// Only with -a.
     #[arg(long, value_enum)]
     pub adaptive_rule: Option<RuleName>,
-    /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black).
+    /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (the rest stays black). Default: the
+    /// scene file's crop window, if it has one.
     #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..))]
     pub crop: Option<Vec<u32>>,
     /// Output image: .exr (linear) or .png (sRGB). Repeat for several files from one render

@@ -66,7 +66,7 @@ pub struct RenderRequest {
     pub neyman: bool,
     /// A progressive render, and when it stops.
     pub progressive: Option<ProgressiveStop>,
-    /// Only these pixels: x0, y0, x1, y1.
+    /// Only these pixels: x0, y0, x1, y1 (default: the scene file's crop window, if any).
     pub crop: Option<[u32; 4]>,
     /// Only this shard of the samples.
     pub shard: Option<Shard>,
@@ -130,19 +130,23 @@ impl Plan {
             });
         let mut settings = RenderSettings::new(spp, req.seed, sampler);
         settings.adaptive = req.adaptive;
-        if let Some(c) = req.crop {
-            let [w, h] = desc.resolution;
-            if c[2] > w || c[3] > h {
-                bail!(
-                    "--crop {} {} {} {}: need x1 <= {w} and y1 <= {h}",
-                    c[0],
-                    c[1],
-                    c[2],
-                    c[3]
-                );
+        settings.crop = match req.crop {
+            Some(c) => {
+                let [w, h] = desc.resolution;
+                if c[2] > w || c[3] > h {
+                    bail!(
+                        "--crop {} {} {} {}: need x1 <= {w} and y1 <= {h}",
+                        c[0],
+                        c[1],
+                        c[2],
+                        c[3]
+                    );
+                }
+                Some(c)
             }
-            settings.crop = Some(c);
-        }
+            // The file's window, at the size the image now has.
+            None => desc.hints.crop.and_then(|c| c.window_for(desc.resolution)),
+        };
         if let (Some(a), true) = (settings.adaptive.as_mut(), req.neyman) {
             let seed = req.seed.wrapping_add(1);
             let (rule, _) =

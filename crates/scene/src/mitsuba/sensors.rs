@@ -195,21 +195,28 @@ fn film_settings(ctx: &mut Ctx, film: Obj) -> Result<(), Error> {
             "compensate",
         ],
     );
-    for key in [
+    let keys = [
         "crop_offset_x",
         "crop_offset_y",
         "crop_width",
         "crop_height",
-    ] {
-        if ctx.has(film, key) {
-            ctx.warn(
-                ctx.loc_of(film, key),
-                format!(
-                    "<film>: '{key}' is not supported (pathlab renders the whole film; use --crop)"
-                ),
-            );
-            ctx.accept(film, &[key]);
+    ];
+    if keys.iter().any(|k| ctx.has(film, k)) {
+        let x = ctx.int(film, "crop_offset_x", 0)?;
+        let y = ctx.int(film, "crop_offset_y", 0)?;
+        let cw = ctx.int(film, "crop_width", w)?;
+        let ch = ctx.int(film, "crop_height", h)?;
+        // As Mitsuba checks them: the window lies inside the film and holds a pixel.
+        if x < 0 || y < 0 || cw < 1 || ch < 1 || x + cw > w || y + ch > h {
+            return Err(ctx.error(
+                film.loc,
+                format!("the crop window ({x}, {y}) size {cw} x {ch} does not lie inside the {w} x {h} film"),
+            ));
         }
+        ctx.desc.hints.crop = Some(CropHint {
+            window: [x, y, x + cw, y + ch].map(|v| v as u32),
+            of: [w as u32, h as u32],
+        });
     }
     if ctx.boolean(film, "sample_border", false)? {
         ctx.warn(

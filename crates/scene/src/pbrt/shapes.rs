@@ -248,7 +248,7 @@ impl Builder {
         }))
     }
 
-    fn param_numbers<'p>(
+    pub(super) fn param_numbers<'p>(
         &self,
         params: &'p ParamList,
         name: &str,

@@ -128,6 +128,55 @@ impl Builder {
         Ok(())
     }
 
+    /// The part of the image `Film` asks to render: `pixelbounds` (pixels x0 x1 y0 y1) or
+    /// `cropwindow` (fractions x0 x1 y0 y1, each edge at the first pixel at or past it), as
+    /// pbrt-v4 reads them (`pixelbounds` first), cut to the image of size `of`.
+    fn crop_hint(&mut self, params: &ParamList, of: [u32; 2]) -> Result<Option<CropHint>, Error> {
+        let bounds = self.param_numbers(params, "pixelbounds")?;
+        let fractions = self.param_numbers(params, "cropwindow")?;
+        let [w, h] = of.map(f64::from);
+        let four = |v: &[f64], what: &str| {
+            if v.len() == 4 && v.iter().all(|x| x.is_finite()) {
+                Ok([v[0], v[1], v[2], v[3]])
+            } else {
+                Err(self.error(format!("Film: {what} takes four numbers x0 x1 y0 y1")))
+            }
+        };
+        let [x0, x1, y0, y1] = match (bounds, fractions) {
+            (Some(b), f) => {
+                let b = four(b, "pixelbounds")?;
+                if f.is_some() {
+                    self.warn("Film: both pixelbounds and cropwindow are given; pixelbounds is used, as in pbrt-v4");
+                }
+                b
+            }
+            (None, Some(f)) => {
+                let [a, b, c, d] = four(f, "cropwindow")?;
+                let unit = |v: f64| v.clamp(0.0, 1.0);
+                [
+                    (w * unit(a.min(b))).ceil(),
+                    (w * unit(a.max(b))).ceil(),
+                    (h * unit(c.min(d))).ceil(),
+                    (h * unit(c.max(d))).ceil(),
+                ]
+            }
+            (None, None) => return Ok(None),
+        };
+        let window = [
+            x0.clamp(0.0, w) as u32,
+            y0.clamp(0.0, h) as u32,
+            x1.clamp(0.0, w) as u32,
+            y1.clamp(0.0, h) as u32,
+        ];
+        if window[0] >= window[2] || window[1] >= window[3] {
+            self.warn(
+                "Film: the crop window holds no pixel of the image; the whole image is rendered",
+            );
+            return Ok(None);
+        }
+        Ok(Some(CropHint { window, of }))
+    }
+
     /// The camera and film, once the whole file is read.
     pub(crate) fn finish_options(&mut self) -> Result<(), Error> {
         let (mut w, mut h) = (1280u32, 720u32);
@@ -148,11 +197,7 @@ impl Builder {
             if clamp.is_finite() {
                 self.warn(format!("Film: maxcomponentvalue {clamp} (a clamp of each sample) is not supported; samples are not clamped"));
             }
-            if params.has("cropwindow") || params.has("pixelbounds") {
-                params.get("cropwindow");
-                params.get("pixelbounds");
-                self.warn("Film: cropwindow and pixelbounds are not supported; the whole image is rendered (use --crop)");
-            }
+            self.desc.hints.crop = self.crop_hint(&params, [w, h])?;
             if kind != "rgb" {
                 self.warn(format!("Film \"{kind}\": rendered as an RGB film"));
             }

@@ -1,0 +1,98 @@
+//! A render's plan: what the request leaves open the scene's hints, then the defaults, fill.
+
+use pathlab_lab::render::{Plan, RenderRequest, SceneEdits, PROGRESSIVE_CAP};
+use pathlab_lab::render::{ProgressiveStop, DEFAULT_SPP};
+use pathlab_mc::sampler::SamplerKind;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+fn plan(req: &RenderRequest) -> (Plan, Vec<String>) {
+    let mut warnings = Vec::new();
+    let plan = Plan::new(
+        req,
+        &mut |w| warnings.push(w.to_string()),
+        &AtomicBool::new(false),
+    )
+    .expect("the plan");
+    (plan, warnings)
+}
+
+/// A pbrt-v4 file of a 100 x 50 image that asks for 8 samples and a crop window.
+fn cropped_scene() -> String {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("plan-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("crop.pbrt");
+    std::fs::write(
+        &path,
+        r#"Film "rgb" "integer xresolution" 100 "integer yresolution" 50 "float cropwindow" [ 0.1 0.5 0 0.5 ]
+Sampler "independent" "integer pixelsamples" 8
+LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective"
+WorldBegin
+Shape "sphere"
+"#,
+    )
+    .unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+#[test]
+fn the_scene_fills_what_the_request_leaves_open() {
+    let req = RenderRequest {
+        scene: cropped_scene(),
+        ..Default::default()
+    };
+    let (p, warnings) = plan(&req);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!((p.spp, p.settings.sampler), (8, SamplerKind::Independent));
+    assert_eq!(p.resolution, [100, 50]);
+    assert_eq!(p.settings.crop, Some([10, 0, 50, 25]));
+    assert_eq!(p.total_samples(), 40 * 25 * 8);
+
+    // Twice the size: the same part of the image.
+    let req = RenderRequest {
+        edits: SceneEdits {
+            resolution: Some([200, 100]),
+            ..Default::default()
+        },
+        ..req
+    };
+    assert_eq!(plan(&req).0.settings.crop, Some([20, 0, 100, 50]));
+    // The caller's window and samples win.
+    let req = RenderRequest {
+        crop: Some([0, 0, 4, 4]),
+        spp: Some(3),
+        sampler: Some(SamplerKind::Sobol),
+        ..req
+    };
+    let p = plan(&req).0;
+    assert_eq!(p.settings.crop, Some([0, 0, 4, 4]));
+    assert_eq!((p.spp, p.settings.sampler), (3, SamplerKind::Sobol));
+}
+
+#[test]
+fn defaults_fill_what_neither_says() {
+    let req = RenderRequest {
+        scene: "cornell-box".into(),
+        ..Default::default()
+    };
+    let p = plan(&req).0;
+    assert_eq!(
+        (p.spp, p.settings.sampler),
+        (DEFAULT_SPP, SamplerKind::Sobol)
+    );
+    assert_eq!((p.settings.crop, p.max_depth), (None, u32::MAX));
+    // Progressive renders take independent samples, up to the cap.
+    let req = RenderRequest {
+        progressive: Some(ProgressiveStop {
+            time: Some(1.0),
+            ..Default::default()
+        }),
+        ..req
+    };
+    let p = plan(&req).0;
+    assert_eq!(
+        (p.stop_cap, p.settings.sampler),
+        (PROGRESSIVE_CAP, SamplerKind::Independent)
+    );
+}
