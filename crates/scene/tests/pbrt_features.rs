@@ -734,3 +734,88 @@ fn a_films_crop_window_and_pixel_bounds_are_placed_as_pbrt_places_them() {
     .to_string();
     assert!(e.contains("cropwindow takes four numbers"), "{e}");
 }
+
+#[test]
+fn dielectrics_take_textured_and_anisotropic_roughness() {
+    use glam::{Vec2, Vec3};
+    use pathlab_render::desc::MaterialDesc;
+    use pathlab_render::texture::{Tex, TexPoint};
+    let desc = load_text(
+        "dielectric-roughness",
+        &[(
+            "r.pbrt",
+            r#"WorldBegin
+Texture "ramp" "float" "bilerp"
+MakeNamedMaterial "textured" "string type" "dielectric" "texture roughness" "ramp" "float eta" 1.33
+MakeNamedMaterial "anisotropic" "string type" "dielectric" "float uroughness" 0.04 "float vroughness" 0.25
+MakeNamedMaterial "plain" "string type" "dielectric" "float roughness" 0.04
+NamedMaterial "textured"
+Shape "sphere"
+"#,
+        )],
+    )
+    .unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let at = |t: &TextureDesc, v: f32| Tex::from_desc(t).eval(&TexPoint::uv(Vec2::new(0.3, v)));
+    let close = |a: Vec3, b: f32| (a - Vec3::splat(b)).abs().max_element() < 1e-6;
+    use pathlab_render::desc::TextureDesc;
+    // α = √roughness along the bilerp's v, on both axes; the index as given.
+    match &desc.materials[0] {
+        MaterialDesc::RoughGlass {
+            alpha_u,
+            alpha_v,
+            ior,
+            ..
+        } => {
+            assert!(close(at(alpha_u, 0.25), 0.5) && close(at(alpha_v, 0.64), 0.8));
+            assert_eq!(*ior, 1.33);
+        }
+        other => panic!("not textured glass: {other:?}"),
+    }
+    // Different roughness along u and v: α = (0.2, 0.5).
+    match &desc.materials[1] {
+        MaterialDesc::RoughGlass {
+            alpha_u, alpha_v, ..
+        } => assert!(close(at(alpha_u, 0.5), 0.2) && close(at(alpha_v, 0.5), 0.5)),
+        other => panic!("not anisotropic glass: {other:?}"),
+    }
+    // One number: the plain rough glass.
+    match &desc.materials[2] {
+        MaterialDesc::Glass { roughness, .. } => assert!((roughness - 0.2).abs() < 1e-6),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn glass_of_textured_roughness_renders_as_glass_of_that_roughness() {
+    // A bilerp texture of one value is a texture that the loader cannot fold to a number, so
+    // the sphere takes the textured model; it must render what the number renders.
+    let scene = |roughness: &str| {
+        FURNACE.replace("LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]", "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\nLightSource \"distant\" \"point3 from\" [ 1 2 3 ] \"rgb L\" [ 3 3 3 ]")
+            + &format!(
+                r#"Texture "flat" "float" "bilerp" "float v00" 0.09 "float v01" 0.09 "float v10" 0.09 "float v11" 0.09
+Material "dielectric" {roughness}
+Shape "sphere"
+Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
+Translate 0 0 -3
+Shape "bilinearmesh" "point3 P" [ -4 -4 0  4 -4 0  -4 4 0  4 4 0 ] "integer indices" [ 0 1 2 3 ]
+"#
+            )
+    };
+    let textured = load_text(
+        "glass-textured",
+        &[("s.pbrt", &scene(r#""texture roughness" "flat""#))],
+    )
+    .unwrap();
+    assert!(matches!(
+        textured.materials[0],
+        pathlab_render::desc::MaterialDesc::RoughGlass { .. }
+    ));
+    let plain = load_text(
+        "glass-plain",
+        &[("s.pbrt", &scene(r#""float roughness" 0.09"#))],
+    )
+    .unwrap();
+    let (a, b) = (render_film(&textured, 256, 1), render_film(&plain, 256, 2));
+    pathlab_testkit::render::assert_same_image("textured against plain roughness", &a, &b);
+}

@@ -68,6 +68,7 @@ impl Material {
                 distribution,
             } => conductor(eta, k, Rgb::ONE, distribution, alpha),
             MaterialDesc::RoughConductor { .. } => rough_conductor(d, &mut tex),
+            MaterialDesc::RoughGlass { .. } => rough_glass(d, &mut tex),
             &MaterialDesc::Plastic {
                 diffuse,
                 specular,
@@ -255,6 +256,39 @@ fn rough_conductor(d: &MaterialDesc, tex: &mut dyn FnMut(&TextureDesc) -> Tex) -
                 kind: *distribution,
             },
             two_sided: true,
+        }),
+    }
+}
+
+/// Glass of textured or anisotropic roughness: the fixed glass of its roughness when that is
+/// one constant, else a textured model. The side matters, as for all glass.
+fn rough_glass(d: &MaterialDesc, tex: &mut dyn FnMut(&TextureDesc) -> Tex) -> Material {
+    let &MaterialDesc::RoughGlass {
+        ref alpha_u,
+        ref alpha_v,
+        ior,
+        distribution,
+    } = d
+    else {
+        unreachable!("rough_glass() is called with rough glass")
+    };
+    match (alpha_u.as_constant(), alpha_v.as_constant()) {
+        (Some(a), Some(b)) if a == b => glass(&MaterialDesc::Glass {
+            reflectance: Rgb::ONE,
+            transmittance: Rgb::ONE,
+            roughness: a.x,
+            ior,
+            distribution,
+            fresnel: crate::desc::FresnelModel::Exact,
+        }),
+        _ => Material::Leaf(Leaf {
+            model: Model::Dielectric {
+                alpha_u: tex(alpha_u),
+                alpha_v: tex(alpha_v),
+                eta: usable_ior(ior),
+                kind: distribution,
+            },
+            two_sided: false,
         }),
     }
 }

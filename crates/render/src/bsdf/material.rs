@@ -84,6 +84,17 @@ pub enum Model {
         /// The distribution.
         kind: NormalDistribution,
     },
+    /// Glass with textured, possibly anisotropic roughness (smooth where it is negligible).
+    Dielectric {
+        /// Roughness along the u tangent.
+        alpha_u: Tex,
+        /// Roughness along the v tangent.
+        alpha_v: Tex,
+        /// Index of refraction inside relative to outside.
+        eta: f32,
+        /// The distribution.
+        kind: NormalDistribution,
+    },
     /// Rough plastic with a textured base.
     RoughPlastic {
         /// The base's albedo.
@@ -266,7 +277,7 @@ impl Material {
     pub fn needs_tangents(&self) -> bool {
         match self {
             Material::Leaf(l) => match &l.model {
-                Model::Conductor { .. } => true,
+                Model::Conductor { .. } | Model::Dielectric { .. } => true,
                 Model::Coated { anisotropic, .. } => *anisotropic,
                 Model::Principled(p) => p.anisotropic.is_some(),
                 _ => false,
@@ -447,6 +458,29 @@ impl Model {
                     }),
                     au != av,
                 )
+            }
+            Model::Dielectric {
+                alpha_u,
+                alpha_v,
+                eta,
+                kind,
+            } => {
+                let (au, av) = (alpha_u.eval_float(p), alpha_v.eval_float(p));
+                let bxdf = match Microfacet::unless_smooth(*kind, au, av) {
+                    Some(distribution) => Bxdf::RoughDielectric(RoughDielectric {
+                        eta: *eta,
+                        distribution,
+                        reflectance: Rgb::ONE,
+                        transmittance: Rgb::ONE,
+                    }),
+                    None => Bxdf::Dielectric(SmoothDielectric {
+                        eta: *eta,
+                        reflectance: Rgb::ONE,
+                        transmittance: Rgb::ONE,
+                        fresnel: crate::desc::FresnelModel::Exact,
+                    }),
+                };
+                (bxdf, au != av)
             }
             Model::RoughPlastic {
                 diffuse,

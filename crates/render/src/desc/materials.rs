@@ -283,6 +283,19 @@ pub enum MaterialDesc {
         /// Microfacet distribution.
         distribution: NormalDistribution,
     },
+    /// Rough glass whose roughness is textured or anisotropic (α along the surface's u tangent
+    /// and along v; pbrt-v4's `dielectric` with roughness textures or `uroughness` ≠
+    /// `vroughness`), smooth where both are negligible.
+    RoughGlass {
+        /// Roughness along the u tangent.
+        alpha_u: TextureDesc,
+        /// Roughness along the v tangent.
+        alpha_v: TextureDesc,
+        /// Index of refraction inside relative to outside.
+        ior: f32,
+        /// Microfacet distribution.
+        distribution: NormalDistribution,
+    },
     /// A diffuse base under a rough dielectric coat (Mitsuba's `roughplastic`).
     RoughPlastic {
         /// Diffuse reflectance of the base.
@@ -362,6 +375,7 @@ impl MaterialDesc {
             MaterialDesc::Conductor { .. } => "conductor",
             MaterialDesc::Plastic { .. } => "plastic",
             MaterialDesc::RoughConductor { .. } => "rough conductor",
+            MaterialDesc::RoughGlass { .. } => "rough glass",
             MaterialDesc::RoughPlastic { .. } => "rough plastic",
             MaterialDesc::Principled(p) if p.thin => "principled thin",
             MaterialDesc::Principled(_) => "principled",

@@ -255,22 +255,7 @@ impl Builder {
         Ok(match kind {
             "diffuse" => self.diffuse(params, "reflectance", 0.5)?,
             "conductor" => self.conductor(params)?,
-            "dielectric" => {
-                let (au, av) = self.roughness(params)?;
-                if au != av {
-                    self.warn(
-                        "dielectric: anisotropic roughness is not supported; the mean α is used",
-                    );
-                }
-                MaterialDesc::Glass {
-                    reflectance: Rgb::ONE,
-                    transmittance: Rgb::ONE,
-                    roughness: 0.5 * (au + av),
-                    ior: self.eta(params)?,
-                    distribution: NormalDistribution::Ggx,
-                    fresnel: FresnelModel::Exact,
-                }
-            }
+            "dielectric" => self.dielectric(params)?,
             "thindielectric" => MaterialDesc::ThinGlass {
                 reflectance: Rgb::ONE,
                 transmittance: Rgb::ONE,
@@ -335,6 +320,39 @@ impl Builder {
             }
         };
         Ok(two_sided(m))
+    }
+
+    /// pbrt-v4's `dielectric`: smooth or rough glass, its roughness textured or anisotropic
+    /// where the file says so.
+    fn dielectric(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
+        let distribution = NormalDistribution::Ggx;
+        let ior = self.eta(params)?;
+        if let Some([alpha_u, alpha_v]) = self.textured_roughness(params)? {
+            return Ok(MaterialDesc::RoughGlass {
+                alpha_u,
+                alpha_v,
+                ior,
+                distribution,
+            });
+        }
+        let (au, av) = self.roughness(params)?;
+        Ok(if au == av {
+            MaterialDesc::Glass {
+                reflectance: Rgb::ONE,
+                transmittance: Rgb::ONE,
+                roughness: au,
+                ior,
+                distribution,
+                fresnel: FresnelModel::Exact,
+            }
+        } else {
+            MaterialDesc::RoughGlass {
+                alpha_u: TextureDesc::value(au),
+                alpha_v: TextureDesc::value(av),
+                ior,
+                distribution,
+            }
+        })
     }
 
     /// A conductor's complex index: from its `reflectance` r (pbrt-v4: η = 1 and
