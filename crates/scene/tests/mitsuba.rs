@@ -369,3 +369,25 @@ fn a_films_crop_window_is_the_part_of_the_image_to_render() {
     let e = mitsuba::load(&path).unwrap_err().to_string();
     assert!(e.contains("does not lie inside the 64 x 32 film"), "{e}");
 }
+
+#[test]
+fn a_rough_dielectric_with_two_roughnesses_is_anisotropic() {
+    use pathlab_render::desc::MaterialDesc;
+    let main = write(
+        "anisotropic-glass.xml",
+        r#"<scene version="3.0.0">
+  <shape type="sphere"><bsdf type="roughdielectric"><float name="alpha_u" value="0.05"/>
+    <float name="alpha_v" value="0.3"/><rgb name="specular_transmittance" value="0.5"/></bsdf></shape>
+  <shape type="rectangle"><bsdf type="roughdielectric"><float name="alpha" value="0.2"/></bsdf></shape>
+</scene>"#,
+    );
+    let desc = mitsuba::load(&main).unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let constant = |t: &pathlab_render::desc::TextureDesc| t.as_constant().map(|c| c.x);
+    assert!(desc.materials.iter().any(|m| matches!(m,
+        MaterialDesc::RoughGlass { alpha_u, alpha_v, transmittance, .. }
+            if constant(alpha_u) == Some(0.05) && constant(alpha_v) == Some(0.3)
+                && *transmittance == glam::Vec3::splat(0.5))));
+    assert!(desc.materials.iter().any(|m| matches!(m,
+        MaterialDesc::Glass { roughness, .. } if *roughness == 0.2)));
+}

@@ -268,14 +268,16 @@ fn rough_glass(d: &MaterialDesc, tex: &mut dyn FnMut(&TextureDesc) -> Tex) -> Ma
         ref alpha_v,
         ior,
         distribution,
+        reflectance,
+        transmittance,
     } = d
     else {
         unreachable!("rough_glass() is called with rough glass")
     };
     match (alpha_u.as_constant(), alpha_v.as_constant()) {
         (Some(a), Some(b)) if a == b => glass(&MaterialDesc::Glass {
-            reflectance: Rgb::ONE,
-            transmittance: Rgb::ONE,
+            reflectance,
+            transmittance,
             roughness: a.x,
             ior,
             distribution,
@@ -287,6 +289,8 @@ fn rough_glass(d: &MaterialDesc, tex: &mut dyn FnMut(&TextureDesc) -> Tex) -> Ma
                 alpha_v: tex(alpha_v),
                 eta: usable_ior(ior),
                 kind: distribution,
+                reflectance,
+                transmittance,
             },
             two_sided: false,
         }),

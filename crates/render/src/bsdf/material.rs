@@ -94,6 +94,10 @@ pub enum Model {
         eta: f32,
         /// The distribution.
         kind: NormalDistribution,
+        /// Reflectance scale.
+        reflectance: Rgb,
+        /// Transmittance scale.
+        transmittance: Rgb,
     },
     /// Rough plastic with a textured base.
     RoughPlastic {
@@ -464,19 +468,21 @@ impl Model {
                 alpha_v,
                 eta,
                 kind,
+                reflectance,
+                transmittance,
             } => {
                 let (au, av) = (alpha_u.eval_float(p), alpha_v.eval_float(p));
                 let bxdf = match Microfacet::unless_smooth(*kind, au, av) {
                     Some(distribution) => Bxdf::RoughDielectric(RoughDielectric {
                         eta: *eta,
                         distribution,
-                        reflectance: Rgb::ONE,
-                        transmittance: Rgb::ONE,
+                        reflectance: *reflectance,
+                        transmittance: *transmittance,
                     }),
                     None => Bxdf::Dielectric(SmoothDielectric {
                         eta: *eta,
-                        reflectance: Rgb::ONE,
-                        transmittance: Rgb::ONE,
+                        reflectance: *reflectance,
+                        transmittance: *transmittance,
                         fresnel: crate::desc::FresnelModel::Exact,
                     }),
                 };

@@ -285,7 +285,8 @@ pub enum MaterialDesc {
     },
     /// Rough glass whose roughness is textured or anisotropic (α along the surface's u tangent
     /// and along v; pbrt-v4's `dielectric` with roughness textures or `uroughness` ≠
-    /// `vroughness`), smooth where both are negligible.
+    /// `vroughness`, Mitsuba's `roughdielectric` with `alpha_u` ≠ `alpha_v`), smooth where both are
+    /// negligible.
     RoughGlass {
         /// Roughness along the u tangent.
         alpha_u: TextureDesc,
@@ -295,6 +296,10 @@ pub enum MaterialDesc {
         ior: f32,
         /// Microfacet distribution.
         distribution: NormalDistribution,
+        /// Reflectance scale.
+        reflectance: Rgb,
+        /// Transmittance scale.
+        transmittance: Rgb,
     },
     /// A diffuse base under a rough dielectric coat (Mitsuba's `roughplastic`).
     RoughPlastic {

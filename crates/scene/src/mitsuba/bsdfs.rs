@@ -89,21 +89,16 @@ fn nested<'t>(ctx: &Ctx<'t>, b: Obj) -> Result<Vec<Obj<'t>>, Error> {
         .collect())
 }
 
-/// Roughness α (isotropic) of a rough model.
-fn alpha(ctx: &mut Ctx, b: Obj) -> Result<f32, Error> {
+/// A rough dielectric's α along u and v: `alpha`, or `alpha_u` and `alpha_v` (Mitsuba's default
+/// 0.1 each).
+fn alphas(ctx: &mut Ctx, b: Obj) -> Result<(f32, f32), Error> {
     if ctx.has(b, "alpha_u") || ctx.has(b, "alpha_v") {
-        ctx.warn(
-            b.loc,
-            format!(
-                "{}: anisotropic roughness is drawn with alpha_u only",
-                ctx.what(b)
-            ),
-        );
-        let a = ctx.float(b, "alpha_u", 0.1)? as f32;
-        ctx.accept(b, &["alpha_v"]);
-        return Ok(a);
+        let u = ctx.float(b, "alpha_u", 0.1)? as f32;
+        let v = ctx.float(b, "alpha_v", 0.1)? as f32;
+        return Ok((u, v));
     }
-    Ok(ctx.float(b, "alpha", 0.1)? as f32)
+    let a = ctx.float(b, "alpha", 0.1)? as f32;
+    Ok((a, a))
 }
 
 /// The material for BSDF object `b`.
@@ -181,19 +176,31 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
             }
         }
         "dielectric" | "roughdielectric" => {
-            let (roughness, distribution) = if b.plugin == "roughdielectric" {
-                (alpha(ctx, b)?, distribution(ctx, b)?)
+            let ((alpha_u, alpha_v), distribution) = if b.plugin == "roughdielectric" {
+                (alphas(ctx, b)?, distribution(ctx, b)?)
             } else {
-                (0.0, NormalDistribution::Beckmann)
+                ((0.0, 0.0), NormalDistribution::Beckmann)
             };
             let (reflectance, transmittance) = specular_scales(ctx, b)?;
-            MaterialDesc::Glass {
-                reflectance,
-                transmittance,
-                roughness,
-                ior: relative_ior(ctx, b, BK7)?,
-                distribution,
-                fresnel: FresnelModel::Exact,
+            let ior = relative_ior(ctx, b, BK7)?;
+            if alpha_u == alpha_v {
+                MaterialDesc::Glass {
+                    reflectance,
+                    transmittance,
+                    roughness: alpha_u,
+                    ior,
+                    distribution,
+                    fresnel: FresnelModel::Exact,
+                }
+            } else {
+                MaterialDesc::RoughGlass {
+                    alpha_u: TextureDesc::value(alpha_u),
+                    alpha_v: TextureDesc::value(alpha_v),
+                    ior,
+                    distribution,
+                    reflectance,
+                    transmittance,
+                }
             }
         }
         "plastic" => MaterialDesc::Plastic {

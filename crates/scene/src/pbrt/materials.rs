@@ -333,6 +333,8 @@ impl Builder {
                 alpha_v,
                 ior,
                 distribution,
+                reflectance: Rgb::ONE,
+                transmittance: Rgb::ONE,
             });
         }
         let (au, av) = self.roughness(params)?;
@@ -351,6 +353,8 @@ impl Builder {
                 alpha_v: TextureDesc::value(av),
                 ior,
                 distribution,
+                reflectance: Rgb::ONE,
+                transmittance: Rgb::ONE,
             }
         })
     }
