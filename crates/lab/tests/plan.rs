@@ -1,7 +1,7 @@
 //! A render's plan: what the request leaves open the scene's hints, then the defaults, fill.
 
+use pathlab_lab::render::ProgressiveStop;
 use pathlab_lab::render::{Plan, RenderRequest, SceneEdits, PROGRESSIVE_CAP};
-use pathlab_lab::render::{ProgressiveStop, DEFAULT_SPP};
 use pathlab_mc::sampler::SamplerKind;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -77,10 +77,7 @@ fn defaults_fill_what_neither_says() {
         ..Default::default()
     };
     let p = plan(&req).0;
-    assert_eq!(
-        (p.spp, p.settings.sampler),
-        (DEFAULT_SPP, SamplerKind::Sobol)
-    );
+    assert_eq!((p.spp, p.settings.sampler), (64, SamplerKind::Sobol));
     assert_eq!((p.settings.crop, p.max_depth), (None, u32::MAX));
     // Progressive renders take independent samples, up to the cap.
     let req = RenderRequest {

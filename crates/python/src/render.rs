@@ -81,7 +81,7 @@ fn request(
     let hints = &scene.desc.hints;
     let spp = match spp {
         Some(n) => positive_u32(n, "spp")?,
-        None => hints.spp.unwrap_or(64),
+        None => hints.spp_or_default(),
     };
     let max_depth = match max_depth {
         Some(d) if d < 0 => {
@@ -114,7 +114,7 @@ fn request(
     let (name, integrator) = choice.integrator(hints);
     let sampler = match sampler {
         Some(s) => s.parse::<SamplerKind>().map_err(value_error)?,
-        None => hints.sampler.unwrap_or(SamplerKind::Sobol),
+        None => hints.sampler_or_default(false),
     };
     let resolution = match resolution {
         Some(r) => checked_resolution(r)?,

@@ -111,6 +111,24 @@ pub struct RenderHints {
     pub crop: Option<CropHint>,
 }
 
+impl RenderHints {
+    /// Samples per pixel when the caller does not say: the file's, else 64.
+    pub fn spp_or_default(&self) -> u32 {
+        self.spp.unwrap_or(64)
+    }
+
+    /// The sampler when the caller does not say: the file's, else Sobol (independent samples
+    /// for a progressive render, whose error estimate needs them).
+    pub fn sampler_or_default(&self, progressive: bool) -> pathlab_mc::sampler::SamplerKind {
+        use pathlab_mc::sampler::SamplerKind;
+        self.sampler.unwrap_or(if progressive {
+            SamplerKind::Independent
+        } else {
+            SamplerKind::Sobol
+        })
+    }
+}
+
 /// A crop window a scene file names: the pixels `x0 <= x < x1`, `y0 <= y < y1` of an image of
 /// size `of`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -20,8 +20,6 @@ use pathlab_render::scene::Scene;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-/// Samples per pixel when neither the caller nor the scene says.
-pub const DEFAULT_SPP: u32 = 64;
 /// Most samples a progressive render's pixel takes unless the caller caps it.
 pub const PROGRESSIVE_CAP: u32 = 65536;
 
@@ -120,14 +118,10 @@ impl Plan {
         req.edits.apply(&mut desc)?;
         let scene = Scene::build(&desc).context("cannot build the scene")?;
         let (integrator_name, integrator) = choice.integrator(&desc.hints);
-        let spp = req.spp.or(desc.hints.spp).unwrap_or(DEFAULT_SPP);
+        let spp = req.spp.unwrap_or(desc.hints.spp_or_default());
         let sampler = req
             .sampler
-            .or(desc.hints.sampler)
-            .unwrap_or(match req.progressive {
-                Some(_) => SamplerKind::Independent,
-                None => SamplerKind::Sobol,
-            });
+            .unwrap_or(desc.hints.sampler_or_default(req.progressive.is_some()));
         let mut settings = RenderSettings::new(spp, req.seed, sampler);
         settings.adaptive = req.adaptive;
         settings.crop = match req.crop {
