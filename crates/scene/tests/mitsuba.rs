@@ -371,7 +371,7 @@ fn a_films_crop_window_is_the_part_of_the_image_to_render() {
 }
 
 #[test]
-fn a_rough_dielectric_with_two_roughnesses_is_anisotropic() {
+fn a_rough_dielectric_with_two_roughnesses_or_a_textured_one_is_read_as_such() {
     use pathlab_render::desc::MaterialDesc;
     let main = write(
         "anisotropic-glass.xml",
@@ -379,6 +379,8 @@ fn a_rough_dielectric_with_two_roughnesses_is_anisotropic() {
   <shape type="sphere"><bsdf type="roughdielectric"><float name="alpha_u" value="0.05"/>
     <float name="alpha_v" value="0.3"/><rgb name="specular_transmittance" value="0.5"/></bsdf></shape>
   <shape type="rectangle"><bsdf type="roughdielectric"><float name="alpha" value="0.2"/></bsdf></shape>
+  <shape type="cube"><bsdf type="roughdielectric"><texture type="checkerboard" name="alpha">
+    <float name="color0" value="0.1"/><float name="color1" value="0.3"/></texture></bsdf></shape>
 </scene>"#,
     );
     let desc = mitsuba::load(&main).unwrap();
@@ -390,4 +392,8 @@ fn a_rough_dielectric_with_two_roughnesses_is_anisotropic() {
                 && *transmittance == glam::Vec3::splat(0.5))));
     assert!(desc.materials.iter().any(|m| matches!(m,
         MaterialDesc::Glass { roughness, .. } if *roughness == 0.2)));
+    // A textured α: the textured rough glass, the same texture along u and v.
+    assert!(desc.materials.iter().any(|m| matches!(m,
+        MaterialDesc::RoughGlass { alpha_u, alpha_v, .. }
+            if constant(alpha_u).is_none() && alpha_u == alpha_v)));
 }

@@ -89,16 +89,22 @@ fn nested<'t>(ctx: &Ctx<'t>, b: Obj) -> Result<Vec<Obj<'t>>, Error> {
         .collect())
 }
 
-/// A rough dielectric's α along u and v: `alpha`, or `alpha_u` and `alpha_v` (Mitsuba's default
-/// 0.1 each).
-fn alphas(ctx: &mut Ctx, b: Obj) -> Result<(f32, f32), Error> {
+/// A rough model's α along u and v, each a number or a texture: `alpha`, or `alpha_u` and
+/// `alpha_v` (Mitsuba's default 0.1 each).
+fn alphas(ctx: &mut Ctx, b: Obj) -> Result<(TextureDesc, TextureDesc), Error> {
+    let alpha =
+        |ctx: &mut Ctx, name| ctx.texture(b, name, Vec3::splat(0.1), SpectrumKind::Unbounded);
     if ctx.has(b, "alpha_u") || ctx.has(b, "alpha_v") {
-        let u = ctx.float(b, "alpha_u", 0.1)? as f32;
-        let v = ctx.float(b, "alpha_v", 0.1)? as f32;
-        return Ok((u, v));
+        if ctx.has(b, "alpha") {
+            return Err(ctx.error(
+                b.loc,
+                format!("{}: give either alpha or alpha_u and alpha_v", ctx.what(b)),
+            ));
+        }
+        return Ok((alpha(ctx, "alpha_u")?, alpha(ctx, "alpha_v")?));
     }
-    let a = ctx.float(b, "alpha", 0.1)? as f32;
-    Ok((a, a))
+    let a = alpha(ctx, "alpha")?;
+    Ok((a.clone(), a))
 }
 
 /// The material for BSDF object `b`.
@@ -179,28 +185,28 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
             let ((alpha_u, alpha_v), distribution) = if b.plugin == "roughdielectric" {
                 (alphas(ctx, b)?, distribution(ctx, b)?)
             } else {
-                ((0.0, 0.0), NormalDistribution::Beckmann)
+                let smooth = TextureDesc::value(0.0);
+                ((smooth.clone(), smooth), NormalDistribution::Beckmann)
             };
             let (reflectance, transmittance) = specular_scales(ctx, b)?;
             let ior = relative_ior(ctx, b, BK7)?;
-            if alpha_u == alpha_v {
-                MaterialDesc::Glass {
+            match (alpha_u.as_constant(), alpha_v.as_constant()) {
+                (Some(u), Some(v)) if u == v => MaterialDesc::Glass {
                     reflectance,
                     transmittance,
-                    roughness: alpha_u,
+                    roughness: u.x,
                     ior,
                     distribution,
                     fresnel: FresnelModel::Exact,
-                }
-            } else {
-                MaterialDesc::RoughGlass {
-                    alpha_u: TextureDesc::value(alpha_u),
-                    alpha_v: TextureDesc::value(alpha_v),
+                },
+                _ => MaterialDesc::RoughGlass {
+                    alpha_u,
+                    alpha_v,
                     ior,
                     distribution,
                     reflectance,
                     transmittance,
-                }
+                },
             }
         }
         "plastic" => MaterialDesc::Plastic {
@@ -311,21 +317,7 @@ fn conductor(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
         }
     } else {
         let distribution = distribution(ctx, b)?;
-        let (alpha_u, alpha_v) = if ctx.has(b, "alpha_u") || ctx.has(b, "alpha_v") {
-            if ctx.has(b, "alpha") {
-                return Err(ctx.error(
-                    b.loc,
-                    format!("{}: give either alpha or alpha_u and alpha_v", ctx.what(b)),
-                ));
-            }
-            (
-                ctx.texture(b, "alpha_u", Vec3::splat(0.1), SpectrumKind::Unbounded)?,
-                ctx.texture(b, "alpha_v", Vec3::splat(0.1), SpectrumKind::Unbounded)?,
-            )
-        } else {
-            let a = ctx.texture(b, "alpha", Vec3::splat(0.1), SpectrumKind::Unbounded)?;
-            (a.clone(), a)
-        };
+        let (alpha_u, alpha_v) = alphas(ctx, b)?;
         MaterialDesc::RoughConductor {
             alpha_u,
             alpha_v,
