@@ -181,34 +181,7 @@ pub(super) fn bsdf(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
                 ior: relative_ior(ctx, b, BK7)?,
             }
         }
-        "dielectric" | "roughdielectric" => {
-            let ((alpha_u, alpha_v), distribution) = if b.plugin == "roughdielectric" {
-                (alphas(ctx, b)?, distribution(ctx, b)?)
-            } else {
-                let smooth = TextureDesc::value(0.0);
-                ((smooth.clone(), smooth), NormalDistribution::Beckmann)
-            };
-            let (reflectance, transmittance) = specular_scales(ctx, b)?;
-            let ior = relative_ior(ctx, b, BK7)?;
-            match (alpha_u.as_constant(), alpha_v.as_constant()) {
-                (Some(u), Some(v)) if u == v => MaterialDesc::Glass {
-                    reflectance,
-                    transmittance,
-                    roughness: u.x,
-                    ior,
-                    distribution,
-                    fresnel: FresnelModel::Exact,
-                },
-                _ => MaterialDesc::RoughGlass {
-                    alpha_u,
-                    alpha_v,
-                    ior,
-                    distribution,
-                    reflectance,
-                    transmittance,
-                },
-            }
-        }
+        "dielectric" | "roughdielectric" => dielectric(ctx, b)?,
         "plastic" => MaterialDesc::Plastic {
             specular: ctx.color(
                 b,
@@ -326,6 +299,37 @@ fn conductor(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
             specular,
             distribution,
         }
+    })
+}
+
+/// Mitsuba's `dielectric` and `roughdielectric`: glass of one roughness, or of roughness that
+/// is textured or differs along u and v.
+fn dielectric(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
+    let ((alpha_u, alpha_v), distribution) = if b.plugin == "roughdielectric" {
+        (alphas(ctx, b)?, distribution(ctx, b)?)
+    } else {
+        let smooth = TextureDesc::value(0.0);
+        ((smooth.clone(), smooth), NormalDistribution::Beckmann)
+    };
+    let (reflectance, transmittance) = specular_scales(ctx, b)?;
+    let ior = relative_ior(ctx, b, BK7)?;
+    Ok(match (alpha_u.as_constant(), alpha_v.as_constant()) {
+        (Some(u), Some(v)) if u == v => MaterialDesc::Glass {
+            reflectance,
+            transmittance,
+            roughness: u.x,
+            ior,
+            distribution,
+            fresnel: FresnelModel::Exact,
+        },
+        _ => MaterialDesc::RoughGlass {
+            alpha_u,
+            alpha_v,
+            ior,
+            distribution,
+            reflectance,
+            transmittance,
+        },
     })
 }
 

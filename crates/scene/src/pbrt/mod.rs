@@ -8,15 +8,17 @@
 //! - Handedness: pbrt's camera space is left-handed (x right, y up, z forward). When the
 //!   camera's transform keeps orientation, the whole world is mirrored in x (camera included),
 //!   which renders the same image with pathlab's right-handed camera.
-//! - The graphics state's transforms and attributes ([`state`]); shapes ([`shapes`]),
-//!   materials ([`materials`]), textures ([`textures`]), spectra ([`spectra`]); lights,
-//!   camera, film, sampler and integrator ([`world`]). What pathlab cannot render is a warning naming the
-//!   file and line, never ignored silently.
+//! - The graphics state's transforms and attributes ([`state`]); shapes ([`shapes`], the
+//!   quadrics in [`quadrics`]), materials ([`materials`]), textures ([`textures`]), spectra
+//!   ([`spectra`]), lights ([`lights`]); camera, film, sampler and integrator ([`world`]). What
+//!   pathlab cannot render is a warning naming the file and line, never ignored silently.
 
 mod lexer;
+mod lights;
 mod loop_subdiv;
 mod materials;
 mod params;
+mod quadrics;
 mod shapes;
 mod spectra;
 mod state;
