@@ -204,15 +204,17 @@ fn bad_files_are_one_line_errors_with_file_and_line() {
         ("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 5 ]\n", "out of range", 2),
         ("Camera \"perspective\"\n", "no WorldBegin", 0),
         ("WorldBegin\nInclude \"missing.pbrt\"\n", "missing.pbrt", 0),
-        ("WorldBegin\nShape \"plymesh\" \"string filename\" \"no.ply\"\n", "", 0),
+        ("WorldBegin\nShape \"plymesh\" \"string filename\" \"no.ply\"\n", "no.ply", 0),
+        ("WorldBegin\nShape \"plymesh\" \"string filename\" \"no.ply.gz\"\n", "no.ply.gz", 0),
     ];
     for (i, (text, expected, line)) in cases.iter().enumerate() {
         let result = load_text(&format!("bad{i}"), &[("bad.pbrt", text)]);
         let Err(e) = result else {
-            // A missing PLY is a warning, the scene still loads.
+            // A missing file (a PLY mesh, an include) is a warning naming it; the scene
+            // still loads.
             let desc = result.unwrap();
             assert!(
-                desc.warnings.iter().any(|w| w.contains("no.ply")),
+                desc.warnings.iter().any(|w| w.contains(expected)),
                 "case {i}: {:?}",
                 desc.warnings
             );
@@ -316,4 +318,38 @@ Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indi
     let desc = pathlab_scene::load(dir.join("side.pbrt").to_str().unwrap()).unwrap();
     let l = render_film(&desc, 256, 3).image_mean();
     assert!((l.x - 0.5).abs() < 0.02, "floor radiance {l}");
+}
+
+#[test]
+fn a_scene_missing_some_of_its_files_warns_once_for_each_and_renders() {
+    // As Bitterli's scenes are found in some mirrors: textures, meshes (one used twice) and an
+    // included file left out.
+    let scene = r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective"
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+WorldBegin
+LightSource "infinite" "string filename" "textures/sky.exr"
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+Texture "wood" "spectrum" "imagemap" "string filename" "textures/wood.png"
+Material "diffuse" "texture reflectance" "wood"
+Shape "plymesh" "string filename" "models/mesh1.ply"
+Shape "plymesh" "string filename" "models/mesh1.ply"
+Shape "plymesh" "string filename" "models/mesh2.ply.gz"
+Include "geometry.pbrt"
+Shape "sphere"
+"#;
+    let desc = load_text("missing-files", &[("scene.pbrt", scene)]).unwrap();
+    let missing = [
+        "sky.exr",
+        "wood.png",
+        "mesh1.ply",
+        "mesh2.ply.gz",
+        "geometry.pbrt",
+    ];
+    assert_eq!(desc.warnings.len(), missing.len(), "{:?}", desc.warnings);
+    for (w, name) in desc.warnings.iter().zip(missing) {
+        assert!(w.contains(name), "{w} should name {name}");
+    }
+    let film = render_film(&desc, 4, 1);
+    assert!(film.image_mean().min_element() > 0.0 && film.image_mean().is_finite());
 }

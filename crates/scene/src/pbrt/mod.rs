@@ -383,6 +383,15 @@ impl Builder {
                     )));
                 }
                 let path = self.resolve(&name);
+                // A file that is not there is a warning (scenes are shared without some of
+                // their parts); one that cannot be read or parsed is an error.
+                if !path.exists() {
+                    self.warn(format!(
+                        "{word} \"{name}\": {} does not exist; its contents are skipped",
+                        path.display()
+                    ));
+                    return Ok(true);
+                }
                 let line = self.line;
                 self.parse_file(&path, depth + 1)?;
                 self.line = line;

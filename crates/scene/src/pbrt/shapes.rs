@@ -370,9 +370,12 @@ impl Builder {
                 let gz = path
                     .extension()
                     .is_some_and(|e| e.eq_ignore_ascii_case("gz"));
+                // A file that cannot be opened is a warning (scenes are shared without some of
+                // their meshes); one that does not decompress or parse is an error.
                 let mesh = if gz {
-                    let bytes = super::read_bytes(&path)?;
-                    crate::meshfile::ply_mesh_from(&mut std::io::Cursor::new(bytes), &path)
+                    super::read_bytes(&path).and_then(|bytes| {
+                        crate::meshfile::ply_mesh_from(&mut std::io::Cursor::new(bytes), &path)
+                    })
                 } else {
                     crate::meshfile::ply_mesh(&path)
                 };
