@@ -67,6 +67,26 @@ def test_a_mitsuba_file_takes_parameters(data):
     assert np.array_equal(image, pathlab.render(scene, seed=1, max_depth=2))
 
 
+def test_a_files_crop_window_is_the_part_rendered(tmp_path):
+    # pbrt-v4's cropwindow [x0 x1 y0 y1] as fractions: the middle half of the top half.
+    path = tmp_path / "crop.pbrt"
+    path.write_text(
+        'LookAt 0 0 5  0 0 0  0 1 0\n'
+        'Camera "perspective"\n'
+        'Film "rgb" "integer xresolution" 40 "integer yresolution" 20'
+        ' "float cropwindow" [ 0.25 0.75 0 0.5 ]\n'
+        "WorldBegin\n"
+        'LightSource "infinite" "rgb L" [ 1 1 1 ]\n'
+        'Shape "sphere"\n'
+    )
+    image = pathlab.render(pathlab.load(str(path)), spp=4, seed=1)
+    assert image.shape == (20, 40, 3)
+    inside = np.zeros(image.shape[:2], dtype=bool)
+    inside[0:10, 10:30] = True
+    assert (image[inside] > 0).all()
+    assert (image[~inside] == 0).all()
+
+
 def test_parameters_a_format_cannot_use_are_warned_about():
     with pytest.warns(UserWarning, match="parameter 'resx' is not used"):
         pathlab.load("cornell-box", resx=64)

@@ -2,6 +2,10 @@
 //! the scene's hints complete it ([`Plan`]): the scene loaded, edited and built, the integrator
 //! chosen, the samples, sampler and adaptive rule settled, and its film files' header. The
 //! plan then runs as a [`RenderJob`], and [`summary`] says what was made.
+//!
+//! Errors about what depends on the scene (a crop window past its image, a bounce beyond its
+//! largest, a shard of more parts than samples) name the command line's flags, whose values
+//! the request carries.
 
 pub mod edits;
 pub mod summary;
