@@ -442,6 +442,10 @@ AttributeEnd
     for t in mesh.indices.chunks_exact(3) {
         let p = [0, 1, 2].map(|k| mesh.positions[t[k] as usize].as_dvec3());
         let cross = (p[1] - p[0]).cross(p[2] - p[0]);
+        if cross == DVec3::ZERO {
+            // Collapsed at the pole: no area, and dropped when the scene is built.
+            continue;
+        }
         area += 0.5 * cross.length();
         let outward = (p[0] + p[1] + p[2]) / 3.0 - centre;
         assert!(cross.dot(outward) > 0.0, "a triangle faces inwards");

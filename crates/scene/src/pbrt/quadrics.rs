@@ -19,8 +19,8 @@ pub(super) enum SphereExtent {
 /// The part of the sphere of `radius` between heights `z0 < z1` and azimuths 0 to `phi_max`
 /// (radians): [`SEGMENTS`] columns over the azimuths, rows evenly spaced in θ (as many per
 /// radian as the columns of a whole turn), vertices on the sphere with its normals, pbrt-v4's
-/// (u, v), outward-facing triangles; the triangles that a pole would make degenerate are left
-/// out.
+/// (u, v), outward-facing triangles (those a pole makes degenerate are dropped when the scene
+/// is built, as every mesh's are).
 fn partial_sphere(radius: f64, z0: f64, z1: f64, phi_max: f64) -> ObjectMesh {
     let (theta0, theta1) = ((z0 / radius).acos(), (z1 / radius).acos());
     let rows = ((theta0 - theta1) / std::f64::consts::TAU * SEGMENTS as f64)
@@ -40,20 +40,22 @@ fn partial_sphere(radius: f64, z0: f64, z1: f64, phi_max: f64) -> ObjectMesh {
             m.uvs.push(Vec2::new(u as f32, v as f32));
         }
     }
-    let column = rows as u32 + 1;
+    grid_triangles(&mut m, rows as u32 + 1);
+    m
+}
+
+/// The triangles of a tessellated quadric whose vertices run in [`SEGMENTS`] + 1 columns
+/// (one per azimuth step) of `per_column` each: two per cell, wound as a column's first
+/// vertex, the next column's, then the next column's second (the outward side of a disk's
+/// annulus and of the cylinder and sphere walls).
+fn grid_triangles(m: &mut ObjectMesh, per_column: u32) {
     for i in 0..SEGMENTS as u32 {
-        for j in 0..rows as u32 {
-            let (a, b) = (i * column + j, i * column + j + 1);
-            let (c, d) = (a + column, b + column);
-            for t in [[a, c, d], [a, d, b]] {
-                let p = t.map(|k| m.positions[k as usize]);
-                if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 1e-24 * radius.powi(4) {
-                    m.indices.extend(t);
-                }
-            }
+        for j in 0..per_column - 1 {
+            let (a, b) = (i * per_column + j, i * per_column + j + 1);
+            let (c, d) = (a + per_column, b + per_column);
+            m.indices.extend([a, c, d, a, d, b]);
         }
     }
-    m
 }
 
 impl Builder {
@@ -81,11 +83,8 @@ impl Builder {
             m.uvs.push(Vec2::new(u, 0.0));
             m.uvs.push(Vec2::new(u, 1.0));
         }
-        for i in 0..SEGMENTS as u32 {
-            let (o0, i0, o1, i1) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
-            // Counter-clockwise seen from +z.
-            m.indices.extend([o0, o1, i1, o0, i1, i0]);
-        }
+        // Outer then inner in each column: counter-clockwise seen from +z.
+        grid_triangles(&mut m, 2);
         Ok(m)
     }
 
@@ -110,10 +109,7 @@ impl Builder {
                 m.normals.push(DVec3::new(c, s, 0.0));
             }
         }
-        for i in 0..SEGMENTS as u32 {
-            let (a, b, c, d) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
-            m.indices.extend([a, c, d, a, d, b]);
-        }
+        grid_triangles(&mut m, 2);
         Ok(m)
     }
 
