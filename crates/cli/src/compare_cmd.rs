@@ -72,10 +72,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         })
         .collect::<Result<Vec<_>>>()?;
     let mut desc = pathlab_scene::load(&args.scene)?;
-    pathlab_lab::render::apply_resolution(
-        &mut desc,
-        args.resolution.as_deref().map(|r| [r[0], r[1]]),
-    )?;
+    pathlab_lab::render::apply_resolution(&mut desc, crate::image_size(&args.resolution))?;
     let [w, h] = desc.resolution;
     let reference = args
         .reference

@@ -52,10 +52,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
     let format = plot::Format::from_path(&args.output)?;
     let mut desc = pathlab_scene::load(&args.scene)?;
-    pathlab_lab::render::apply_resolution(
-        &mut desc,
-        args.resolution.as_deref().map(|r| [r[0], r[1]]),
-    )?;
+    pathlab_lab::render::apply_resolution(&mut desc, crate::image_size(&args.resolution))?;
     let reference = read_reference(&args.reference, desc.resolution)?;
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let integrator = IntegratorKind::Path(PathIntegrator {

@@ -78,6 +78,11 @@ fn main() -> ExitCode {
     }
 }
 
+/// A `-r W H` flag (clap takes exactly two values) as a size.
+pub(crate) fn image_size(resolution: &Option<Vec<u32>>) -> Option<[u32; 2]> {
+    resolution.as_deref().map(|r| [r[0], r[1]])
+}
+
 /// The first paragraph of clap's message as one line: "the following required arguments were
 /// not provided:" keeps the arguments listed under it.
 fn first_paragraph(text: &str) -> String {

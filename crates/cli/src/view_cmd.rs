@@ -36,10 +36,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     for w in &desc.warnings {
         eprintln!("warning: {w}");
     }
-    pathlab_lab::render::apply_resolution(
-        &mut desc,
-        args.resolution.as_deref().map(|r| [r[0], r[1]]),
-    )?;
+    pathlab_lab::render::apply_resolution(&mut desc, crate::image_size(&args.resolution))?;
     let signals = crate::farm::Signals::install();
     let options = ViewOptions {
         host: args.host.clone(),

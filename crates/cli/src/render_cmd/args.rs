@@ -400,7 +400,7 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
             focal_distance: args.focal_distance,
             envmap: args.envmap.clone().map(|e| (e, args.envmap_scale)),
             schlick_fresnel: args.fresnel == FresnelName::Schlick,
-            resolution: args.resolution.as_deref().map(|r| [r[0], r[1]]),
+            resolution: crate::image_size(&args.resolution),
             scale: args.scale,
             fov: args.fov,
         },
