@@ -12,6 +12,14 @@ use pathlab_render::desc::{
     CoatedBase, CoatedDesc, FresnelModel, MaterialDesc, NormalDistribution, Rgb, TextureDesc,
 };
 
+/// A surface's roughness as pbrt-v4's conductors and dielectrics give it.
+enum Roughness {
+    /// One α everywhere, both ways.
+    Isotropic(f32),
+    /// α along u and along v, textures (constants where the two numbers differ).
+    Varying([TextureDesc; 2]),
+}
+
 impl Builder {
     /// A float parameter (exactly one value, as pbrt-v4 requires) or `default`.
     pub(crate) fn float(&self, params: &ParamList, name: &str, default: f64) -> Result<f64, Error> {
@@ -130,9 +138,18 @@ impl Builder {
         self.float(params, name, default)
     }
 
-    /// `roughness`, `uroughness`, `vroughness` and `remaproughness` as (α_u, α_v).
-    fn roughness(&mut self, params: &ParamList) -> Result<(f32, f32), Error> {
-        self.roughness_of(params, "")
+    /// `roughness`, `uroughness`, `vroughness` and `remaproughness` of a conductor or a
+    /// dielectric: one α, or α along u and v where they differ or are textured.
+    fn surface_roughness(&mut self, params: &ParamList) -> Result<Roughness, Error> {
+        if let Some(alphas) = self.textured_roughness(params)? {
+            return Ok(Roughness::Varying(alphas));
+        }
+        let (au, av) = self.roughness_of(params, "")?;
+        Ok(if au == av {
+            Roughness::Isotropic(au)
+        } else {
+            Roughness::Varying([TextureDesc::value(au), TextureDesc::value(av)])
+        })
     }
 
     /// `roughness`, `uroughness` and `vroughness` as α along u and v, each a texture, where
@@ -289,37 +306,25 @@ impl Builder {
 
     /// pbrt-v4's `conductor`: by its `reflectance`, or `eta` and `k` (copper by default), smooth or rough (anisotropic where `uroughness` and `vroughness` differ).
     fn conductor(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
-        if let Some([alpha_u, alpha_v]) = self.textured_roughness(params)? {
-            let (eta, k) = self.conductor_optics(params, "eta", "k")?;
-            return Ok(two_sided(MaterialDesc::RoughConductor {
+        let roughness = self.surface_roughness(params)?;
+        let (eta, k) = self.conductor_optics(params, "eta", "k")?;
+        let distribution = NormalDistribution::Ggx;
+        Ok(two_sided(match roughness {
+            Roughness::Isotropic(alpha) => MaterialDesc::Conductor {
+                alpha,
+                eta,
+                k,
+                distribution,
+            },
+            Roughness::Varying([alpha_u, alpha_v]) => MaterialDesc::RoughConductor {
                 alpha_u,
                 alpha_v,
                 eta,
                 k,
                 specular: TextureDesc::value(1.0),
-                distribution: NormalDistribution::Ggx,
-            }));
-        }
-        let (au, av) = self.roughness(params)?;
-        let (eta, k) = self.conductor_optics(params, "eta", "k")?;
-        let m = if au == av {
-            MaterialDesc::Conductor {
-                alpha: au,
-                eta,
-                k,
-                distribution: NormalDistribution::Ggx,
-            }
-        } else {
-            MaterialDesc::RoughConductor {
-                alpha_u: TextureDesc::value(au),
-                alpha_v: TextureDesc::value(av),
-                eta,
-                k,
-                specular: TextureDesc::value(1.0),
-                distribution: NormalDistribution::Ggx,
-            }
-        };
-        Ok(two_sided(m))
+                distribution,
+            },
+        }))
     }
 
     /// pbrt-v4's `dielectric`: smooth or rough glass, its roughness textured or anisotropic
@@ -327,35 +332,23 @@ impl Builder {
     fn dielectric(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
         let distribution = NormalDistribution::Ggx;
         let ior = self.eta(params)?;
-        if let Some([alpha_u, alpha_v]) = self.textured_roughness(params)? {
-            return Ok(MaterialDesc::RoughGlass {
+        Ok(match self.surface_roughness(params)? {
+            Roughness::Isotropic(roughness) => MaterialDesc::Glass {
+                reflectance: Rgb::ONE,
+                transmittance: Rgb::ONE,
+                roughness,
+                ior,
+                distribution,
+                fresnel: FresnelModel::Exact,
+            },
+            Roughness::Varying([alpha_u, alpha_v]) => MaterialDesc::RoughGlass {
                 alpha_u,
                 alpha_v,
                 ior,
                 distribution,
                 reflectance: Rgb::ONE,
                 transmittance: Rgb::ONE,
-            });
-        }
-        let (au, av) = self.roughness(params)?;
-        Ok(if au == av {
-            MaterialDesc::Glass {
-                reflectance: Rgb::ONE,
-                transmittance: Rgb::ONE,
-                roughness: au,
-                ior,
-                distribution,
-                fresnel: FresnelModel::Exact,
-            }
-        } else {
-            MaterialDesc::RoughGlass {
-                alpha_u: TextureDesc::value(au),
-                alpha_v: TextureDesc::value(av),
-                ior,
-                distribution,
-                reflectance: Rgb::ONE,
-                transmittance: Rgb::ONE,
-            }
+            },
         })
     }
 
