@@ -4,9 +4,11 @@
 //!
 //! The light type and what every light answers (`mod.rs`); area lights' shapes, textures and the
 //! triangle emitter shared with the packet path (`area`); projectors (`projector`); environment
-//! maps (`envmap`); choosing a light (`sampler`).
+//! maps (`envmap`); choosing a light (`sampler`); rays of emitted light, where the bidirectional
+//! path tracer's light subpaths start (`emission`).
 
 mod area;
+mod emission;
 pub mod envmap;
 mod projector;
 mod sampler;
@@ -14,6 +16,7 @@ mod sampler;
 pub use area::{
     sphere_uv, AreaShape, AreaTexture, AreaTriangle, TriangleEmitter, TriangleLiSample,
 };
+pub use emission::LightLeSample;
 pub use projector::Projector;
 pub use sampler::LightSampler;
 
