@@ -218,6 +218,38 @@ impl Bsdf {
             .sum()
     }
 
+    /// f(wi, wo) |cos θi|: the adjoint of [`Bsdf::f_cos`], for importance carried from the
+    /// lights (pbrt-v4's `TransportMode::Importance`): light that arrived along `wo` leaving
+    /// along `wi`, foreshortened on the side it leaves. The radiance BSDF with its directions
+    /// exchanged is its adjoint, so that refraction's 1/η² scaling of radiance, which
+    /// importance does not undergo, comes out right without a mode in every model.
+    pub fn f_cos_importance(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        self.lobes()
+            .map(|l| {
+                l.bxdf.f(l.frame.to_local(wi), l.frame.to_local(wo))
+                    * (l.weight * l.attenuation(wo) * wi.dot(l.frame.n).abs())
+            })
+            .sum()
+    }
+
+    /// The factor that turns the weight f cos / p of a delta sample from `wo` to `wi`, which
+    /// [`Bsdf::sample_f`] gives for radiance, into the one for importance: η'² for a
+    /// refraction through smooth glass (η' the relative index along the sample; radiance is
+    /// scaled by 1/η'² crossing the interface, importance is not), one for anything else.
+    pub fn delta_importance_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
+        for l in self.lobes() {
+            if let Bxdf::Dielectric(d) = l.bxdf {
+                let (o, i) = (l.frame.to_local(wo), l.frame.to_local(wi));
+                if let Some((t, etap)) = refract(o, d.eta) {
+                    if o.z * i.z < 0.0 && t.dot(i) > 1.0 - 1e-4 {
+                        return etap * etap;
+                    }
+                }
+            }
+        }
+        1.0
+    }
+
     /// Whether every lobe is a delta distribution (light sampling can never help).
     pub fn is_delta(&self) -> bool {
         self.lobes().all(|l| l.bxdf.is_delta() || l.weight <= 0.0)
