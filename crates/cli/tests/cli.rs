@@ -61,7 +61,7 @@ fn render_writes_png_exr_and_aovs_with_statistics() {
     );
     let (w, h, px) = pathlab_render::image_io::read_exr_rgb(&exr).unwrap();
     assert_eq!((w, h, px.len()), (16, 16, 256));
-    for view in ["normals", "depth", "bvh"] {
+    for view in ["normals", "depth", "bvh", "bdpt"] {
         let out = pathlab(&[
             "render",
             "--integrator",
@@ -85,8 +85,8 @@ fn render_writes_png_exr_and_aovs_with_statistics() {
 
 #[test]
 fn render_same_seed_same_image_for_any_thread_count() {
-    let run = |threads: &str, name: &str| {
-        let path = scratch(name);
+    let run = |threads: &str, integrator: &str| {
+        let path = scratch(&format!("t{threads}-{integrator}.exr"));
         let out = pathlab(&[
             "render",
             "-s",
@@ -98,6 +98,8 @@ fn render_same_seed_same_image_for_any_thread_count() {
             threads,
             "--seed",
             "5",
+            "--integrator",
+            integrator,
             "-o",
             path.to_str().unwrap(),
             "-q",
@@ -105,7 +107,9 @@ fn render_same_seed_same_image_for_any_thread_count() {
         assert!(out.status.success());
         pathlab_render::image_io::read_exr_rgb(&path).unwrap().2
     };
-    assert_eq!(run("1", "t1.exr"), run("2", "t2.exr"));
+    for integrator in ["path", "bdpt"] {
+        assert_eq!(run("1", integrator), run("2", integrator), "{integrator}");
+    }
 }
 
 #[test]

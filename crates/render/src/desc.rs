@@ -171,6 +171,8 @@ impl CropHint {
 pub enum IntegratorHint {
     /// Path tracing (also what a particle tracer's image converges to).
     Path,
+    /// Bidirectional path tracing.
+    Bdpt,
     /// Direct lighting with `emitter_samples` light samples and `bsdf_samples` BSDF samples
     /// per pixel sample, combined by the power heuristic.
     Direct {

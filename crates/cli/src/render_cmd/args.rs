@@ -152,7 +152,9 @@ pub struct RenderArgs {
     #[arg(short = 'o', long, visible_short_alias = 'f', value_name = "FILE")]
     pub output: Vec<PathBuf>,
     /// The integrator: path (path tracing with next-event estimation, MIS and Russian
-    /// roulette), direct (direct lighting only, by the strategy --direct names), or the debug
+    /// roulette), bdpt (bidirectional path tracing: camera and light subpaths joined by every
+    /// strategy but light tracing, weighted by MIS), direct (direct lighting only, by the
+    /// strategy --direct names), or the debug
     /// views normals (shading normals), depth (distance to the first surface) and bvh (BVH
     /// nodes visited per camera ray). Default: the one the scene file names, else path.
     #[arg(long)]
@@ -327,7 +329,7 @@ fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>>
     if args.only_bounce.is_some() && !path {
         unused("--only-bounce", "the path tracer (--integrator path)");
     }
-    if debug && args.light_samples > 1 {
+    if (debug || integrator == Some(IntegratorName::Bdpt)) && args.light_samples > 1 {
         unused("--light-samples", "the path and direct integrators");
     }
     if args.adaptive_rule.is_some() && args.adaptive.is_none() {

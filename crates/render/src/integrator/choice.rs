@@ -3,7 +3,8 @@
 //! Python module's `render` arguments all turn into an [`IntegratorKind`].
 
 use super::{
-    DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator, PathLighting,
+    BdptIntegrator, DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
+    PathLighting,
 };
 use crate::desc::{IntegratorHint, RenderHints};
 
@@ -12,6 +13,8 @@ use crate::desc::{IntegratorHint, RenderHints};
 pub enum IntegratorName {
     /// Path tracing with next-event estimation, MIS and Russian roulette.
     Path,
+    /// Bidirectional path tracing.
+    Bdpt,
     /// Direct lighting only, by a [`DirectStrategy`].
     Direct,
     /// Debug view: shading normals.
@@ -24,8 +27,9 @@ pub enum IntegratorName {
 
 impl IntegratorName {
     /// Every integrator.
-    pub const ALL: [IntegratorName; 5] = [
+    pub const ALL: [IntegratorName; 6] = [
         IntegratorName::Path,
+        IntegratorName::Bdpt,
         IntegratorName::Direct,
         IntegratorName::Normals,
         IntegratorName::Depth,
@@ -36,6 +40,7 @@ impl IntegratorName {
     pub fn name(self) -> &'static str {
         match self {
             IntegratorName::Path => "path",
+            IntegratorName::Bdpt => "bdpt",
             IntegratorName::Direct => "direct",
             IntegratorName::Normals => "normals",
             IntegratorName::Depth => "depth",
@@ -51,7 +56,9 @@ impl std::str::FromStr for IntegratorName {
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(s))
             .ok_or_else(|| {
-                format!("unknown integrator '{s}' (expected path, direct, normals, depth or bvh)")
+                format!(
+                    "unknown integrator '{s}' (expected path, bdpt, direct, normals, depth or bvh)"
+                )
             })
     }
 }
@@ -101,6 +108,7 @@ impl IntegratorChoice {
     pub fn integrator(&self, hints: &RenderHints) -> (IntegratorName, IntegratorKind) {
         let name = self.name.unwrap_or(match hints.integrator {
             Some(IntegratorHint::Direct { .. }) => IntegratorName::Direct,
+            Some(IntegratorHint::Bdpt) => IntegratorName::Bdpt,
             _ => IntegratorName::Path,
         });
         let kind = match name {
@@ -112,6 +120,11 @@ impl IntegratorChoice {
                 only_bounce: self.only_bounce,
                 light_samples: self.light_samples,
                 lighting: self.lighting,
+            }),
+            IntegratorName::Bdpt => IntegratorKind::Bdpt(BdptIntegrator {
+                max_depth: self.max_depth(hints),
+                rr_depth: self.rr_depth.or(hints.rr_depth).unwrap_or(5),
+                hide_emitters: hints.hide_emitters,
             }),
             IntegratorName::Direct => IntegratorKind::Direct(DirectIntegrator {
                 strategy: self.direct.unwrap_or(DirectStrategy::Mis),

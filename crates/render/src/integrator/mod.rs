@@ -3,16 +3,20 @@
 //! - [`PathIntegrator`]: unidirectional path tracing with next-event estimation, multiple
 //!   importance sampling of light and BSDF samples (power heuristic), Russian roulette and
 //!   per-bounce output;
+//! - [`BdptIntegrator`]: bidirectional path tracing, camera and light subpaths joined by every
+//!   strategy and weighted by MIS;
 //! - [`DirectIntegrator`]: direct lighting only, by one of four strategies (uniform hemisphere,
 //!   cosine-weighted hemisphere, light sampling, MIS), the course's comparison;
 //! - debug views: shading normals, distance, BVH nodes visited.
 
+mod bdpt;
 mod choice;
 mod debug;
 mod direct;
 mod packet;
 mod path;
 
+pub use bdpt::BdptIntegrator;
 pub use choice::{IntegratorChoice, IntegratorName};
 pub use debug::DebugView;
 pub use direct::{direct_samples, DirectIntegrator, DirectSample, DirectStrategy, SampleStrategy};
@@ -114,6 +118,8 @@ pub fn camera_ray(scene: &Scene, sampler: &mut AnySampler, s: SampleRef) -> (Ray
 pub enum IntegratorKind {
     /// Path tracing.
     Path(PathIntegrator),
+    /// Bidirectional path tracing.
+    Bdpt(BdptIntegrator),
     /// Direct lighting.
     Direct(DirectIntegrator),
     /// A debug view.
@@ -122,7 +128,8 @@ pub enum IntegratorKind {
 
 impl IntegratorKind {
     /// The integrator a scene file asks for ([`crate::desc::RenderHints`]): its path tracer
-    /// with the file's depth, roulette and emitter visibility, or direct lighting with its
+    /// (or bidirectional path tracer) with the file's depth, roulette and emitter visibility,
+    /// or direct lighting with its
     /// numbers of light and BSDF samples combined by MIS; the path tracer without a hint.
     pub fn from_hints(hints: &crate::desc::RenderHints) -> IntegratorKind {
         match hints.integrator {
@@ -133,6 +140,11 @@ impl IntegratorKind {
                 strategy: DirectStrategy::Mis,
                 samples: emitter_samples,
                 bsdf_samples: Some(bsdf_samples),
+                hide_emitters: hints.hide_emitters,
+            }),
+            Some(crate::desc::IntegratorHint::Bdpt) => IntegratorKind::Bdpt(BdptIntegrator {
+                max_depth: hints.max_depth.unwrap_or(u32::MAX),
+                rr_depth: hints.rr_depth.unwrap_or(5),
                 hide_emitters: hints.hide_emitters,
             }),
             Some(crate::desc::IntegratorHint::Path) | None => {
@@ -152,6 +164,7 @@ impl Integrator for IntegratorKind {
     fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
         match self {
             IntegratorKind::Path(i) => i.li(scene, ray, sampler, stats),
+            IntegratorKind::Bdpt(i) => i.li(scene, ray, sampler, stats),
             IntegratorKind::Direct(i) => i.li(scene, ray, sampler, stats),
             IntegratorKind::Debug(i) => i.li(scene, ray, sampler, stats),
         }
@@ -167,6 +180,7 @@ impl Integrator for IntegratorKind {
     ) {
         match self {
             IntegratorKind::Path(i) => i.li_samples(scene, sampler, samples, out, stats),
+            IntegratorKind::Bdpt(i) => i.li_samples(scene, sampler, samples, out, stats),
             IntegratorKind::Direct(i) => i.li_samples(scene, sampler, samples, out, stats),
             IntegratorKind::Debug(i) => i.li_samples(scene, sampler, samples, out, stats),
         }

@@ -1,0 +1,620 @@
+//! Bidirectional path tracing ([`BdptIntegrator`], Veach 1997, ch. 10; pbrt-v4's `BDPTIntegrator`
+//! without the light-tracing strategy).
+//!
+//! Each pixel sample traces a camera subpath x₀ x₁ … (x₀ on the lens) and a light subpath
+//! y₀ y₁ … (y₀ on a light, chosen by the scene's light sampler, its ray by
+//! [`crate::light::Light::sample_le`]), then joins every prefix of one with every prefix of the
+//! other: strategy (s, t) takes s light vertices and t camera vertices, so that the same path
+//! of length s + t − 1 segments can come from several strategies. s = 0 is the camera path
+//! finding emission itself, s = 1 light sampling at its last vertex, s ≥ 2 a shadow ray
+//! between xₜ₋₁ and yₛ₋₁. Each contribution is weighted by the power heuristic over the
+//! densities with which every other strategy would have produced the same path (computed from
+//! the per-vertex densities `pdf_fwd` and `pdf_rev`, both per unit area), so that the weights of
+//! one path sum to one and the estimate stays unbiased.
+//!
+//! The strategy t = 1 (a light subpath joined to the lens, splatted on another pixel) is not
+//! taken: every estimate here belongs to its own pixel, which keeps the film's per-pixel
+//! statistics, checkpoints and shards exact. Its share goes to the other strategies; caustics
+//! seen directly (light → specular → diffuse → camera) are then found by s = 0 alone, as the
+//! path tracer finds them. Lights that do not emit rays (at infinity, projectors) are reached
+//! by s = 0 and s = 1 only.
+//!
+//! Light subpaths carry importance: at their vertices the BSDF is the adjoint one
+//! ([`Bsdf::f_cos_importance`], [`Bsdf::delta_importance_scale`]).
+
+use super::{trace, Integrator, PathStats};
+use crate::bsdf::Bsdf;
+use crate::desc::{RayKind, Rgb};
+use crate::geometry::{offset_ray_origin, spawn_ray, spawn_ray_to, Ray};
+use crate::scene::{Scene, SurfaceInteraction};
+use glam::Vec3;
+use pathlab_mc::sampler::{AnySampler, Sampler};
+
+/// Bidirectional path tracing with the power heuristic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BdptIntegrator {
+    /// Largest bounce counted, s + t − 2 (`u32::MAX`: unbounded).
+    pub max_depth: u32,
+    /// First bounce of either subpath at which Russian roulette may end it.
+    pub rr_depth: u32,
+    /// Camera rays see no emitters.
+    pub hide_emitters: bool,
+}
+
+impl Default for BdptIntegrator {
+    fn default() -> Self {
+        BdptIntegrator {
+            max_depth: u32::MAX,
+            rr_depth: 5,
+            hide_emitters: false,
+        }
+    }
+}
+
+/// What a subpath vertex is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    /// The lens.
+    Camera,
+    /// A point on a light: a light subpath's start, or one sampled for s = 1.
+    Light,
+    /// A surface point (possibly on an emitter: `light` is then set).
+    Surface,
+    /// A camera ray that left the scene, or a light at infinity: `p` holds the direction.
+    Infinite,
+}
+
+/// A subpath vertex.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    kind: Kind,
+    /// Position (the direction for [`Kind::Infinite`]).
+    p: Vec3,
+    /// Geometric normal, for points on surfaces.
+    n: Option<Vec3>,
+    /// The light it lies on (or, at infinity, comes from).
+    light: Option<u32>,
+    /// Throughput from the subpath's start to here (for a sampled light vertex, its radiance
+    /// over its density).
+    beta: Rgb,
+    /// Density per unit area with which its own subpath produced it.
+    pdf_fwd: f32,
+    /// Density per unit area with which the other direction would have produced it.
+    pdf_rev: f32,
+    /// Whether the subpath left it through a delta lobe.
+    delta: bool,
+    /// Direction to the vertex before it on its subpath.
+    wo: Vec3,
+    /// The surface point and its BSDF (surfaces only).
+    surface: Option<(SurfaceInteraction, Bsdf)>,
+}
+
+impl Vertex {
+    fn endpoint(kind: Kind, p: Vec3, n: Option<Vec3>, light: Option<u32>, beta: Rgb) -> Self {
+        Vertex {
+            kind,
+            p,
+            n,
+            light,
+            beta,
+            pdf_fwd: 0.0,
+            pdf_rev: 0.0,
+            delta: false,
+            wo: Vec3::ZERO,
+            surface: None,
+        }
+    }
+
+    /// The BSDF of a surface vertex a connection can pass through (one with a lobe that is not
+    /// a delta).
+    fn connectible(&self) -> Option<&(SurfaceInteraction, Bsdf)> {
+        self.surface.as_ref().filter(|(_, b)| !b.is_delta())
+    }
+
+    /// Density per unit solid angle `pdf` of the direction from here to `next`, per unit area
+    /// at `next` (unchanged towards infinity).
+    fn convert_density(&self, pdf: f32, next: &Vertex) -> f32 {
+        if next.kind == Kind::Infinite {
+            return pdf;
+        }
+        let w = next.p - self.p;
+        let d2 = w.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let cos = next.n.map_or(1.0, |n| n.dot(w).abs() / d2.sqrt());
+        pdf * cos / d2
+    }
+
+    /// Unit direction from here to `other`.
+    fn towards(&self, other: &Vertex) -> Vec3 {
+        match other.kind {
+            Kind::Infinite => other.p,
+            _ => (other.p - self.p).normalize_or_zero(),
+        }
+    }
+}
+
+/// The vertices of one sample's two subpaths.
+struct Subpaths {
+    camera: Vec<Vertex>,
+    light: Vec<Vertex>,
+}
+
+impl BdptIntegrator {
+    /// Follows `ray` from the subpath's last vertex, appending at most `max_vertices` surface
+    /// (or, for the camera, escaped) vertices. `importance`: a light subpath, whose BSDFs are
+    /// the adjoint ones.
+    #[allow(clippy::too_many_arguments)]
+    fn random_walk(
+        &self,
+        scene: &Scene,
+        path: &mut Vec<Vertex>,
+        mut ray: Ray,
+        mut beta: Rgb,
+        max_vertices: u32,
+        importance: bool,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+    ) {
+        // The product of the BSDF weights alone, for Russian roulette (a light subpath's
+        // throughput starts at the light's radiance over its density).
+        let mut walk = Rgb::ONE;
+        let mut bounces = 0u32;
+        while bounces < max_vertices {
+            let kind = if importance || bounces > 0 {
+                RayKind::Indirect
+            } else {
+                RayKind::Camera
+            };
+            let Some(si) = trace(scene, &ray, kind, stats) else {
+                if !importance && scene.environment().is_some() {
+                    let mut v =
+                        Vertex::endpoint(Kind::Infinite, ray.d, None, scene.environment(), beta);
+                    v.wo = -ray.d;
+                    Self::append(scene, path, v);
+                }
+                return;
+            };
+            let wo = -ray.d;
+            let bsdf = scene.bsdf(&si, wo);
+            let mut v = Vertex::endpoint(Kind::Surface, si.p, Some(si.ng), si.light, beta);
+            v.wo = wo;
+            v.surface = Some((si, bsdf));
+            Self::append(scene, path, v);
+            bounces += 1;
+            if !importance {
+                stats.random_vertices += u64::from(!bsdf.is_black());
+            }
+            if bounces >= max_vertices {
+                return;
+            }
+            let Some(bs) = bsdf.sample_f(wo, sampler.next_1d(), sampler.next_2d()) else {
+                return;
+            };
+            let weight = match (importance, bs.delta) {
+                (false, _) => bs.f * (bs.cos / bs.pdf),
+                (true, false) => bsdf.f_cos_importance(wo, bs.wi) / bs.pdf,
+                (true, true) => bs.f * (bs.cos / bs.pdf * bsdf.delta_importance_scale(wo, bs.wi)),
+            };
+            beta *= weight;
+            walk *= weight;
+            if beta.max_element() <= 0.0 || !beta.is_finite() {
+                return;
+            }
+            if let Some(last) = path.last_mut() {
+                last.delta = bs.delta;
+            }
+            if bounces >= self.rr_depth {
+                let q = walk.max_element().min(0.95);
+                if sampler.next_1d() >= q {
+                    return;
+                }
+                beta /= q;
+                walk /= q;
+            }
+            ray = spawn_ray(si.p, si.ng, bs.wi);
+        }
+    }
+
+    /// Appends `v` to `path`, with the density per unit area with which the vertex before
+    /// produced it, and sets the reverse density of the one before that. Both come from the
+    /// vertices' positions by [`BdptIntegrator::pdf`], as every density the MIS weights
+    /// recompute does (not from the sample's own density and direction, which the ray's
+    /// offset origin and rounding make differ slightly, by a few percent for short grazing
+    /// segments): the weights of one path must sum to one. Zero after a delta lobe.
+    fn append(scene: &Scene, path: &mut Vec<Vertex>, mut v: Vertex) {
+        let k = path.len();
+        let prev = &path[k - 1];
+        if !prev.delta {
+            v.pdf_fwd = Self::pdf(scene, prev, k.checked_sub(2).map(|i| &path[i]), &v);
+            if k >= 2 {
+                path[k - 2].pdf_rev = Self::pdf(scene, &path[k - 1], Some(&v), &path[k - 2]);
+            }
+        }
+        path.push(v);
+    }
+
+    /// The camera subpath of camera ray `ray` and a light subpath.
+    fn subpaths(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+    ) -> Subpaths {
+        let mut camera = Vec::with_capacity(8);
+        camera.push(Vertex::endpoint(Kind::Camera, ray.o, None, None, Rgb::ONE));
+        let max_camera = self.max_depth.saturating_add(1);
+        self.random_walk(
+            scene,
+            &mut camera,
+            ray,
+            Rgb::ONE,
+            max_camera,
+            false,
+            sampler,
+            stats,
+        );
+        let mut light = Vec::with_capacity(8);
+        let u_select = sampler.next_1d();
+        let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
+        let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
+            return Subpaths { camera, light };
+        };
+        let Some(le) = scene.lights()[index].sample_le(u_pos, u_dir) else {
+            return Subpaths { camera, light };
+        };
+        let pdf_pos = pmf * le.pdf_pos;
+        let cos = le.n.map_or(1.0, |n| n.dot(le.w).abs());
+        let mut y0 = Vertex::endpoint(Kind::Light, le.p, le.n, Some(index as u32), le.le);
+        y0.pdf_fwd = pdf_pos;
+        light.push(y0);
+        let beta = le.le * (cos / (pdf_pos * le.pdf_dir));
+        let o = match le.n {
+            Some(n) => offset_ray_origin(le.p, n, le.w),
+            None => le.p,
+        };
+        let ray = Ray::new(o, le.w);
+        self.random_walk(
+            scene,
+            &mut light,
+            ray,
+            beta,
+            self.max_depth,
+            true,
+            sampler,
+            stats,
+        );
+        Subpaths { camera, light }
+    }
+
+    /// Density per unit area at `next` with which the light `v` lies on emits towards it.
+    fn pdf_light(scene: &Scene, v: &Vertex, next: &Vertex) -> f32 {
+        let Some(light) = v.light.map(|i| &scene.lights()[i as usize]) else {
+            return 0.0;
+        };
+        if v.kind == Kind::Infinite {
+            // Lights at infinity start no subpaths: no strategy needs this.
+            return 0.0;
+        }
+        let w = next.p - v.p;
+        let d2 = w.length_squared();
+        if d2 == 0.0 {
+            return 0.0;
+        }
+        let pdf_dir = light.pdf_le_dir(v.n, w / d2.sqrt());
+        v.convert_density(pdf_dir, next)
+    }
+
+    /// Density with which a light subpath (or light sampling) starts at endpoint `v`: per unit
+    /// area on a surface, per unit solid angle at infinity.
+    fn pdf_light_origin(scene: &Scene, v: &Vertex) -> f32 {
+        let Some(index) = v.light else { return 0.0 };
+        let light = &scene.lights()[index as usize];
+        let pmf = scene.light_sampler().pmf(index as usize);
+        if v.kind == Kind::Infinite {
+            pmf * light.pdf_li_towards(v.p)
+        } else {
+            pmf * light.pdf_le_pos()
+        }
+    }
+
+    /// Density per unit area at `next` with which vertex `v`, reached from `prev`, produces it.
+    fn pdf(scene: &Scene, v: &Vertex, prev: Option<&Vertex>, next: &Vertex) -> f32 {
+        match v.kind {
+            Kind::Light | Kind::Infinite => Self::pdf_light(scene, v, next),
+            Kind::Camera => 0.0,
+            Kind::Surface => {
+                let (Some((_, bsdf)), Some(prev)) = (&v.surface, prev) else {
+                    return 0.0;
+                };
+                let pdf = bsdf.pdf(v.towards(prev), v.towards(next));
+                v.convert_density(pdf, next)
+            }
+        }
+    }
+
+    /// The power-heuristic weight of strategy (s, t), `sampled` being the light vertex that
+    /// light sampling chose for s = 1. `emits`: whether the path's light starts subpaths;
+    /// `delta_light`: whether no ray can hit it.
+    #[allow(clippy::too_many_arguments)]
+    fn mis_weight(
+        scene: &Scene,
+        paths: &Subpaths,
+        sampled: Option<&Vertex>,
+        s: usize,
+        t: usize,
+        emits: bool,
+        delta_light: bool,
+    ) -> f32 {
+        if s + t == 2 {
+            return 1.0;
+        }
+        let qs = match s {
+            0 => None,
+            1 => sampled,
+            _ => Some(&paths.light[s - 1]),
+        };
+        let pt = &paths.camera[t - 1];
+        let pt_minus = &paths.camera[t - 2];
+        let qs_minus = (s > 1).then(|| &paths.light[s - 2]);
+        // The reverse densities the join changes (of x_{t-1}, x_{t-2}, y_{s-1}, y_{s-2}).
+        let (pt_rev, pt_minus_rev, qs_rev, qs_minus_rev) = match qs {
+            Some(qs) => (
+                Self::pdf(scene, qs, qs_minus, pt),
+                Self::pdf(scene, pt, Some(qs), pt_minus),
+                Self::pdf(scene, pt, Some(pt_minus), qs),
+                qs_minus.map_or(0.0, |qm| Self::pdf(scene, qs, Some(pt), qm)),
+            ),
+            None => (
+                Self::pdf_light_origin(scene, pt),
+                Self::pdf_light(scene, pt, pt_minus),
+                0.0,
+                0.0,
+            ),
+        };
+        // (pdf_fwd, pdf_rev, delta) of the vertices of this strategy's path; the vertices
+        // joined are not degenerate, whatever their subpaths left them by.
+        let camera = |i: usize| {
+            let v = &paths.camera[i];
+            match t - 1 - i {
+                0 => (v.pdf_fwd, pt_rev, false),
+                1 => (v.pdf_fwd, pt_minus_rev, v.delta),
+                _ => (v.pdf_fwd, v.pdf_rev, v.delta),
+            }
+        };
+        let light = |i: usize| {
+            let v = match (s, qs) {
+                (1, Some(sampled)) => sampled,
+                _ => &paths.light[i],
+            };
+            match s - 1 - i {
+                0 => (v.pdf_fwd, qs_rev, false),
+                1 => (v.pdf_fwd, qs_minus_rev, v.delta),
+                _ => (v.pdf_fwd, v.pdf_rev, v.delta),
+            }
+        };
+        let remap = |f: f32| if f != 0.0 { f } else { 1.0 };
+        let mut sum = 0.0f32;
+        // Strategies with fewer camera vertices, down to t = 2 (t = 1 is not taken).
+        let mut ri = 1.0f32;
+        for i in (2..t).rev() {
+            let (fwd, rev, delta) = camera(i);
+            ri *= remap(rev) / remap(fwd);
+            let s_other = s + t - i;
+            if !delta && !camera(i - 1).2 && (emits || s_other < 2) {
+                sum += ri * ri;
+            }
+        }
+        // Strategies with fewer light vertices, down to s = 0.
+        ri = 1.0;
+        for i in (0..s).rev() {
+            let (fwd, rev, delta) = light(i);
+            ri *= remap(rev) / remap(fwd);
+            let delta_before = if i > 0 { light(i - 1).2 } else { delta_light };
+            if !delta && !delta_before {
+                sum += ri * ri;
+            }
+        }
+        let w = 1.0 / (1.0 + sum);
+        if w.is_finite() {
+            w
+        } else {
+            0.0
+        }
+    }
+
+    /// Strategy s = 0: the camera subpath's vertex t − 1 is on a light.
+    fn emission(&self, scene: &Scene, paths: &Subpaths, t: usize) -> Rgb {
+        let pt = &paths.camera[t - 1];
+        if t == 2 && self.hide_emitters {
+            return Rgb::ZERO;
+        }
+        let Some(index) = pt.light else {
+            return Rgb::ZERO;
+        };
+        let light = &scene.lights()[index as usize];
+        let le = match (&pt.surface, pt.kind) {
+            (Some((si, _)), _) => light.le(si.ng, pt.wo, si.uv),
+            (None, Kind::Infinite) => light.le_environment(pt.p),
+            _ => Rgb::ZERO,
+        };
+        let l = pt.beta * le;
+        if l.max_element() <= 0.0 {
+            return Rgb::ZERO;
+        }
+        if t == 2 || Self::pdf_light_origin(scene, pt) == 0.0 {
+            // Seen directly, or on a light no other strategy samples.
+            return l;
+        }
+        l * Self::mis_weight(scene, paths, None, 0, t, light.emits_rays(), false)
+    }
+
+    /// Strategy s = 1: light sampling at the camera subpath's vertex t − 1.
+    fn light_sample(
+        &self,
+        scene: &Scene,
+        paths: &Subpaths,
+        t: usize,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+    ) -> Rgb {
+        let pt = &paths.camera[t - 1];
+        let Some((si, bsdf)) = pt.connectible() else {
+            return Rgb::ZERO;
+        };
+        let (u_select, u) = (sampler.next_1d(), sampler.next_2d());
+        let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
+            return Rgb::ZERO;
+        };
+        let light = &scene.lights()[index];
+        let Some(ls) = light.sample_li(si.p, u) else {
+            return Rgb::ZERO;
+        };
+        if ls.pdf <= 0.0 || ls.li.max_element() <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let f = bsdf.f_cos(pt.wo, ls.wi);
+        if f.max_element() <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let shadow = if light.is_infinite() {
+            spawn_ray(si.p, si.ng, ls.wi)
+        } else {
+            spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light)
+        };
+        stats.rays += 1;
+        if scene.occluded(&shadow) {
+            return Rgb::ZERO;
+        }
+        let (kind, p) = if light.is_infinite() {
+            (Kind::Infinite, ls.wi)
+        } else {
+            (Kind::Light, ls.p_light)
+        };
+        let mut sampled = Vertex::endpoint(kind, p, ls.n_light, Some(index as u32), Rgb::ZERO);
+        sampled.pdf_fwd = Self::pdf_light_origin(scene, &sampled);
+        let l = pt.beta * f * ls.li / (pmf * ls.pdf);
+        let w = Self::mis_weight(
+            scene,
+            paths,
+            Some(&sampled),
+            1,
+            t,
+            light.emits_rays(),
+            ls.is_delta,
+        );
+        l * w
+    }
+
+    /// Strategy s ≥ 2, t ≥ 2: a shadow ray between the light subpath's vertex s − 1 and the
+    /// camera subpath's vertex t − 1.
+    fn join(
+        &self,
+        scene: &Scene,
+        paths: &Subpaths,
+        s: usize,
+        t: usize,
+        stats: &mut PathStats,
+    ) -> Rgb {
+        let (qs, pt) = (&paths.light[s - 1], &paths.camera[t - 1]);
+        let (Some((sq, bq)), Some((sp, bp))) = (qs.connectible(), pt.connectible()) else {
+            return Rgb::ZERO;
+        };
+        let d = qs.p - pt.p;
+        let d2 = d.length_squared();
+        if d2 == 0.0 {
+            return Rgb::ZERO;
+        }
+        let w = d / d2.sqrt();
+        let l = qs.beta * bq.f_cos_importance(qs.wo, -w) * bp.f_cos(pt.wo, w) * pt.beta / d2;
+        if l.max_element() <= 0.0 || !l.is_finite() {
+            return Rgb::ZERO;
+        }
+        stats.rays += 1;
+        if scene.occluded(&spawn_ray_to(sp.p, sp.ng, sq.p, Some(sq.ng))) {
+            return Rgb::ZERO;
+        }
+        let delta_light = paths.light[0]
+            .light
+            .is_some_and(|i| scene.lights()[i as usize].is_delta_position());
+        l * Self::mis_weight(scene, paths, None, s, t, true, delta_light)
+    }
+}
+
+impl Integrator for BdptIntegrator {
+    fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
+        let paths = self.subpaths(scene, ray, sampler, stats);
+        let mut l = Rgb::ZERO;
+        for t in 2..=paths.camera.len() {
+            // s = 1 samples its own light point, so it needs no light subpath.
+            for s in 0..=paths.light.len().max(1) {
+                let depth = (s + t - 2) as u64;
+                if depth > self.max_depth as u64 {
+                    break;
+                }
+                l += match s {
+                    0 => self.emission(scene, &paths, t),
+                    1 => self.light_sample(scene, &paths, t, sampler, stats),
+                    _ => self.join(scene, &paths, s, t, stats),
+                };
+            }
+        }
+        l
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::desc::*;
+    use pathlab_mc::sampler::SamplerKind;
+
+    /// Inside a sphere that emits everywhere, every camera path x₀ x₁ x₂ ends on the light,
+    /// and light sampling at x₁ (s = 1, t = 2) could have chosen x₂ too: the two strategies'
+    /// weights of that path must sum to one, including for the short grazing segments where
+    /// a sample's own density and the one recomputed from the vertices differ most.
+    #[test]
+    fn weights_of_the_strategies_of_one_path_sum_to_one() {
+        let desc = SceneDesc {
+            spheres: vec![SphereDesc {
+                center: Vec3::ZERO,
+                radius: 1.0,
+                material: 0,
+                emission: Some(Emission {
+                    radiance: Vec3::ONE,
+                    two_sided: true,
+                }),
+                ..Default::default()
+            }],
+            materials: vec![crate::scene::diffuse(Vec3::splat(0.6), true)],
+            resolution: [16, 16],
+            ..Default::default()
+        };
+        let scene = Scene::build(&desc).expect("the sphere builds");
+        let bdpt = BdptIntegrator {
+            max_depth: 1,
+            ..Default::default()
+        };
+        let mut sampler = SamplerKind::Independent.build(1 << 12, 1);
+        let mut stats = PathStats::default();
+        let origin = Vec3::new(0.1, -0.2, 0.05);
+        for i in 0..4096 {
+            sampler.start_pixel_sample([3, 4], i, 0);
+            let d = pathlab_mc::warp::sample_uniform_sphere(sampler.next_2d());
+            let paths = bdpt.subpaths(&scene, Ray::new(origin, d), &mut sampler, &mut stats);
+            assert_eq!(paths.camera.len(), 3, "every path ends on the sphere");
+            let x2 = &paths.camera[2];
+            let w_emission = BdptIntegrator::mis_weight(&scene, &paths, None, 0, 3, true, false);
+            let mut sampled = Vertex::endpoint(Kind::Light, x2.p, x2.n, x2.light, Rgb::ZERO);
+            sampled.pdf_fwd = BdptIntegrator::pdf_light_origin(&scene, &sampled);
+            let w_light =
+                BdptIntegrator::mis_weight(&scene, &paths, Some(&sampled), 1, 2, true, false);
+            assert!(
+                (w_emission + w_light - 1.0).abs() < 1e-4,
+                "sample {i}: {w_emission} + {w_light}"
+            );
+        }
+    }
+}
