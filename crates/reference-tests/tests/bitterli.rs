@@ -15,8 +15,9 @@ use glam::DVec3;
 use pathlab_render::bsdf::NormalDistribution;
 use pathlab_render::desc::{MaterialDesc, SceneDesc, TextureDesc};
 use pathlab_render::image_io::read_exr_rgb;
+use pathlab_render::integrator::IntegratorKind;
 use pathlab_render::scene::Scene;
-use pathlab_testkit::render::{path, render_independent};
+use pathlab_testkit::render::render_independent;
 use std::path::PathBuf;
 
 fn data(name: &str) -> PathBuf {
@@ -38,7 +39,8 @@ fn against_tungsten(scene: &str, mut desc: SceneDesc, spp: u32) -> (DVec3, f64) 
     // Averaging 4 x 4 blocks of the reference is a box filter at this resolution.
     desc.filter = pathlab_render::desc::PixelFilter::Box;
     let built = Scene::build(&desc).unwrap();
-    let integrator = path(desc.hints.max_depth.unwrap_or(u32::MAX));
+    // The integrator the file names (veach-bidir asks for the bidirectional path tracer).
+    let integrator = IntegratorKind::from_hints(&desc.hints);
     let film = render_independent(&built, &integrator, spp, 7).0;
     let ours = film.mean_image();
     let mean =
@@ -107,17 +109,25 @@ fn bitterli_veach_mis_matches_tungsten() {
 }
 
 #[test]
-#[ignore = "open: unidirectional paths reach its light through the lamp's glossy shade too rarely for the noise to fall below the bound in a minute"]
+#[ignore = "open: the glass egg's caustic seen directly needs light tracing (t = 1), which the bidirectional path tracer does not do yet: at 128 samples (half a minute) a few such paths make the relative MSE about 1; without the 5 brightest pixels it is 0.010"]
 fn bitterli_veach_bidir_matches_tungsten() {
     // Tungsten's lamp is Beckmann too (albedo 1); the file's is pbrt-v4's GGX.
     let mut desc = load("veach-bidir");
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    // Light reaches the room off the inside of the lamps' glossy shades, which paths from the
+    // camera find too rarely (relative MSE 2.3 at 256 samples): the file asks for the
+    // bidirectional path tracer, whose light subpaths start at the lamps.
+    assert!(matches!(
+        IntegratorKind::from_hints(&desc.hints),
+        IntegratorKind::Bdpt(_)
+    ));
     let lamps: usize = desc
         .materials
         .iter_mut()
         .map(|m| as_tungsten_conductor(m, 1.0))
         .sum();
     assert_eq!(lamps, 2);
-    let (ratio, rel) = against_tungsten("veach-bidir", desc, 256);
+    let (ratio, rel) = against_tungsten("veach-bidir", desc, 128);
     assert!((ratio - DVec3::ONE).abs().max_element() < 0.03, "{ratio}");
     assert!(rel < 0.02, "relative MSE {rel}");
 }

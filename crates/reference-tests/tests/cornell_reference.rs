@@ -5,7 +5,9 @@
 mod common;
 
 use common::*;
-use pathlab_render::integrator::{DirectIntegrator, DirectStrategy, IntegratorKind};
+use pathlab_render::integrator::{
+    BdptIntegrator, DirectIntegrator, DirectStrategy, IntegratorKind,
+};
 use pathlab_render::scene::Scene;
 use std::path::PathBuf;
 
@@ -230,4 +232,14 @@ fn environment_map_scene_matches_mitsuba() {
         c.outliers, c.ours_mean, c.ref_mean, c.mean_z
     );
     assert_agrees("sky-spheres", &c);
+}
+
+#[test]
+fn bidirectional_path_tracer_matches_mitsuba() {
+    // A band of rows through both boxes, the walls and the floor (a quarter of the image keeps
+    // the test short): the unbounded depth, whose paths every join strategy samples.
+    let integrator = IntegratorKind::Bdpt(BdptIntegrator::default());
+    let film = render_cornell_window(integrator, 512, 29, Some([0, 128, 256, 192]));
+    let r = reference("inf");
+    assert_agrees("bdpt vs Mitsuba max_depth inf", &compare(&film, &r));
 }

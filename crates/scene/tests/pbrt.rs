@@ -268,6 +268,9 @@ fn bitterli_scenes_load_with_only_documented_warnings() {
         for w in &desc.warnings {
             assert!(w.contains("rendered by the path tracer"), "{scene}: {w}");
         }
+        // "bdpt" is rendered by the bidirectional path tracer, without a note.
+        let bdpt = desc.hints.integrator == Some(pathlab_render::desc::IntegratorHint::Bdpt);
+        assert_eq!(bdpt, scene == "veach-bidir", "{scene}");
         assert!(Path::new(&path).exists());
     }
 }

@@ -89,7 +89,8 @@ impl Builder {
                 self.desc.hints.integrator = Some(IntegratorHint::Path);
                 match kind.as_str() {
                     "path" | "volpath" => {}
-                    "bdpt" | "mlt" | "sppm" | "lightpath" | "simplepath" | "simplevolpath"
+                    "bdpt" => self.desc.hints.integrator = Some(IntegratorHint::Bdpt),
+                    "mlt" | "sppm" | "lightpath" | "simplepath" | "simplevolpath"
                     | "randomwalk" => {
                         self.warn(format!("Integrator \"{kind}\": rendered by the path tracer, which converges to the same image"));
                     }
