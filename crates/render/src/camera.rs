@@ -1,11 +1,15 @@
 //! The camera: perspective (pinhole, or thin lens when it has an aperture) or orthographic,
-//! and the pixel filter that places each pixel's samples.
+//! and the pixel filter that places each pixel's samples; its importance, for light traced to
+//! the lens (`importance`).
 
 use crate::desc::{CameraDesc, FovAxis, PixelFilter, Projection};
 use crate::geometry::Ray;
 use glam::{Vec2, Vec3};
 use pathlab_mc::warp::sample_uniform_disk_concentric;
 use std::sync::Arc;
+
+mod importance;
+pub use importance::CameraWiSample;
 
 /// A camera generating rays through film positions.
 ///
