@@ -263,24 +263,24 @@ fn interruptible(
 /// The film's mean radiance as an `(H, W, 3)` float32 array, written once into the buffer
 /// numpy then owns.
 pub fn mean_image<'py>(py: Python<'py>, film: &Film) -> Bound<'py, PyAny> {
-    rgb_image(py, film, PixelStats::mean)
+    rgb_image(py, film, Film::pixel_value)
 }
 
 /// Each pixel's variance of its mean, `(H, W, 3)`.
 fn variance_image<'py>(py: Python<'py>, film: &Film) -> Bound<'py, PyAny> {
-    rgb_image(py, film, PixelStats::variance_of_mean)
+    rgb_image(py, film, |f, i| f.pixels()[i].variance_of_mean())
 }
 
-/// `(H, W, 3)` float32 of a statistic of each pixel.
+/// `(H, W, 3)` float32 of a statistic of each pixel (by its index).
 fn rgb_image<'py>(
     py: Python<'py>,
     film: &Film,
-    statistic: impl Fn(&PixelStats) -> glam::DVec3,
+    statistic: impl Fn(&Film, usize) -> glam::DVec3,
 ) -> Bound<'py, PyAny> {
     let (w, h) = (film.width() as usize, film.height() as usize);
     let mut data = Vec::with_capacity(w * h * 3);
-    for p in film.pixels() {
-        let v = statistic(p);
+    for i in 0..film.pixels().len() {
+        let v = statistic(film, i);
         data.extend([v.x as f32, v.y as f32, v.z as f32]);
     }
     Array3::from_shape_vec((h, w, 3), data)

@@ -2,7 +2,7 @@
 
 use crate::desc::Rgb;
 use glam::{DVec3, Vec3};
-use pathlab_mc::exact::{to_fixed, ExactStats};
+use pathlab_mc::exact::{from_fixed, to_fixed, ExactStats};
 
 /// Statistics of one pixel's samples: their count, and exact sums of each channel and of
 /// luminance and of their squares ([`pathlab_mc::exact`]): the same for any order in which
@@ -113,12 +113,19 @@ impl PixelStats {
     }
 }
 
-/// An image of pixel statistics, row 0 at the top.
+/// An image of pixel statistics, row 0 at the top; and, for integrators that trace light to
+/// the lens (the bidirectional path tracer), the light it brought to each pixel: exact sums of
+/// splatted radiance and the number of light paths traced, whose ratio (times the pixel
+/// count, as camera importance is normalised over the whole image) adds to each pixel's mean.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Film {
     width: u32,
     height: u32,
     pixels: Vec<PixelStats>,
+    /// Σ of splatted R, G, B per pixel, fixed point (empty until the first splat).
+    splats: Vec<[i128; 3]>,
+    /// Light paths traced for the splats (one per camera sample that traced one).
+    light_paths: u64,
 }
 
 impl Film {
@@ -128,7 +135,79 @@ impl Film {
             width,
             height,
             pixels: vec![PixelStats::default(); width as usize * height as usize],
+            splats: Vec::new(),
+            light_paths: 0,
         }
+    }
+
+    /// Adds radiance splatted on pixel (x, y) by a light path.
+    pub fn add_splat(&mut self, x: u32, y: u32, v: Rgb) {
+        if self.splats.is_empty() {
+            self.splats = vec![[0; 3]; self.pixels.len()];
+        }
+        let s = &mut self.splats[(y * self.width + x) as usize];
+        for (c, v) in [v.x, v.y, v.z].into_iter().enumerate() {
+            s[c] = s[c].saturating_add(to_fixed(v as f64));
+        }
+    }
+
+    /// Counts `n` more light paths traced for the splats.
+    pub fn add_light_paths(&mut self, n: u64) {
+        self.light_paths += n;
+    }
+
+    /// Light paths traced for the splats.
+    pub fn light_paths(&self) -> u64 {
+        self.light_paths
+    }
+
+    /// The exact splat sums, row-major (empty when nothing was splatted).
+    pub fn splat_sums(&self) -> &[[i128; 3]] {
+        &self.splats
+    }
+
+    /// Sets the splat sums and light-path count (a film file's).
+    pub fn set_splats(&mut self, sums: Vec<[i128; 3]>, light_paths: u64) {
+        debug_assert!(sums.is_empty() || sums.len() == self.pixels.len());
+        self.splats = sums;
+        self.light_paths = light_paths;
+    }
+
+    /// Adds another film's splats and light paths (exactly).
+    pub fn merge_splats(&mut self, o: &Film) {
+        self.light_paths += o.light_paths;
+        if o.splats.is_empty() {
+            return;
+        }
+        if self.splats.is_empty() {
+            self.splats = vec![[0; 3]; self.pixels.len()];
+        }
+        for (a, b) in self.splats.iter_mut().zip(&o.splats) {
+            for c in 0..3 {
+                a[c] = a[c].saturating_add(b[c]);
+            }
+        }
+    }
+
+    /// What light traced to the lens adds to pixel `i`'s mean.
+    fn splat_mean(&self, i: usize) -> DVec3 {
+        match self.splats.get(i) {
+            Some(s) if self.light_paths > 0 => {
+                let scale = self.pixels.len() as f64 / self.light_paths as f64;
+                DVec3::new(from_fixed(s[0]), from_fixed(s[1]), from_fixed(s[2])) * scale
+            }
+            _ => DVec3::ZERO,
+        }
+    }
+
+    /// The radiance estimate of pixel `i`: its samples' mean, plus the light traced to it.
+    pub fn pixel_value(&self, i: usize) -> DVec3 {
+        let mean = self.pixels[i].mean();
+        if self.light_paths == 0 || self.splats.is_empty() {
+            // Nothing traced to the lens: the samples' mean to the bit (-0.0 included).
+            return mean;
+        }
+        mean + self.splat_mean(i)
     }
 
     /// Width in pixels.
@@ -163,9 +242,11 @@ impl Film {
         &mut self.pixels
     }
 
-    /// Mean radiance per pixel, row-major.
+    /// Mean radiance per pixel (with the light traced to it), row-major.
     pub fn mean_image(&self) -> Vec<Vec3> {
-        self.pixels.iter().map(|p| p.mean().as_vec3()).collect()
+        (0..self.pixels.len())
+            .map(|i| self.pixel_value(i).as_vec3())
+            .collect()
     }
 
     /// Variance of each pixel's mean, row-major.
@@ -192,9 +273,9 @@ impl Film {
         SampleCountRange { min, max, mean }
     }
 
-    /// Mean of all pixel means.
+    /// Mean of all pixel values ([`Film::pixel_value`]).
     pub fn image_mean(&self) -> DVec3 {
-        let sum: DVec3 = self.pixels.iter().map(|p| p.mean()).sum();
+        let sum: DVec3 = (0..self.pixels.len()).map(|i| self.pixel_value(i)).sum();
         sum / self.pixels.len().max(1) as f64
     }
 

@@ -3,7 +3,9 @@
 //!
 //! Layout (little-endian): the magic `PLFILM01`; a u32 length and that many bytes of header,
 //! `key=value` lines ([`FilmHeader`]); a u64 pixel count (width × height); each pixel's
-//! [`PixelStats::to_bytes`]; a u64 FNV-1a hash of everything before it. Files are written to
+//! [`PixelStats::to_bytes`]; for a film with light traced to the lens (the bidirectional path
+//! tracer's splats), a u64 count of light paths and each pixel's three i128 splat sums; a u64
+//! FNV-1a hash of everything before it. Files are written to
 //! a temporary name and renamed, so a file is either whole or absent; reading checks the
 //! sizes against the file's length before allocating, and the hash.
 
@@ -16,6 +18,10 @@ pub const MAGIC: &[u8; 8] = b"PLFILM01";
 
 /// Longest header read.
 const MAX_HEADER: usize = 1 << 20;
+
+/// Bytes of one pixel's splat sums (three `i128`), after the pixels in films with light traced
+/// to the lens.
+const SPLAT_BYTES: usize = 3 * 16;
 
 /// What a film file says about the render it belongs to.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -130,6 +136,17 @@ pub fn write(path: &Path, header: &FilmHeader, film: &Film) -> Result<(), FilmFi
     for p in film.pixels() {
         p.to_bytes(&mut bytes);
     }
+    // Light traced to the lens, when there is any: the light paths, then each pixel's sums.
+    if film.light_paths() > 0 {
+        bytes.extend(film.light_paths().to_le_bytes());
+        let zero = [[0i128; 3]];
+        let sums = film.splat_sums();
+        for s in (0..film.pixels().len()).map(|i| sums.get(i).unwrap_or(&zero[0])) {
+            for v in s {
+                bytes.extend(v.to_le_bytes());
+            }
+        }
+    }
     let hash = fnv1a(&bytes);
     bytes.extend(hash.to_le_bytes());
     let mut tmp_name = path.as_os_str().to_owned();
@@ -188,10 +205,17 @@ pub fn parse(bytes: &[u8]) -> Result<(FilmHeader, Film), String> {
         return Err(format!("{count} pixels for a {w} x {h} image"));
     }
     let body = at + 8;
-    let expected = (count as usize)
+    let pixels_end = (count as usize)
         .checked_mul(PIXEL_BYTES)
-        .and_then(|n| n.checked_add(body + 8))
+        .and_then(|n| n.checked_add(body))
         .ok_or("sizes out of range")?;
+    let splat_bytes = (count as usize)
+        .checked_mul(SPLAT_BYTES)
+        .and_then(|n| n.checked_add(8))
+        .ok_or("sizes out of range")?;
+    // With or without the light traced to the lens.
+    let splats = bytes.len() == pixels_end + splat_bytes + 8;
+    let expected = pixels_end + if splats { splat_bytes } else { 0 } + 8;
     if bytes.len() != expected {
         return Err(format!(
             "{} bytes where its sizes say {expected} (truncated or padded)",
@@ -212,9 +236,24 @@ pub fn parse(bytes: &[u8]) -> Result<(FilmHeader, Film), String> {
     for (p, chunk) in film
         .pixels_mut()
         .iter_mut()
-        .zip(bytes[body..expected - 8].chunks_exact(PIXEL_BYTES))
+        .zip(bytes[body..pixels_end].chunks_exact(PIXEL_BYTES))
     {
         *p = PixelStats::from_bytes(chunk).ok_or("a pixel record of the wrong size")?;
+    }
+    if splats {
+        let light_paths = u64_at(pixels_end)?;
+        let sums = bytes[pixels_end + 8..expected - 8]
+            .chunks_exact(SPLAT_BYTES)
+            .map(|c| {
+                let v = |k: usize| {
+                    let mut b = [0u8; 16];
+                    b.copy_from_slice(&c[16 * k..16 * k + 16]);
+                    i128::from_le_bytes(b)
+                };
+                [v(0), v(1), v(2)]
+            })
+            .collect();
+        film.set_splats(sums, light_paths);
     }
     Ok((header, film))
 }
@@ -286,6 +325,7 @@ pub fn merge(parts: &[(String, FilmHeader, Film)]) -> Result<(FilmHeader, Film),
         for (a, b) in film.pixels_mut().iter_mut().zip(f.pixels()) {
             a.merge(b);
         }
+        film.merge_splats(f);
     }
     let mut header = first.clone();
     header.range = [0, first.spp];

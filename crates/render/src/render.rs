@@ -1,7 +1,7 @@
 //! The render loop: tiles on rayon, one sampler stream per pixel, pixel statistics on the film.
 
 use crate::film::{Film, PixelStats};
-use crate::integrator::{Integrator, PathStats, SampleRef};
+use crate::integrator::{camera_ray, Integrator, PathStats, SampleRef};
 use crate::scene::Scene;
 use pathlab_mc::sampler::SamplerKind;
 use rayon::prelude::*;
@@ -110,6 +110,10 @@ struct TileResult {
     samples: u64,
     nonfinite: u64,
     pilot: u64,
+    /// Radiance that light traced to the lens brought to film positions (pixels).
+    splats: Vec<(glam::Vec2, crate::desc::Rgb)>,
+    /// Light paths traced for them.
+    light_paths: u64,
 }
 
 /// Adds the samples with indices `range` of pixel `[x, y]` to `px`; returns how many were
@@ -290,6 +294,8 @@ impl<'a> Frame<'a> {
             samples: 0,
             nonfinite: 0,
             pilot: 0,
+            splats: Vec::new(),
+            light_paths: 0,
         };
         (w, h, out)
     }
@@ -322,6 +328,7 @@ impl<'a> Frame<'a> {
         cancel: &AtomicBool,
     ) {
         let first = self.settings.sample_range.map_or(0, |r| r[0]);
+        let splatting = self.integrator.splats(self.scene);
         let film_now = &*film;
         let results: Vec<TileResult> = self
             .tiles
@@ -346,13 +353,29 @@ impl<'a> Frame<'a> {
                 });
                 let (mut ok, mut bad) = (0, 0);
                 let pixels = &mut out.pixels;
-                self.integrator.li_samples(
-                    self.scene,
-                    &mut sampler,
-                    &mut samples,
-                    &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
-                    &mut out.path,
-                );
+                if splatting {
+                    // One sample after another, each tracing light to the lens too.
+                    for s in &mut samples {
+                        let (ray, weight) = camera_ray(self.scene, &mut sampler, s);
+                        let l = self.integrator.li_splat(
+                            self.scene,
+                            ray,
+                            &mut sampler,
+                            &mut out.path,
+                            &mut |x, v| out.splats.push((x, v)),
+                        );
+                        add_sample(&mut pixels[s.tag as usize], l * weight, &mut ok, &mut bad);
+                        out.light_paths += 1;
+                    }
+                } else {
+                    self.integrator.li_samples(
+                        self.scene,
+                        &mut sampler,
+                        &mut samples,
+                        &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
+                        &mut out.path,
+                    );
+                }
                 out.samples += ok;
                 out.nonfinite += bad;
                 progress(&TileDone {
@@ -365,7 +388,28 @@ impl<'a> Frame<'a> {
                 out
             })
             .collect();
+        self.add_splats(film, &results);
         Self::merge(film, stats, results);
+    }
+
+    /// Adds the tiles' splats to the pixels of the window the filter gives them (exact sums:
+    /// the same in any order), and counts their light paths.
+    fn add_splats(&self, film: &mut Film, results: &[TileResult]) {
+        let mut weights = Vec::new();
+        for t in results {
+            film.add_light_paths(t.light_paths);
+            for &(x, v) in &t.splats {
+                if !v.is_finite() {
+                    continue;
+                }
+                self.scene
+                    .camera()
+                    .splat_weights(x, self.window, &mut weights);
+                for &([px, py], w) in &weights {
+                    film.add_splat(px, py, v * w);
+                }
+            }
+        }
     }
 }
 

@@ -134,24 +134,25 @@ impl Layers {
 /// mean, the variance of the mean and the count, computed as [`Film::mean_image`],
 /// [`Film::variance_image`] and [`Film::sample_counts`] compute them.
 fn region_values(film: &Film, layers: Layers, [x0, y0, w, h]: [u32; 4]) -> Vec<f32> {
-    let px = |x, y| film.pixel(x, y);
-    let plane = |f: &dyn Fn(&PixelStats) -> f32| -> Vec<f32> {
+    let index = |x: u32, y: u32| (y * film.width() + x) as usize;
+    let plane = |f: &dyn Fn(usize) -> f32| -> Vec<f32> {
         (y0..y0 + h)
             .flat_map(|y| (x0..x0 + w).map(move |x| (x, y)))
-            .map(|(x, y)| f(px(x, y)))
+            .map(|(x, y)| f(index(x, y)))
             .collect()
     };
+    let pixels = film.pixels();
     let mut out = Vec::new();
     for c in 0..3 {
-        out.extend(plane(&|p| p.mean().as_vec3()[c]));
+        out.extend(plane(&|i| film.pixel_value(i).as_vec3()[c]));
     }
     if layers.variance {
         for c in 0..3 {
-            out.extend(plane(&|p| p.variance_of_mean().as_vec3()[c]));
+            out.extend(plane(&|i| pixels[i].variance_of_mean().as_vec3()[c]));
         }
     }
     if layers.samples {
-        out.extend(plane(&|p| p.count() as f32));
+        out.extend(plane(&|i| pixels[i].count() as f32));
     }
     out
 }

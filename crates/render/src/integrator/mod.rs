@@ -71,6 +71,27 @@ pub trait Integrator: Sync {
     /// next dimensions.
     fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb;
 
+    /// Whether [`Integrator::li_splat`] traces light to the lens in `scene`, adding radiance
+    /// to film positions other than the sample's (which the render loop then collects).
+    fn splats(&self, _scene: &Scene) -> bool {
+        false
+    }
+
+    /// [`Integrator::li`], also handing the radiance that light traced to the lens brings to
+    /// film position `film` (pixels) to `splat`, for a film whose splats are divided by the
+    /// light paths traced (one per call) and multiplied by the pixel count
+    /// ([`crate::film::Film`]). By default [`Integrator::li`], which splats nothing.
+    fn li_splat(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+        _splat: &mut dyn FnMut(Vec2, Rgb),
+    ) -> Rgb {
+        self.li(scene, ray, sampler, stats)
+    }
+
     /// Estimates each of `samples`: positions `sampler` at the sample, makes its camera ray
     /// ([`camera_ray`]) and hands `(tag, radiance)` to `out`. By default one sample after
     /// another with [`Integrator::li`]; an integrator that follows several paths together may
@@ -161,6 +182,27 @@ impl IntegratorKind {
 }
 
 impl Integrator for IntegratorKind {
+    fn splats(&self, scene: &Scene) -> bool {
+        match self {
+            IntegratorKind::Bdpt(i) => i.splats(scene),
+            _ => false,
+        }
+    }
+
+    fn li_splat(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+        splat: &mut dyn FnMut(Vec2, Rgb),
+    ) -> Rgb {
+        match self {
+            IntegratorKind::Bdpt(i) => i.li_splat(scene, ray, sampler, stats, splat),
+            _ => self.li(scene, ray, sampler, stats),
+        }
+    }
+
     fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
         match self {
             IntegratorKind::Path(i) => i.li(scene, ray, sampler, stats),
