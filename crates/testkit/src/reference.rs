@@ -62,37 +62,80 @@ pub struct Comparison {
     pub ref_mean: DVec3,
 }
 
-/// Per-pixel z-tests of `film` against `r` (the pixels it rendered), and of the image means.
+/// Per-pixel z-tests of `film` against `r` (the pixels it rendered), and of the image means;
+/// each pixel's variance is that of its own samples' mean.
 pub fn compare(film: &Film, r: &Reference) -> Comparison {
+    let estimates: Vec<Option<(DVec3, DVec3)>> = film
+        .pixels()
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (p.count() > 0).then(|| (film.pixel_value(i), p.variance_of_mean())))
+        .collect();
+    compare_estimates(&estimates, r, MAX_Z)
+}
+
+/// [`compare`] of the mean of independent renders (other seeds), each pixel's variance
+/// estimated from how its value varies between them: for films whose pixels also hold light
+/// traced from other pixels' samples (the bidirectional path tracer's splats), whose variance
+/// a pixel's own samples do not tell. With few renders that estimate has few degrees of
+/// freedom, so a pixel is an outlier beyond the quantile of Student's t (renders − 1 degrees
+/// of freedom) with the tail probability that |z| > [`MAX_Z`] has for a normal z.
+pub fn compare_replicated(films: &[Film], r: &Reference) -> Comparison {
+    use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
+    let k = films.len() as f64;
+    let tail = Normal::standard().cdf(-MAX_Z);
+    let limit = StudentsT::new(0.0, 1.0, k - 1.0)
+        .map(|t| t.inverse_cdf(1.0 - tail))
+        .unwrap_or(f64::INFINITY);
+    let estimates: Vec<Option<(DVec3, DVec3)>> = (0..films[0].pixels().len())
+        .map(|i| {
+            (films[0].pixels()[i].count() > 0).then(|| {
+                let values: Vec<DVec3> = films.iter().map(|f| f.pixel_value(i)).collect();
+                let mean = values.iter().sum::<DVec3>() / k;
+                let var = values
+                    .iter()
+                    .map(|v| (*v - mean) * (*v - mean))
+                    .sum::<DVec3>()
+                    / (k - 1.0);
+                (mean, var / k)
+            })
+        })
+        .collect();
+    compare_estimates(&estimates, r, limit)
+}
+
+/// Per-pixel z-tests of estimates (value, variance of the value; `None` where nothing was
+/// rendered) against `r`, outliers beyond `limit` standard errors; and of the image means.
+pub fn compare_estimates(
+    estimates: &[Option<(DVec3, DVec3)>],
+    r: &Reference,
+    limit: f64,
+) -> Comparison {
     let mut outliers = [0usize; 3];
     let mut ref_var_sum = DVec3::ZERO;
+    let (mut ours_sum, mut ours_var, mut ref_sum) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
     let mut compared = 0usize;
-    for (i, p) in film.pixels().iter().enumerate() {
-        if p.count() == 0 {
+    for (i, e) in estimates.iter().enumerate() {
+        let Some((ours, var)) = *e else {
             continue; // outside the rendered window
-        }
+        };
         compared += 1;
-        let ours = p.mean();
         let rounding = r.mean[i].abs() * REFERENCE_ROUNDING;
-        let se2 = p.variance_of_mean() + r.stderr[i] * r.stderr[i] + rounding * rounding;
+        let se2 = var + r.stderr[i] * r.stderr[i] + rounding * rounding;
         ref_var_sum += r.stderr[i] * r.stderr[i];
+        ours_sum += ours;
+        ours_var += var;
+        ref_sum += r.mean[i];
         for c in 0..3 {
             let diff = (ours[c] - r.mean[i][c]).abs();
-            outliers[c] += (diff > MAX_Z * se2[c].sqrt()) as usize;
+            outliers[c] += (diff > limit * se2[c].sqrt()) as usize;
         }
     }
     let n = compared as f64;
-    let rendered = || {
-        film.pixels()
-            .iter()
-            .zip(&r.mean)
-            .filter(|(p, _)| p.count() > 0)
-    };
-    let ref_mean = rendered().map(|(_, m)| *m).sum::<DVec3>() / n;
+    let ref_mean = ref_sum / n;
     let ref_se = (ref_var_sum / (n * n)).map(f64::sqrt);
-    let ours_mean = rendered().map(|(p, _)| p.mean()).sum::<DVec3>() / n;
-    let ours_var = rendered().map(|(p, _)| p.variance_of_mean()).sum::<DVec3>() / (n * n);
-    let se = (ours_var + ref_se * ref_se).map(f64::sqrt);
+    let ours_mean = ours_sum / n;
+    let se = (ours_var / (n * n) + ref_se * ref_se).map(f64::sqrt);
     Comparison {
         outliers,
         pixels: compared,

@@ -1,5 +1,5 @@
-//! Bidirectional path tracing ([`BdptIntegrator`], Veach 1997, ch. 10; pbrt-v4's `BDPTIntegrator`
-//! without the light-tracing strategy).
+//! Bidirectional path tracing ([`BdptIntegrator`], Veach 1997, ch. 10; pbrt-v4's
+//! `BDPTIntegrator`).
 //!
 //! Each pixel sample traces a camera subpath x₀ x₁ … (x₀ on the lens) and a light subpath
 //! y₀ y₁ … (y₀ on a light, chosen by the scene's light sampler, its ray by
@@ -7,28 +7,35 @@
 //! other: strategy (s, t) takes s light vertices and t camera vertices, so that the same path
 //! of length s + t − 1 segments can come from several strategies. s = 0 is the camera path
 //! finding emission itself, s = 1 light sampling at its last vertex, s ≥ 2 a shadow ray
-//! between xₜ₋₁ and yₛ₋₁. Each contribution is weighted by the power heuristic over the
-//! densities with which every other strategy would have produced the same path (computed from
-//! the per-vertex densities `pdf_fwd` and `pdf_rev`, both per unit area), so that the weights of
-//! one path sum to one and the estimate stays unbiased.
+//! between xₜ₋₁ and yₛ₋₁, and t = 1 light tracing: yₛ₋₁ joined to a point on the lens
+//! ([`crate::camera::Camera::sample_wi`]), its contribution splatted on the film position it
+//! reaches, which may be another pixel's ([`Integrator::li_splat`]). Each contribution is
+//! weighted by the power heuristic over the densities with which every other strategy would
+//! have produced the same path (computed from the per-vertex densities `pdf_fwd` and
+//! `pdf_rev`, both per unit area, recomputed from the vertices' positions), so that the
+//! weights of one path sum to one and the estimate stays unbiased.
 //!
-//! The strategy t = 1 (a light subpath joined to the lens, splatted on another pixel) is not
-//! taken: every estimate here belongs to its own pixel, which keeps the film's per-pixel
-//! statistics, checkpoints and shards exact. Its share goes to the other strategies; caustics
-//! seen directly (light → specular → diffuse → camera) are then found by s = 0 alone, as the
-//! path tracer finds them. Lights that do not emit rays (at infinity, projectors) are reached
-//! by s = 0 and s = 1 only.
+//! Light tracing is taken when the render loop collects splats and the camera can receive
+//! light (a perspective camera without clipping planes); otherwise (adaptive sampling, one
+//! pixel's samples, an orthographic camera) the other strategies share its paths, caustics
+//! seen directly then being found by s = 0 alone, as the path tracer finds them. Lights that
+//! do not emit rays (at infinity, projectors) are reached by s = 0 and s = 1 only.
 //!
 //! Light subpaths carry importance: at their vertices the BSDF is the adjoint one
-//! ([`Bsdf::f_cos_importance`], [`Bsdf::delta_importance_scale`]).
+//! ([`crate::bsdf::Bsdf::f_cos_importance`],
+//! [`crate::bsdf::Bsdf::delta_importance_scale`]).
+
+#[cfg(test)]
+mod tests;
+mod vertex;
 
 use super::{trace, Integrator, PathStats};
-use crate::bsdf::Bsdf;
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, spawn_ray, spawn_ray_to, Ray};
-use crate::scene::{Scene, SurfaceInteraction};
-use glam::Vec3;
+use crate::scene::Scene;
+use glam::Vec2;
 use pathlab_mc::sampler::{AnySampler, Sampler};
+use vertex::{Kind, Vertex};
 
 /// Bidirectional path tracing with the power heuristic.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,94 +58,13 @@ impl Default for BdptIntegrator {
     }
 }
 
-/// What a subpath vertex is.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Kind {
-    /// The lens.
-    Camera,
-    /// A point on a light: a light subpath's start, or one sampled for s = 1.
-    Light,
-    /// A surface point (possibly on an emitter: `light` is then set).
-    Surface,
-    /// A camera ray that left the scene, or a light at infinity: `p` holds the direction.
-    Infinite,
-}
-
-/// A subpath vertex.
-#[derive(Clone, Copy, Debug)]
-struct Vertex {
-    kind: Kind,
-    /// Position (the direction for [`Kind::Infinite`]).
-    p: Vec3,
-    /// Geometric normal, for points on surfaces.
-    n: Option<Vec3>,
-    /// The light it lies on (or, at infinity, comes from).
-    light: Option<u32>,
-    /// Throughput from the subpath's start to here (for a sampled light vertex, its radiance
-    /// over its density).
-    beta: Rgb,
-    /// Density per unit area with which its own subpath produced it.
-    pdf_fwd: f32,
-    /// Density per unit area with which the other direction would have produced it.
-    pdf_rev: f32,
-    /// Whether the subpath left it through a delta lobe.
-    delta: bool,
-    /// Direction to the vertex before it on its subpath.
-    wo: Vec3,
-    /// The surface point and its BSDF (surfaces only).
-    surface: Option<(SurfaceInteraction, Bsdf)>,
-}
-
-impl Vertex {
-    fn endpoint(kind: Kind, p: Vec3, n: Option<Vec3>, light: Option<u32>, beta: Rgb) -> Self {
-        Vertex {
-            kind,
-            p,
-            n,
-            light,
-            beta,
-            pdf_fwd: 0.0,
-            pdf_rev: 0.0,
-            delta: false,
-            wo: Vec3::ZERO,
-            surface: None,
-        }
-    }
-
-    /// The BSDF of a surface vertex a connection can pass through (one with a lobe that is not
-    /// a delta).
-    fn connectible(&self) -> Option<&(SurfaceInteraction, Bsdf)> {
-        self.surface.as_ref().filter(|(_, b)| !b.is_delta())
-    }
-
-    /// Density per unit solid angle `pdf` of the direction from here to `next`, per unit area
-    /// at `next` (unchanged towards infinity).
-    fn convert_density(&self, pdf: f32, next: &Vertex) -> f32 {
-        if next.kind == Kind::Infinite {
-            return pdf;
-        }
-        let w = next.p - self.p;
-        let d2 = w.length_squared();
-        if d2 == 0.0 {
-            return 0.0;
-        }
-        let cos = next.n.map_or(1.0, |n| n.dot(w).abs() / d2.sqrt());
-        pdf * cos / d2
-    }
-
-    /// Unit direction from here to `other`.
-    fn towards(&self, other: &Vertex) -> Vec3 {
-        match other.kind {
-            Kind::Infinite => other.p,
-            _ => (other.p - self.p).normalize_or_zero(),
-        }
-    }
-}
-
 /// The vertices of one sample's two subpaths.
 struct Subpaths {
     camera: Vec<Vertex>,
     light: Vec<Vertex>,
+    /// Whether this sample takes the light-tracing strategies (t = 1): when its light can be
+    /// splatted on the film, and the camera can receive it.
+    light_tracing: bool,
 }
 
 impl BdptIntegrator {
@@ -240,6 +166,7 @@ impl BdptIntegrator {
         &self,
         scene: &Scene,
         ray: Ray,
+        light_tracing: bool,
         sampler: &mut AnySampler,
         stats: &mut PathStats,
     ) -> Subpaths {
@@ -260,10 +187,18 @@ impl BdptIntegrator {
         let u_select = sampler.next_1d();
         let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
         let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
-            return Subpaths { camera, light };
+            return Subpaths {
+                camera,
+                light,
+                light_tracing,
+            };
         };
         let Some(le) = scene.lights()[index].sample_le(u_pos, u_dir) else {
-            return Subpaths { camera, light };
+            return Subpaths {
+                camera,
+                light,
+                light_tracing,
+            };
         };
         let pdf_pos = pmf * le.pdf_pos;
         let cos = le.n.map_or(1.0, |n| n.dot(le.w).abs());
@@ -286,7 +221,11 @@ impl BdptIntegrator {
             sampler,
             stats,
         );
-        Subpaths { camera, light }
+        Subpaths {
+            camera,
+            light,
+            light_tracing,
+        }
     }
 
     /// Density per unit area at `next` with which the light `v` lies on emits towards it.
@@ -324,7 +263,10 @@ impl BdptIntegrator {
     fn pdf(scene: &Scene, v: &Vertex, prev: Option<&Vertex>, next: &Vertex) -> f32 {
         match v.kind {
             Kind::Light | Kind::Infinite => Self::pdf_light(scene, v, next),
-            Kind::Camera => 0.0,
+            Kind::Camera => {
+                let w = v.towards(next);
+                v.convert_density(scene.camera().pdf_we_dir(v.p, w), next)
+            }
             Kind::Surface => {
                 let (Some((_, bsdf)), Some(prev)) = (&v.surface, prev) else {
                     return 0.0;
@@ -335,9 +277,11 @@ impl BdptIntegrator {
         }
     }
 
-    /// The power-heuristic weight of strategy (s, t), `sampled` being the light vertex that
-    /// light sampling chose for s = 1. `emits`: whether the path's light starts subpaths;
-    /// `delta_light`: whether no ray can hit it.
+    /// The power-heuristic weight of strategy (s, t), `sampled` being the vertex this strategy
+    /// chose itself: the light point of light sampling (s = 1), or the lens point of light
+    /// tracing (t = 1). `emits`: whether the path's light starts subpaths; `delta_light`:
+    /// whether no ray can hit it. Light tracing counts among the strategies when the sample
+    /// takes it ([`Subpaths::light_tracing`]).
     #[allow(clippy::too_many_arguments)]
     fn mis_weight(
         scene: &Scene,
@@ -356,23 +300,29 @@ impl BdptIntegrator {
             1 => sampled,
             _ => Some(&paths.light[s - 1]),
         };
-        let pt = &paths.camera[t - 1];
-        let pt_minus = &paths.camera[t - 2];
+        let (pt, pt_minus) = match t {
+            1 => match sampled {
+                Some(lens) => (lens, None),
+                None => return 0.0,
+            },
+            _ => (&paths.camera[t - 1], Some(&paths.camera[t - 2])),
+        };
         let qs_minus = (s > 1).then(|| &paths.light[s - 2]);
         // The reverse densities the join changes (of x_{t-1}, x_{t-2}, y_{s-1}, y_{s-2}).
-        let (pt_rev, pt_minus_rev, qs_rev, qs_minus_rev) = match qs {
-            Some(qs) => (
+        let (pt_rev, pt_minus_rev, qs_rev, qs_minus_rev) = match (qs, pt_minus) {
+            (Some(qs), _) => (
                 Self::pdf(scene, qs, qs_minus, pt),
-                Self::pdf(scene, pt, Some(qs), pt_minus),
-                Self::pdf(scene, pt, Some(pt_minus), qs),
+                pt_minus.map_or(0.0, |pm| Self::pdf(scene, pt, Some(qs), pm)),
+                Self::pdf(scene, pt, pt_minus, qs),
                 qs_minus.map_or(0.0, |qm| Self::pdf(scene, qs, Some(pt), qm)),
             ),
-            None => (
+            (None, Some(pt_minus)) => (
                 Self::pdf_light_origin(scene, pt),
                 Self::pdf_light(scene, pt, pt_minus),
                 0.0,
                 0.0,
             ),
+            (None, None) => return 0.0,
         };
         // (pdf_fwd, pdf_rev, delta) of the vertices of this strategy's path; the vertices
         // joined are not degenerate, whatever their subpaths left them by.
@@ -397,9 +347,11 @@ impl BdptIntegrator {
         };
         let remap = |f: f32| if f != 0.0 { f } else { 1.0 };
         let mut sum = 0.0f32;
-        // Strategies with fewer camera vertices, down to t = 2 (t = 1 is not taken).
+        // Strategies with fewer camera vertices, down to t = 1 when light tracing is taken,
+        // else t = 2.
+        let lowest = if paths.light_tracing { 1 } else { 2 };
         let mut ri = 1.0f32;
-        for i in (2..t).rev() {
+        for i in (lowest..t).rev() {
             let (fwd, rev, delta) = camera(i);
             ri *= remap(rev) / remap(fwd);
             let s_other = s + t - i;
@@ -543,17 +495,31 @@ impl BdptIntegrator {
     }
 }
 
-impl Integrator for BdptIntegrator {
-    fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
-        let paths = self.subpaths(scene, ray, sampler, stats);
+impl BdptIntegrator {
+    /// The estimate of one camera ray: every strategy's weighted contribution, those of light
+    /// tracing handed to `splat` when there is one.
+    fn estimate(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+        mut splat: Option<&mut dyn FnMut(Vec2, Rgb)>,
+    ) -> Rgb {
+        let light_tracing = splat.is_some() && self.splats(scene);
+        let paths = self.subpaths(scene, ray, light_tracing, sampler, stats);
         let mut l = Rgb::ZERO;
+        let within = |s: usize, t: usize| (s + t - 2) as u64 <= self.max_depth as u64;
+        if let Some(splat) = splat.as_mut().filter(|_| light_tracing) {
+            for s in (2..=paths.light.len()).take_while(|&s| within(s, 1)) {
+                if let Some((film, v)) = self.light_trace(scene, &paths, s, sampler, stats) {
+                    splat(film, v);
+                }
+            }
+        }
         for t in 2..=paths.camera.len() {
             // s = 1 samples its own light point, so it needs no light subpath.
-            for s in 0..=paths.light.len().max(1) {
-                let depth = (s + t - 2) as u64;
-                if depth > self.max_depth as u64 {
-                    break;
-                }
+            for s in (0..=paths.light.len().max(1)).take_while(|&s| within(s, t)) {
                 l += match s {
                     0 => self.emission(scene, &paths, t),
                     1 => self.light_sample(scene, &paths, t, sampler, stats),
@@ -563,58 +529,55 @@ impl Integrator for BdptIntegrator {
         }
         l
     }
+
+    /// Strategy t = 1: the light subpath's vertex s − 1 joined to a point on the lens; the
+    /// film position it reaches and its weighted contribution there.
+    fn light_trace(
+        &self,
+        scene: &Scene,
+        paths: &Subpaths,
+        s: usize,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+    ) -> Option<(Vec2, Rgb)> {
+        let qs = &paths.light[s - 1];
+        let u = sampler.next_2d();
+        let (sq, bq) = qs.connectible()?;
+        let cs = scene.camera().sample_wi(sq.p, u)?;
+        let l = qs.beta * bq.f_cos_importance(qs.wo, cs.wi) * (cs.we / cs.pdf);
+        if l.max_element() <= 0.0 || !l.is_finite() {
+            return None;
+        }
+        stats.rays += 1;
+        if scene.occluded(&spawn_ray_to(sq.p, sq.ng, cs.p_lens, None)) {
+            return None;
+        }
+        let lens = Vertex::endpoint(Kind::Camera, cs.p_lens, None, None, Rgb::ZERO);
+        let delta_light = paths.light[0]
+            .light
+            .is_some_and(|i| scene.lights()[i as usize].is_delta_position());
+        let w = Self::mis_weight(scene, paths, Some(&lens), s, 1, true, delta_light);
+        Some((cs.film, l * w))
+    }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::desc::*;
-    use pathlab_mc::sampler::SamplerKind;
+impl Integrator for BdptIntegrator {
+    fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
+        self.estimate(scene, ray, sampler, stats, None)
+    }
 
-    /// Inside a sphere that emits everywhere, every camera path x₀ x₁ x₂ ends on the light,
-    /// and light sampling at x₁ (s = 1, t = 2) could have chosen x₂ too: the two strategies'
-    /// weights of that path must sum to one, including for the short grazing segments where
-    /// a sample's own density and the one recomputed from the vertices differ most.
-    #[test]
-    fn weights_of_the_strategies_of_one_path_sum_to_one() {
-        let desc = SceneDesc {
-            spheres: vec![SphereDesc {
-                center: Vec3::ZERO,
-                radius: 1.0,
-                material: 0,
-                emission: Some(Emission {
-                    radiance: Vec3::ONE,
-                    two_sided: true,
-                }),
-                ..Default::default()
-            }],
-            materials: vec![crate::scene::diffuse(Vec3::splat(0.6), true)],
-            resolution: [16, 16],
-            ..Default::default()
-        };
-        let scene = Scene::build(&desc).expect("the sphere builds");
-        let bdpt = BdptIntegrator {
-            max_depth: 1,
-            ..Default::default()
-        };
-        let mut sampler = SamplerKind::Independent.build(1 << 12, 1);
-        let mut stats = PathStats::default();
-        let origin = Vec3::new(0.1, -0.2, 0.05);
-        for i in 0..4096 {
-            sampler.start_pixel_sample([3, 4], i, 0);
-            let d = pathlab_mc::warp::sample_uniform_sphere(sampler.next_2d());
-            let paths = bdpt.subpaths(&scene, Ray::new(origin, d), &mut sampler, &mut stats);
-            assert_eq!(paths.camera.len(), 3, "every path ends on the sphere");
-            let x2 = &paths.camera[2];
-            let w_emission = BdptIntegrator::mis_weight(&scene, &paths, None, 0, 3, true, false);
-            let mut sampled = Vertex::endpoint(Kind::Light, x2.p, x2.n, x2.light, Rgb::ZERO);
-            sampled.pdf_fwd = BdptIntegrator::pdf_light_origin(&scene, &sampled);
-            let w_light =
-                BdptIntegrator::mis_weight(&scene, &paths, Some(&sampled), 1, 2, true, false);
-            assert!(
-                (w_emission + w_light - 1.0).abs() < 1e-4,
-                "sample {i}: {w_emission} + {w_light}"
-            );
-        }
+    fn splats(&self, scene: &Scene) -> bool {
+        scene.camera().supports_light_tracing()
+    }
+
+    fn li_splat(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+        splat: &mut dyn FnMut(Vec2, Rgb),
+    ) -> Rgb {
+        self.estimate(scene, ray, sampler, stats, Some(splat))
     }
 }
