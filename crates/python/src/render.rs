@@ -12,7 +12,7 @@ use numpy::ndarray::{Array2, Array3};
 use numpy::IntoPyArray;
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::desc::RenderHints;
-use pathlab_render::film::{Film, PixelStats};
+use pathlab_render::film::Film;
 use pathlab_render::integrator::{
     DirectStrategy, IntegratorChoice, IntegratorKind, IntegratorName,
 };

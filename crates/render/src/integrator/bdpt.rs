@@ -29,7 +29,7 @@
 mod tests;
 mod vertex;
 
-use super::{trace, Integrator, PathStats};
+use super::{trace, visible_light_sample, Integrator, PathStats, VisibleLightSample};
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, spawn_ray, spawn_ray_to, Ray};
 use crate::scene::Scene;
@@ -416,30 +416,13 @@ impl BdptIntegrator {
         let Some((si, bsdf)) = pt.connectible() else {
             return Rgb::ZERO;
         };
-        let (u_select, u) = (sampler.next_1d(), sampler.next_2d());
-        let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
+        let u = (sampler.next_1d(), sampler.next_2d());
+        let Some(VisibleLightSample { index, pmf, ls, f }) =
+            visible_light_sample(scene, si, bsdf, pt.wo, u, stats)
+        else {
             return Rgb::ZERO;
         };
         let light = &scene.lights()[index];
-        let Some(ls) = light.sample_li(si.p, u) else {
-            return Rgb::ZERO;
-        };
-        if ls.pdf <= 0.0 || ls.li.max_element() <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let f = bsdf.f_cos(pt.wo, ls.wi);
-        if f.max_element() <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let shadow = if light.is_infinite() {
-            spawn_ray(si.p, si.ng, ls.wi)
-        } else {
-            spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light)
-        };
-        stats.rays += 1;
-        if scene.occluded(&shadow) {
-            return Rgb::ZERO;
-        }
         let (kind, p) = if light.is_infinite() {
             (Kind::Infinite, ls.wi)
         } else {

@@ -25,6 +25,7 @@ pub use path::{PathIntegrator, PathLighting};
 use crate::bsdf::Bsdf;
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, spawn_ray_to, Ray};
+use crate::light::LightLiSample;
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::{Vec2, Vec3};
 use pathlab_mc::sampler::{AnySampler, Sampler};
@@ -269,6 +270,53 @@ pub fn power_heuristic_weight<T: Real>(f: T, g: T) -> T {
     )
 }
 
+/// A light sample that reaches a surface point: the light chosen and the probability of
+/// choosing it, the sample, and f |cos θi| towards it (all positive).
+pub(crate) struct VisibleLightSample {
+    /// The light's index.
+    pub(crate) index: usize,
+    /// The probability of choosing it.
+    pub(crate) pmf: f32,
+    /// The sample.
+    pub(crate) ls: LightLiSample,
+    /// f(wo, wi) |cos θi| along it.
+    pub(crate) f: Rgb,
+}
+
+/// Light sampling at surface point `si` seen from `wo`: a light chosen by `u_select`, a point
+/// or direction on it by `u_light`, kept when it carries light, the BSDF passes it and a
+/// shadow ray finds nothing in between (the ray is counted). The one light sample of the path
+/// tracer, the direct integrator and the bidirectional path tracer's s = 1 strategy.
+pub(crate) fn visible_light_sample(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    (u_select, u_light): (f32, Vec2),
+    stats: &mut PathStats,
+) -> Option<VisibleLightSample> {
+    let (index, pmf) = scene.light_sampler().sample(u_select)?;
+    let light = &scene.lights()[index];
+    let ls = light.sample_li(si.p, u_light)?;
+    if ls.pdf <= 0.0 || ls.li.max_element() <= 0.0 {
+        return None;
+    }
+    let f = bsdf.f_cos(wo, ls.wi);
+    if f.max_element() <= 0.0 {
+        return None;
+    }
+    let shadow = if light.is_infinite() {
+        Ray::new(offset_ray_origin(si.p, si.ng, ls.wi), ls.wi)
+    } else {
+        spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light)
+    };
+    stats.rays += 1;
+    if scene.occluded(&shadow) {
+        return None;
+    }
+    Some(VisibleLightSample { index, pmf, ls, f })
+}
+
 /// A light sample's contribution f · Li · |cos θi| / p at a surface point, weighted by MIS
 /// against `bsdf_samples` BSDF samples when that is nonzero (delta lights always get weight 1).
 /// `light_samples` is how many such light samples the caller averages.
@@ -284,29 +332,11 @@ pub(crate) fn sample_light(
     bsdf_samples: u32,
     stats: &mut PathStats,
 ) -> Rgb {
-    let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
+    let Some(VisibleLightSample { pmf, ls, f, .. }) =
+        visible_light_sample(scene, si, bsdf, wo, (u_select, u_light), stats)
+    else {
         return Rgb::ZERO;
     };
-    let light = &scene.lights()[index];
-    let Some(ls) = light.sample_li(si.p, u_light) else {
-        return Rgb::ZERO;
-    };
-    if ls.pdf <= 0.0 || ls.li.max_element() <= 0.0 {
-        return Rgb::ZERO;
-    }
-    let f = bsdf.f_cos(wo, ls.wi);
-    if f.max_element() <= 0.0 {
-        return Rgb::ZERO;
-    }
-    let shadow = if light.is_infinite() {
-        Ray::new(offset_ray_origin(si.p, si.ng, ls.wi), ls.wi)
-    } else {
-        spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light)
-    };
-    stats.rays += 1;
-    if scene.occluded(&shadow) {
-        return Rgb::ZERO;
-    }
     let pdf = pmf * ls.pdf;
     let weight = if ls.is_delta || bsdf_samples == 0 {
         1.0
