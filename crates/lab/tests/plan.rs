@@ -93,3 +93,27 @@ fn defaults_fill_what_neither_says() {
         (PROGRESSIVE_CAP, SamplerKind::Independent)
     );
 }
+
+#[test]
+fn bdpt_says_when_it_traces_no_light_to_the_lens() {
+    use pathlab_render::integrator::{IntegratorChoice, IntegratorName};
+    use pathlab_render::render::Adaptive;
+    let req = RenderRequest {
+        scene: "cornell-box".into(),
+        integrator: IntegratorChoice {
+            name: Some(IntegratorName::Bdpt),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    assert!(plan(&req).1.is_empty(), "{:?}", plan(&req).1);
+    let req = RenderRequest {
+        adaptive: Some(Adaptive::DEFAULT),
+        ..req
+    };
+    let warnings = plan(&req).1;
+    assert!(
+        warnings.len() == 1 && warnings[0].contains("no light tracing"),
+        "{warnings:?}"
+    );
+}

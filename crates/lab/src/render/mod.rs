@@ -122,6 +122,14 @@ impl Plan {
         req.edits.apply(&mut desc)?;
         let scene = Scene::build(&desc).context("cannot build the scene")?;
         let (integrator_name, integrator) = choice.integrator(&desc.hints);
+        if let IntegratorKind::Bdpt(_) = integrator {
+            // Light traced to the lens lands on any pixel, which only whole-frame passes take.
+            if req.adaptive.is_some() {
+                warn("bdpt with adaptive sampling: no light tracing to the lens (t = 1); the other strategies take its share");
+            } else if !scene.camera().supports_light_tracing() {
+                warn("bdpt: this camera (orthographic, or with clipping planes) takes no light traced to it (t = 1); the other strategies take its share");
+            }
+        }
         let spp = req.spp.unwrap_or(desc.hints.spp_or_default());
         let sampler = req
             .sampler
