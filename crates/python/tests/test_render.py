@@ -132,6 +132,19 @@ def test_direct_lighting_strategies_differ_in_variance_not_in_mean():
     assert v_l < v_h / 4, stats
 
 
+def test_the_bidirectional_path_tracer_agrees_with_the_path_tracer():
+    # Light traced to the lens lands on other pixels, so the standard error of the image mean
+    # comes from independent renders (seeds).
+    scene = pathlab.load("cornell-box")
+    means = {}
+    for integrator in ("path", "bdpt"):
+        m = [pathlab.render(scene, spp=8, seed=s, integrator=integrator, sampler="independent",
+                            resolution=(48, 48)).astype(np.float64).mean() for s in range(6)]
+        means[integrator] = (np.mean(m), np.std(m, ddof=1) / np.sqrt(len(m)))
+    (a, sa), (b, sb) = means["path"], means["bdpt"]
+    assert abs(a - b) < 4 * np.hypot(sa, sb), means
+
+
 def test_the_gil_is_released_while_rendering():
     scene = pathlab.load("cornell-box")
     ticks = []

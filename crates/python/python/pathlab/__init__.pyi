@@ -46,7 +46,7 @@ def load(source: Union[str, PathLike], **params: object) -> Scene:
     ``pathlab render -D name=value`` does. Raises SceneError with the file, line and what was
     expected."""
 
-IntegratorName = Literal["path", "direct", "normals", "depth", "bvh"]
+IntegratorName = Literal["path", "bdpt", "direct", "normals", "depth", "bvh"]
 DirectName = Literal["hemisphere", "cosine", "light", "mis"]
 SamplerName = Literal["independent", "stratified", "sobol"]
 
