@@ -5,14 +5,14 @@ use glam::{Mat3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::desc::{CameraDesc, RenderHints};
 use pathlab_render::integrator::{
-    DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
+    BdptIntegrator, DebugView, DirectIntegrator, DirectStrategy, IntegratorKind, PathIntegrator,
 };
 use serde_json::{json, Value};
 
 /// The settings the page controls.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Controls {
-    /// "path", "direct", or a debug view: "normals", "depth", "bvh" (nodes visited per
+    /// "path", "bdpt", "direct", or a debug view: "normals", "depth", "bvh" (nodes visited per
     /// camera ray, shown as a heat map over its range).
     pub integrator: String,
     /// The direct integrator's strategy.
@@ -93,12 +93,12 @@ impl Controls {
             let bad = || format!("{key}: {value} is not a valid value");
             match key.as_str() {
                 "integrator" => match value.as_str() {
-                    Some(s @ ("path" | "direct" | "normals" | "depth" | "bvh")) => {
+                    Some(s @ ("path" | "bdpt" | "direct" | "normals" | "depth" | "bvh")) => {
                         next.integrator = s.to_string()
                     }
                     _ => {
                         return Err(format!(
-                            "integrator: expected path, direct, normals, depth or bvh, got {value}"
+                            "integrator: expected path, bdpt, direct, normals, depth or bvh, got {value}"
                         ))
                     }
                 },
@@ -204,6 +204,11 @@ impl Controls {
                 samples: self.light_samples,
                 hide_emitters: self.hide_emitters,
                 ..Default::default()
+            }),
+            "bdpt" => IntegratorKind::Bdpt(BdptIntegrator {
+                max_depth: self.max_depth,
+                rr_depth: self.rr_depth,
+                hide_emitters: self.hide_emitters,
             }),
             "normals" => IntegratorKind::Debug(DebugView::Normals),
             "depth" => IntegratorKind::Debug(DebugView::Depth),
@@ -314,7 +319,14 @@ mod tests {
             IntegratorKind::Debug(DebugView::BvhHeat)
         ));
         assert!(c.apply(r#"{"light_samples": 0}"#).is_err());
-        assert!(c.apply(r#"{"integrator": "bdpt"}"#).is_err());
+        assert!(c.apply(r#"{"integrator": "mlt"}"#).is_err());
+        // The bidirectional path tracer takes the depths.
+        c.apply(r#"{"integrator": "bdpt", "max_depth": 4}"#)
+            .unwrap();
+        match c.integrator() {
+            IntegratorKind::Bdpt(b) => assert_eq!((b.max_depth, b.rr_depth), (4, 0)),
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]
