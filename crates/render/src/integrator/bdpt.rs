@@ -183,22 +183,31 @@ impl BdptIntegrator {
             sampler,
             stats,
         );
+        let light = self.light_subpath(scene, sampler, stats);
+        Subpaths {
+            camera,
+            light,
+            light_tracing,
+        }
+    }
+
+    /// A light subpath: a light chosen by the light sampler, a ray of its light
+    /// ([`crate::light::Light::sample_le`]), and the walk from it. Empty when the light
+    /// chosen emits no rays (it lies at infinity).
+    fn light_subpath(
+        &self,
+        scene: &Scene,
+        sampler: &mut AnySampler,
+        stats: &mut PathStats,
+    ) -> Vec<Vertex> {
         let mut light = Vec::with_capacity(8);
         let u_select = sampler.next_1d();
         let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
         let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
-            return Subpaths {
-                camera,
-                light,
-                light_tracing,
-            };
+            return light;
         };
         let Some(le) = scene.lights()[index].sample_le(u_pos, u_dir) else {
-            return Subpaths {
-                camera,
-                light,
-                light_tracing,
-            };
+            return light;
         };
         let pdf_pos = pmf * le.pdf_pos;
         let cos = le.n.map_or(1.0, |n| n.dot(le.w).abs());
@@ -221,11 +230,7 @@ impl BdptIntegrator {
             sampler,
             stats,
         );
-        Subpaths {
-            camera,
-            light,
-            light_tracing,
-        }
+        light
     }
 
     /// Density per unit area at `next` with which the light `v` lies on emits towards it.
