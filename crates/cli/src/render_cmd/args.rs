@@ -153,8 +153,8 @@ pub struct RenderArgs {
     pub output: Vec<PathBuf>,
     /// The integrator: path (path tracing with next-event estimation, MIS and Russian
     /// roulette), bdpt (bidirectional path tracing: camera and light subpaths joined by every
-    /// strategy but light tracing, weighted by MIS), direct (direct lighting only, by the
-    /// strategy --direct names), or the debug
+    /// strategy, light traced to the lens included, weighted by MIS), direct (direct lighting
+    /// only, by the strategy --direct names), or the debug
     /// views normals (shading normals), depth (distance to the first surface) and bvh (BVH
     /// nodes visited per camera ray). Default: the one the scene file names, else path.
     #[arg(long)]
