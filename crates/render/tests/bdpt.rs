@@ -12,6 +12,7 @@ use pathlab_render::bsdf::{FresnelModel, NormalDistribution};
 use pathlab_render::desc::*;
 use pathlab_render::film::Film;
 use pathlab_render::integrator::*;
+use pathlab_testkit::reference::replicated_estimates;
 
 fn bdpt(max_depth: u32) -> IntegratorKind {
     IntegratorKind::Bdpt(BdptIntegrator {
@@ -128,18 +129,9 @@ fn replicated(
     let films: Vec<Film> = (0..renders)
         .map(|k| run(desc, integrator, spp, 100 + k))
         .collect();
-    let n = renders as f64;
-    (0..films[0].pixels().len())
-        .map(|i| {
-            let values: Vec<DVec3> = films.iter().map(|f| f.pixel_value(i)).collect();
-            let mean = values.iter().sum::<DVec3>() / n;
-            let var = values
-                .iter()
-                .map(|v| (*v - mean) * (*v - mean))
-                .sum::<DVec3>()
-                / (n - 1.0);
-            (mean, var / n)
-        })
+    replicated_estimates(&films)
+        .into_iter()
+        .map(|e| e.expect("every pixel is rendered"))
         .collect()
 }
 

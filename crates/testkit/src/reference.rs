@@ -82,12 +82,19 @@ pub fn compare(film: &Film, r: &Reference) -> Comparison {
 /// of freedom) with the tail probability that |z| > [`MAX_Z`] has for a normal z.
 pub fn compare_replicated(films: &[Film], r: &Reference) -> Comparison {
     use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
-    let k = films.len() as f64;
     let tail = Normal::standard().cdf(-MAX_Z);
-    let limit = StudentsT::new(0.0, 1.0, k - 1.0)
+    let limit = StudentsT::new(0.0, 1.0, films.len() as f64 - 1.0)
         .map(|t| t.inverse_cdf(1.0 - tail))
         .unwrap_or(f64::INFINITY);
-    let estimates: Vec<Option<(DVec3, DVec3)>> = (0..films[0].pixels().len())
+    compare_estimates(&replicated_estimates(films), r, limit)
+}
+
+/// Each pixel's value over independent renders of one image (other seeds): the mean of its
+/// values and the variance of that mean, estimated from how they vary between the renders;
+/// `None` for a pixel the first render did not render.
+pub fn replicated_estimates(films: &[Film]) -> Vec<Option<(DVec3, DVec3)>> {
+    let k = films.len() as f64;
+    (0..films[0].pixels().len())
         .map(|i| {
             (films[0].pixels()[i].count() > 0).then(|| {
                 let values: Vec<DVec3> = films.iter().map(|f| f.pixel_value(i)).collect();
@@ -100,8 +107,7 @@ pub fn compare_replicated(films: &[Film], r: &Reference) -> Comparison {
                 (mean, var / k)
             })
         })
-        .collect();
-    compare_estimates(&estimates, r, limit)
+        .collect()
 }
 
 /// Per-pixel z-tests of estimates (value, variance of the value; `None` where nothing was

@@ -88,15 +88,14 @@ impl BdptIntegrator {
         let mut walk = Rgb::ONE;
         let mut bounces = 0u32;
         while bounces < max_vertices {
-            let kind = if importance || bounces > 0 {
+            let kind = if importance {
                 RayKind::Indirect
             } else {
-                RayKind::Camera
+                RayKind::at_depth(bounces)
             };
             let Some(si) = trace(scene, &ray, kind, stats) else {
-                if !importance && scene.environment().is_some() {
-                    let mut v =
-                        Vertex::endpoint(Kind::Infinite, ray.d, None, scene.environment(), beta);
+                if let (false, Some(env)) = (importance, scene.environment()) {
+                    let mut v = Vertex::endpoint(Kind::Infinite, ray.d, None, Some(env), beta);
                     v.wo = -ray.d;
                     Self::append(scene, path, v);
                 }
@@ -401,8 +400,8 @@ impl BdptIntegrator {
         if l.max_element() <= 0.0 {
             return Rgb::ZERO;
         }
-        if t == 2 || Self::pdf_light_origin(scene, pt) == 0.0 {
-            // Seen directly, or on a light no other strategy samples.
+        if Self::pdf_light_origin(scene, pt) == 0.0 {
+            // On a light no other strategy samples.
             return l;
         }
         l * Self::mis_weight(scene, paths, None, 0, t, light.emits_rays(), false)
