@@ -302,7 +302,7 @@ Shape "sphere" "float radius" 1
 
 #[test]
 fn coated_materials_read_their_layers_and_a_lossless_coat_vanishes_in_a_furnace() {
-    use pathlab_render::desc::{CoatedBase, MaterialDesc};
+    use pathlab_render::desc::{CoatedBase, MaterialDesc, TextureDesc};
     let scene = FURNACE.to_string()
         + r#"MakeNamedMaterial "plastic" "string type" "coateddiffuse" "rgb reflectance" [ 0.2 0.4 0.6 ]
   "float roughness" 0.04 "float thickness" 0.2 "rgb albedo" [ 0.5 0.5 0.5 ] "float g" 0.3
@@ -318,7 +318,8 @@ Shape "sphere" "float radius" 1
     let MaterialDesc::Coated(plastic) = &desc.materials[0] else {
         panic!("{:?}", desc.materials[0]);
     };
-    assert_eq!(plastic.coat_alpha, [0.2, 0.2]);
+    let number = |a: f32| [TextureDesc::value(a), TextureDesc::value(a)];
+    assert_eq!(plastic.coat_alpha, number(0.2));
     assert_eq!(
         (plastic.coat_eta, plastic.thickness, plastic.g),
         (1.4, 0.2, 0.3)
@@ -332,7 +333,7 @@ Shape "sphere" "float radius" 1
         panic!("{:?}", desc.materials[1]);
     };
     // remaproughness false: the coat's roughness is its α.
-    assert_eq!(gold.coat_alpha, [0.01, 0.01]);
+    assert_eq!(gold.coat_alpha, number(0.01));
     assert_eq!(
         (gold.coat_eta, gold.thickness, gold.max_depth, gold.samples),
         (1.5, 0.01, 10, 1)
@@ -340,7 +341,7 @@ Shape "sphere" "float radius" 1
     let CoatedBase::Conductor { eta, alpha, .. } = &gold.base else {
         panic!("{:?}", gold.base);
     };
-    assert_eq!(*alpha, [0.09, 0.16]);
+    assert_eq!(*alpha, [TextureDesc::value(0.09), TextureDesc::value(0.16)]);
     assert!(eta.x < 0.5 && eta.z > 1.0, "gold's η {eta}");
     // A white Lambertian under a smooth coat, with no medium and no thickness to absorb in,
     // returns all the light it receives: under a uniform sky the sphere's radiance is the
@@ -559,4 +560,100 @@ Shape "bilinearmesh" "point3 P" [ -4 -4 0  4 -4 0  -4 4 0  4 4 0 ] "integer indi
     .unwrap();
     let (a, b) = (render_film(&textured, 256, 1), render_film(&plain, 256, 2));
     pathlab_testkit::render::assert_same_image("textured against plain roughness", &a, &b);
+}
+
+#[test]
+fn coats_and_their_bases_take_textured_roughness() {
+    use glam::{Vec2, Vec3};
+    use pathlab_render::desc::{CoatedBase, MaterialDesc, TextureDesc};
+    use pathlab_render::texture::{Tex, TexPoint};
+    let desc = load_text(
+        "coat-roughness",
+        &[(
+            "r.pbrt",
+            r#"WorldBegin
+Texture "ramp" "float" "bilerp"
+MakeNamedMaterial "plastic" "string type" "coateddiffuse" "texture roughness" "ramp"
+MakeNamedMaterial "gold" "string type" "coatedconductor" "texture interface.uroughness" "ramp" "float interface.vroughness" 0.2 "bool remaproughness" false
+MakeNamedMaterial "copper" "string type" "coatedconductor" "texture conductor.roughness" "ramp"
+NamedMaterial "plastic"
+Shape "sphere"
+"#,
+        )],
+    )
+    .unwrap();
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let alphas = |m: &MaterialDesc| match m {
+        MaterialDesc::Coated(c) => c.coat_alpha.clone().map(|t| Tex::from_desc(&t)),
+        other => panic!("not coated: {other:?}"),
+    };
+    let at = |t: &Tex, v: f32| t.eval(&TexPoint::uv(Vec2::new(0.3, v)));
+    let close = |a: Vec3, b: f32| (a - Vec3::splat(b)).abs().max_element() < 1e-6;
+    // α = √roughness along the bilerp's v, on both axes.
+    let [u, v] = alphas(&desc.materials[0]);
+    assert!(close(at(&u, 0.25), 0.5) && close(at(&v, 0.64), 0.8));
+    // The interface's roughness, not remapped, v given as a number.
+    let [u, v] = alphas(&desc.materials[1]);
+    assert!(close(at(&u, 0.25), 0.25) && close(at(&v, 0.7), 0.2));
+    // The base conductor's roughness, remapped; the coat smooth.
+    let MaterialDesc::Coated(copper) = &desc.materials[2] else {
+        panic!("{:?}", desc.materials[2]);
+    };
+    let CoatedBase::Conductor { alpha, .. } = &copper.base else {
+        panic!("{:?}", copper.base);
+    };
+    let [u, v] = alpha.clone().map(|t| Tex::from_desc(&t));
+    assert!(close(at(&u, 0.25), 0.5) && close(at(&v, 0.64), 0.8));
+    assert_eq!(
+        copper.coat_alpha,
+        [TextureDesc::value(0.0), TextureDesc::value(0.0)]
+    );
+}
+
+#[test]
+fn a_coat_of_textured_roughness_renders_as_a_coat_of_that_roughness() {
+    // A bilerp texture of one value cannot be folded to a number, so the coat's roughness is
+    // looked up at each point; it must render what the number renders.
+    let scene = |roughness: &str| {
+        FURNACE.replace("LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]", "LightSource \"infinite\" \"rgb L\" [ 0.2 0.2 0.2 ]\nLightSource \"distant\" \"point3 from\" [ 1 2 3 ] \"rgb L\" [ 3 3 3 ]")
+            + &format!(
+                r#"Texture "flat" "float" "bilerp" "float v00" 0.04 "float v01" 0.04 "float v10" 0.04 "float v11" 0.04
+Material "coateddiffuse" "rgb reflectance" [ 0.2 0.4 0.6 ] {roughness}
+Shape "sphere"
+"#
+            )
+    };
+    let textured = load_text(
+        "coat-textured",
+        &[("s.pbrt", &scene(r#""texture roughness" "flat""#))],
+    )
+    .unwrap();
+    assert!(textured.warnings.is_empty(), "{:?}", textured.warnings);
+    let plain = load_text(
+        "coat-plain",
+        &[("s.pbrt", &scene(r#""float roughness" 0.04"#))],
+    )
+    .unwrap();
+    let (a, b) = (render_film(&textured, 256, 1), render_film(&plain, 256, 2));
+    pathlab_testkit::render::assert_same_image("textured against plain coat roughness", &a, &b);
+    // The same for a conductor under a smooth coat.
+    let base = |roughness: &str| {
+        scene("").replace(
+            r#""coateddiffuse" "rgb reflectance" [ 0.2 0.4 0.6 ]"#,
+            &format!(r#""coatedconductor" {roughness}"#),
+        )
+    };
+    let textured = load_text(
+        "coat-base-textured",
+        &[("s.pbrt", &base(r#""texture conductor.roughness" "flat""#))],
+    )
+    .unwrap();
+    assert!(textured.warnings.is_empty(), "{:?}", textured.warnings);
+    let plain = load_text(
+        "coat-base-plain",
+        &[("s.pbrt", &base(r#""float conductor.roughness" 0.04"#))],
+    )
+    .unwrap();
+    let (a, b) = (render_film(&textured, 256, 3), render_film(&plain, 256, 4));
+    pathlab_testkit::render::assert_same_image("textured against plain base roughness", &a, &b);
 }

@@ -122,34 +122,56 @@ impl Material {
     }
 }
 
-/// A coated material: a fixed layered model where nothing is textured or anisotropic.
+/// A roughness α along u and v given as two textures: `Err` with the numbers where both are
+/// numbers (a fixed microfacet distribution), `Ok` with the textures to read at each point.
+fn numbers_or_textures(
+    alpha: &[TextureDesc; 2],
+    tex: &mut impl FnMut(&TextureDesc) -> Tex,
+) -> Result<[Tex; 2], [f32; 2]> {
+    match alpha.clone().map(|t| t.as_constant().map(|a| a.x)) {
+        [Some(au), Some(av)] => Err([au, av]),
+        _ => Ok(alpha.clone().map(|t| tex(&t))),
+    }
+}
+
+/// A coated material: a fixed layered model where nothing is textured or anisotropic; else a
+/// model whose base albedo, coat roughness and base roughness are read at each point.
 fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material {
-    let roughness = |[au, av]: [f32; 2]| Microfacet::unless_smooth(NormalDistribution::Ggx, au, av);
-    let (base, reflectance, base_texture, base_anisotropic) = match &c.base {
+    let roughness = |alpha: &Result<[Tex; 2], [f32; 2]>| match alpha {
+        Err([au, av]) => Microfacet::unless_smooth(NormalDistribution::Ggx, *au, *av),
+        Ok(_) => None,
+    };
+    let mut base_alpha = Ok(None);
+    let (base, reflectance, base_texture) = match &c.base {
         CoatedBase::Diffuse(t) => {
             let reflectance = t
                 .as_constant()
                 .unwrap_or(Rgb::ZERO)
                 .clamp(Vec3::ZERO, Vec3::ONE);
             let texture = t.as_constant().is_none().then(|| tex(t));
-            (Base::Diffuse, reflectance, texture, false)
+            (Base::Diffuse, reflectance, texture)
         }
-        CoatedBase::Conductor { eta, k, alpha } => (
-            Base::Conductor(Conductor {
-                eta: *eta,
-                k: *k,
-                specular: Rgb::ONE,
-                distribution: roughness(*alpha),
-            }),
-            Rgb::ZERO,
-            None,
-            alpha[0] != alpha[1],
-        ),
+        CoatedBase::Conductor { eta, k, alpha } => {
+            let alpha = numbers_or_textures(alpha, tex);
+            let distribution = roughness(&alpha);
+            base_alpha = alpha.map(Some);
+            (
+                Base::Conductor(Conductor {
+                    eta: *eta,
+                    k: *k,
+                    specular: Rgb::ONE,
+                    distribution,
+                }),
+                Rgb::ZERO,
+                None,
+            )
+        }
     };
+    let coat_alpha = numbers_or_textures(&c.coat_alpha, tex);
     let stack = LayerStack {
         coat: Coat {
             eta: usable_ior(c.coat_eta),
-            roughness: roughness(c.coat_alpha),
+            roughness: roughness(&coat_alpha),
         },
         base,
         thickness: c.thickness.max(f32::MIN_POSITIVE),
@@ -159,14 +181,21 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
         samples: c.samples.clamp(1, u16::MAX as u32) as u16,
     };
     let layered = Layered::new(stack, reflectance);
+    let base_anisotropic = match &c.base {
+        CoatedBase::Conductor { alpha, .. } => alpha[0] != alpha[1],
+        CoatedBase::Diffuse(_) => false,
+    };
     let anisotropic = base_anisotropic || c.coat_alpha[0] != c.coat_alpha[1];
-    if base_texture.is_none() && !anisotropic {
+    let (coat_alpha, base_alpha) = (coat_alpha.ok(), base_alpha.ok().flatten());
+    if base_texture.is_none() && coat_alpha.is_none() && base_alpha.is_none() && !anisotropic {
         return Material::new(Bxdf::Layered(layered), false);
     }
     Material::Leaf(Leaf {
         model: Model::Coated {
             layered,
             base_texture,
+            coat_alpha: coat_alpha.map(Box::new),
+            base_alpha: base_alpha.map(Box::new),
             anisotropic,
         },
         two_sided: false,

@@ -60,12 +60,17 @@ pub enum Model {
         /// Albedo of the transmission.
         transmittance: Tex,
     },
-    /// A layered model whose base albedo may be textured.
+    /// A layered model whose base albedo and coat roughness may be textured.
     Coated {
-        /// The model, its base albedo replaced by the texture's where there is one.
+        /// The model, its base albedo and coat roughness replaced by the textures' where
+        /// there are some.
         layered: Layered,
         /// The diffuse base's albedo.
         base_texture: Option<Tex>,
+        /// The coat's roughness α along u and v (GGX).
+        coat_alpha: Option<Box<[Tex; 2]>>,
+        /// A conductor base's roughness α along u and v (GGX).
+        base_alpha: Option<Box<[Tex; 2]>>,
         /// Whether the coat or the base is anisotropic.
         anisotropic: bool,
     },
@@ -435,11 +440,26 @@ impl Model {
             Model::Coated {
                 layered,
                 base_texture,
+                coat_alpha,
+                base_alpha,
                 anisotropic,
             } => {
                 let mut l = *layered;
                 if let Some(t) = base_texture {
                     l.reflectance = t.eval(p).clamp(Vec3::ZERO, Vec3::ONE);
+                }
+                let ggx = |[au, av]: &[Tex; 2]| {
+                    Microfacet::unless_smooth(
+                        NormalDistribution::Ggx,
+                        au.eval_float(p),
+                        av.eval_float(p),
+                    )
+                };
+                if let Some(alpha) = coat_alpha.as_deref() {
+                    l.coat_roughness = ggx(alpha);
+                }
+                if let Some(alpha) = base_alpha.as_deref() {
+                    l.base_roughness = ggx(alpha);
                 }
                 (Bxdf::Layered(l), *anisotropic)
             }

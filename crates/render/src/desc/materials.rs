@@ -404,8 +404,9 @@ pub enum CoatedBase {
         eta: Rgb,
         /// Imaginary part, per channel.
         k: Rgb,
-        /// Roughness α along u and v (0: smooth; GGX).
-        alpha: [f32; 2],
+        /// Roughness α along u and v, each a texture (numbers read as luminance; 0: smooth;
+        /// GGX).
+        alpha: [TextureDesc; 2],
     },
 }
 
@@ -416,8 +417,9 @@ pub struct CoatedDesc {
     pub base: CoatedBase,
     /// The coat's index of refraction relative to outside.
     pub coat_eta: f32,
-    /// The coat's roughness α along u and v (0: smooth; GGX).
-    pub coat_alpha: [f32; 2],
+    /// The coat's roughness α along u and v, each a texture (numbers read as luminance; 0:
+    /// smooth; GGX).
+    pub coat_alpha: [TextureDesc; 2],
     /// Optical thickness of the layer.
     pub thickness: f32,
     /// Single-scattering albedo of the layer's medium (zero: none).

@@ -141,7 +141,7 @@ impl Builder {
     /// `roughness`, `uroughness`, `vroughness` and `remaproughness` of a conductor or a
     /// dielectric: one α, or α along u and v where they differ or are textured.
     fn surface_roughness(&mut self, params: &ParamList) -> Result<Roughness, Error> {
-        if let Some(alphas) = self.textured_roughness(params)? {
+        if let Some(alphas) = self.textured_roughness(params, "")? {
             return Ok(Roughness::Varying(alphas));
         }
         let (au, av) = self.roughness_of(params, "")?;
@@ -152,12 +152,14 @@ impl Builder {
         })
     }
 
-    /// `roughness`, `uroughness` and `vroughness` as α along u and v, each a texture, where
-    /// one of them is a texture that varies (`None` where all are numbers): `uroughness` and
-    /// `vroughness` default to `roughness`, and the remapping √ is a texture node.
+    /// `{prefix}roughness`, `{prefix}uroughness` and `{prefix}vroughness` as α along u and v,
+    /// each a texture, where one of them is a texture that varies (`None` where all are
+    /// numbers): `uroughness` and `vroughness` default to `roughness`, and the remapping √ is
+    /// a texture node.
     fn textured_roughness(
         &mut self,
         params: &ParamList,
+        prefix: &str,
     ) -> Result<Option<[TextureDesc; 2]>, Error> {
         let mut varies = false;
         let mut get = |b: &mut Self, name: &str| -> Result<Option<TextureDesc>, Error> {
@@ -172,9 +174,9 @@ impl Builder {
                 None => None,
             })
         };
-        let r = get(self, "roughness")?;
-        let u = get(self, "uroughness")?;
-        let v = get(self, "vroughness")?;
+        let r = get(self, &format!("{prefix}roughness"))?;
+        let u = get(self, &format!("{prefix}uroughness"))?;
+        let v = get(self, &format!("{prefix}vroughness"))?;
         if !varies {
             return Ok(None);
         }
@@ -396,7 +398,7 @@ impl Builder {
     /// base (`reflectance`), with the layer's `thickness`, `albedo`, `g`, `maxdepth` and
     /// `nsamples`.
     fn coated_diffuse(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
-        let coat_alpha = self.roughness_of(params, "")?;
+        let coat_alpha = self.layer_roughness(params, "")?;
         let coat_eta = self.eta_of(params, "eta")?;
         let reflectance = self.color_texture(params, "reflectance", Rgb::splat(0.5))?;
         self.coated(
@@ -411,16 +413,27 @@ impl Builder {
     /// `interface.eta`) over a conductor (`conductor.eta` and `conductor.k`, copper by
     /// default, or `reflectance`; `conductor.roughness`), with the layer's parameters.
     fn coated_conductor(&mut self, params: &ParamList) -> Result<MaterialDesc, Error> {
-        let coat_alpha = self.roughness_of(params, "interface.")?;
+        let coat_alpha = self.layer_roughness(params, "interface.")?;
         let coat_eta = self.eta_of(params, "interface.eta")?;
-        let alpha = self.roughness_of(params, "conductor.")?;
+        let alpha = self.layer_roughness(params, "conductor.")?;
         let (eta, k) = self.conductor_optics(params, "conductor.eta", "conductor.k")?;
-        let base = CoatedBase::Conductor {
-            eta,
-            k,
-            alpha: [alpha.0, alpha.1],
-        };
+        let base = CoatedBase::Conductor { eta, k, alpha };
         self.coated(params, base, coat_eta, coat_alpha)
+    }
+
+    /// A coated material's roughness (`{prefix}roughness` and its u and v), of the coat or of
+    /// a conductor base, as α along u and v: numbers where they are numbers, else textures
+    /// read at each point.
+    fn layer_roughness(
+        &mut self,
+        params: &ParamList,
+        prefix: &str,
+    ) -> Result<[TextureDesc; 2], Error> {
+        if let Some(alphas) = self.textured_roughness(params, prefix)? {
+            return Ok(alphas);
+        }
+        let (au, av) = self.roughness_of(params, prefix)?;
+        Ok([TextureDesc::value(au), TextureDesc::value(av)])
     }
 
     /// The layer's parameters shared by both coated materials, with pbrt-v4's defaults.
@@ -429,7 +442,7 @@ impl Builder {
         params: &ParamList,
         base: CoatedBase,
         coat_eta: f32,
-        coat_alpha: (f32, f32),
+        coat_alpha: [TextureDesc; 2],
     ) -> Result<MaterialDesc, Error> {
         let thickness = self.float_value(params, "thickness", 0.01)? as f32;
         let albedo = self.color_texture(params, "albedo", Rgb::ZERO)?;
@@ -455,7 +468,7 @@ impl Builder {
         Ok(MaterialDesc::Coated(Box::new(CoatedDesc {
             base,
             coat_eta,
-            coat_alpha: [coat_alpha.0, coat_alpha.1],
+            coat_alpha,
             thickness,
             albedo: albedo.mean().clamp(Rgb::ZERO, Rgb::ONE),
             g,

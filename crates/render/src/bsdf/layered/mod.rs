@@ -104,13 +104,19 @@ impl LayerStack {
     }
 }
 
-/// A layered BSDF: a [`LayerStack`] and, for a diffuse base, its albedo.
+/// A layered BSDF: a [`LayerStack`] and what may vary over the surface: a diffuse base's
+/// albedo and the coat's roughness.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Layered {
     /// Coat, base and medium.
     pub stack: &'static LayerStack,
     /// Albedo of a diffuse base (unused over a conductor).
     pub reflectance: Rgb,
+    /// The coat's microfacet roughness here (`None`: smooth); the stack's own unless the
+    /// material's roughness is textured.
+    pub coat_roughness: Option<Microfacet>,
+    /// A conductor base's roughness here, as `coat_roughness` (unused over a diffuse base).
+    pub base_roughness: Option<Microfacet>,
 }
 
 /// Whether a walk carries radiance (from the camera) or importance (from a light): refraction
@@ -132,10 +138,10 @@ struct Event {
 
 /// The interface a walk meets.
 #[derive(Clone, Copy)]
-enum Interface<'a> {
-    Top(&'a Coat),
+enum Interface {
+    Top(Coat),
     Diffuse(Diffuse),
-    Conductor(&'a Conductor),
+    Conductor(Conductor),
 }
 
 /// η'² undone on a transmission from `wo` to `wi` (the radiance scaling of refraction, which
@@ -171,7 +177,7 @@ impl Coat {
     }
 }
 
-impl Interface<'_> {
+impl Interface {
     fn specular(self) -> bool {
         match self {
             Interface::Top(c) => c.smooth().is_some(),
@@ -264,21 +270,32 @@ impl Layered {
     /// A layered BSDF of `stack` (interned here) and base albedo `reflectance`.
     pub fn new(stack: LayerStack, reflectance: Rgb) -> Self {
         Layered {
+            coat_roughness: stack.coat.roughness,
+            base_roughness: match stack.base {
+                Base::Conductor(c) => c.distribution,
+                Base::Diffuse => None,
+            },
             stack: stack.interned(),
             reflectance,
         }
     }
 
-    fn top(&self) -> Interface<'static> {
-        Interface::Top(&self.stack.coat)
+    fn top(&self) -> Interface {
+        Interface::Top(Coat {
+            eta: self.stack.coat.eta,
+            roughness: self.coat_roughness,
+        })
     }
 
-    fn bottom(&self) -> Interface<'static> {
+    fn bottom(&self) -> Interface {
         match &self.stack.base {
             Base::Diffuse => Interface::Diffuse(Diffuse {
                 reflectance: self.reflectance,
             }),
-            Base::Conductor(c) => Interface::Conductor(c),
+            Base::Conductor(c) => Interface::Conductor(Conductor {
+                distribution: self.base_roughness,
+                ..*c
+            }),
         }
     }
 
