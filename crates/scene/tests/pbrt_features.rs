@@ -321,11 +321,11 @@ Shape "sphere" "float radius" 1
     let number = |a: f32| [TextureDesc::value(a), TextureDesc::value(a)];
     assert_eq!(plastic.coat_alpha, number(0.2));
     assert_eq!(
-        (plastic.coat_eta, plastic.thickness, plastic.g),
-        (1.4, 0.2, 0.3)
+        (plastic.coat_eta, &plastic.thickness, &plastic.g),
+        (1.4, &TextureDesc::value(0.2), &TextureDesc::value(0.3))
     );
     assert_eq!((plastic.max_depth, plastic.samples), (20, 2));
-    assert_eq!(plastic.albedo, glam::Vec3::splat(0.5));
+    assert_eq!(plastic.albedo, TextureDesc::value(0.5));
     assert!(
         matches!(&plastic.base, CoatedBase::Diffuse(t) if t.as_constant() == Some(glam::Vec3::new(0.2, 0.4, 0.6)))
     );
@@ -335,8 +335,8 @@ Shape "sphere" "float radius" 1
     // remaproughness false: the coat's roughness is its α.
     assert_eq!(gold.coat_alpha, number(0.01));
     assert_eq!(
-        (gold.coat_eta, gold.thickness, gold.max_depth, gold.samples),
-        (1.5, 0.01, 10, 1)
+        (gold.coat_eta, &gold.thickness, gold.max_depth, gold.samples),
+        (1.5, &TextureDesc::value(0.01), 10, 1)
     );
     let CoatedBase::Conductor { eta, alpha, .. } = &gold.base else {
         panic!("{:?}", gold.base);
@@ -611,9 +611,10 @@ Shape "sphere"
 }
 
 #[test]
-fn a_coat_of_textured_roughness_renders_as_a_coat_of_that_roughness() {
-    // A bilerp texture of one value cannot be folded to a number, so the coat's roughness is
-    // looked up at each point; it must render what the number renders.
+fn coats_of_textured_parameters_render_as_coats_of_those_numbers() {
+    // A bilerp texture of one value cannot be folded to a number, so the coat's roughness
+    // (then the base's, then the medium's parameters) is looked up at each point; it must
+    // render what the number renders.
     let scene = |roughness: &str| {
         FURNACE.replace("LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]", "LightSource \"infinite\" \"rgb L\" [ 0.2 0.2 0.2 ]\nLightSource \"distant\" \"point3 from\" [ 1 2 3 ] \"rgb L\" [ 3 3 3 ]")
             + &format!(
@@ -656,4 +657,35 @@ Shape "sphere"
     .unwrap();
     let (a, b) = (render_film(&textured, 256, 3), render_film(&plain, 256, 4));
     pathlab_testkit::render::assert_same_image("textured against plain base roughness", &a, &b);
+    // And for the layer's medium: thickness, albedo and g each a texture of one value.
+    let medium = |parameters: &str| {
+        scene("")
+            .replace(
+                r#""rgb reflectance" [ 0.2 0.4 0.6 ]"#,
+                &format!(r#""rgb reflectance" [ 0.2 0.4 0.6 ] {parameters}"#),
+            )
+            .replace(
+                "Texture \"flat\"",
+                "Texture \"half\" \"spectrum\" \"bilerp\" \"rgb v00\" [ 0.5 0.5 0.5 ] \"rgb v01\" [ 0.5 0.5 0.5 ] \"rgb v10\" [ 0.5 0.5 0.5 ] \"rgb v11\" [ 0.5 0.5 0.5 ]\nTexture \"thick\" \"float\" \"bilerp\" \"float v00\" 1 \"float v01\" 1 \"float v10\" 1 \"float v11\" 1\nTexture \"flat\"",
+            )
+    };
+    let textured = load_text(
+        "coat-medium-textured",
+        &[(
+            "s.pbrt",
+            &medium(r#""texture thickness" "thick" "texture albedo" "half" "texture g" "flat""#),
+        )],
+    )
+    .unwrap();
+    assert!(textured.warnings.is_empty(), "{:?}", textured.warnings);
+    let plain = load_text(
+        "coat-medium-plain",
+        &[(
+            "s.pbrt",
+            &medium(r#""float thickness" 1 "rgb albedo" [ 0.5 0.5 0.5 ] "float g" 0.04"#),
+        )],
+    )
+    .unwrap();
+    let (a, b) = (render_film(&textured, 256, 5), render_film(&plain, 256, 6));
+    pathlab_testkit::render::assert_same_image("textured against plain layer medium", &a, &b);
 }

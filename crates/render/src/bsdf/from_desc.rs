@@ -168,15 +168,29 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
         }
     };
     let coat_alpha = numbers_or_textures(&c.coat_alpha, tex);
+    // The medium: fixed where its three parameters are numbers, else read at each point.
+    let (medium, medium_textures) = match (
+        c.thickness.as_constant(),
+        c.albedo.as_constant(),
+        c.g.as_constant(),
+    ) {
+        (Some(thickness), Some(albedo), Some(g)) => {
+            (LayerMedium::new(thickness.x, albedo, g.x), None)
+        }
+        _ => (
+            LayerMedium::new(1.0, Rgb::ZERO, 0.0),
+            Some(Box::new([&c.thickness, &c.albedo, &c.g].map(&mut *tex))),
+        ),
+    };
     let stack = LayerStack {
         coat: Coat {
             eta: usable_ior(c.coat_eta),
             roughness: roughness(&coat_alpha),
         },
         base,
-        thickness: c.thickness.max(f32::MIN_POSITIVE),
-        albedo: c.albedo.clamp(Vec3::ZERO, Vec3::ONE),
-        g: c.g.clamp(-0.99, 0.99),
+        thickness: medium.thickness,
+        albedo: medium.albedo,
+        g: medium.g,
         max_depth: c.max_depth.min(u16::MAX as u32) as u16,
         samples: c.samples.clamp(1, u16::MAX as u32) as u16,
     };
@@ -187,7 +201,12 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
     };
     let anisotropic = base_anisotropic || c.coat_alpha[0] != c.coat_alpha[1];
     let (coat_alpha, base_alpha) = (coat_alpha.ok(), base_alpha.ok().flatten());
-    if base_texture.is_none() && coat_alpha.is_none() && base_alpha.is_none() && !anisotropic {
+    if base_texture.is_none()
+        && coat_alpha.is_none()
+        && base_alpha.is_none()
+        && medium_textures.is_none()
+        && !anisotropic
+    {
         return Material::new(Bxdf::Layered(layered), false);
     }
     Material::Leaf(Leaf {
@@ -196,6 +215,7 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
             base_texture,
             coat_alpha: coat_alpha.map(Box::new),
             base_alpha: base_alpha.map(Box::new),
+            medium: medium_textures,
             anisotropic,
         },
         two_sided: false,

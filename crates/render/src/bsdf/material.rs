@@ -71,6 +71,8 @@ pub enum Model {
         coat_alpha: Option<Box<[Tex; 2]>>,
         /// A conductor base's roughness α along u and v (GGX).
         base_alpha: Option<Box<[Tex; 2]>>,
+        /// The layer's medium: thickness, albedo and asymmetry g.
+        medium: Option<Box<[Tex; 3]>>,
         /// Whether the coat or the base is anisotropic.
         anisotropic: bool,
     },
@@ -442,6 +444,7 @@ impl Model {
                 base_texture,
                 coat_alpha,
                 base_alpha,
+                medium,
                 anisotropic,
             } => {
                 let mut l = *layered;
@@ -460,6 +463,10 @@ impl Model {
                 }
                 if let Some(alpha) = base_alpha.as_deref() {
                     l.base_roughness = ggx(alpha);
+                }
+                if let Some([thickness, albedo, g]) = medium.as_deref() {
+                    l.medium =
+                        LayerMedium::new(thickness.eval_float(p), albedo.eval(p), g.eval_float(p));
                 }
                 (Bxdf::Layered(l), *anisotropic)
             }

@@ -38,7 +38,7 @@ pub use dielectric::{FresnelModel, SmoothDielectric};
 pub use diffuse::Diffuse;
 pub use diffuse_transmission::DiffuseTransmission;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
-pub use layered::{Base, Coat, LayerStack, Layered};
+pub use layered::{Base, Coat, LayerMedium, LayerStack, Layered};
 pub use material::{Leaf, Material, Model, ShadingPoint};
 pub use microfacet::{Microfacet, NormalDistribution};
 pub use mirror::Mirror;

@@ -420,12 +420,12 @@ pub struct CoatedDesc {
     /// The coat's roughness α along u and v, each a texture (numbers read as luminance; 0:
     /// smooth; GGX).
     pub coat_alpha: [TextureDesc; 2],
-    /// Optical thickness of the layer.
-    pub thickness: f32,
+    /// Optical thickness of the layer (a texture: numbers read as luminance).
+    pub thickness: TextureDesc,
     /// Single-scattering albedo of the layer's medium (zero: none).
-    pub albedo: Rgb,
-    /// Henyey–Greenstein asymmetry of the medium.
-    pub g: f32,
+    pub albedo: TextureDesc,
+    /// Henyey–Greenstein asymmetry of the medium (a texture, as `thickness`).
+    pub g: TextureDesc,
     /// Most scattering events a walk follows.
     pub max_depth: u32,
     /// Walks averaged by each evaluation.

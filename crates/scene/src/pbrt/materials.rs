@@ -124,6 +124,19 @@ impl Builder {
         ))
     }
 
+    /// A number that may be a texture: `"texture NAME"` or a `float`.
+    fn float_texture(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        default: f64,
+    ) -> Result<TextureDesc, Error> {
+        if let Some(t) = self.texture_param(params, name)? {
+            return Ok(t);
+        }
+        Ok(TextureDesc::value(self.float(params, name, default)? as f32))
+    }
+
     /// A number that may be a texture; textures other than constants are used by their mean
     /// (with a warning).
     fn float_value(&mut self, params: &ParamList, name: &str, default: f64) -> Result<f64, Error> {
@@ -444,33 +457,38 @@ impl Builder {
         coat_eta: f32,
         coat_alpha: [TextureDesc; 2],
     ) -> Result<MaterialDesc, Error> {
-        let thickness = self.float_value(params, "thickness", 0.01)? as f32;
+        // Thickness, albedo and g may be textures (read at each point, kept in range there);
+        // numbers are checked here.
+        let thickness = self.float_texture(params, "thickness", 0.01)?;
         let albedo = self.color_texture(params, "albedo", Rgb::ZERO)?;
-        if albedo.as_constant().is_none() {
-            self.warn(
-                "\"texture albedo\": a textured layer albedo is not supported; its mean is used",
-            );
-        }
-        let g = self.float_value(params, "g", 0.0)? as f32;
+        let g = self.float_texture(params, "g", 0.0)?;
         let max_depth = self.float(params, "maxdepth", 10.0)?;
         let samples = self.float(params, "nsamples", 1.0)?;
-        if !(thickness > 0.0 && thickness.is_finite()) {
-            return Err(self.error(format!("thickness {thickness}: must be a positive number")));
+        if let Some(t) = thickness.as_constant().map(|t| t.x) {
+            if !(t > 0.0 && t.is_finite()) {
+                return Err(self.error(format!("thickness {t}: must be a positive number")));
+            }
         }
         if !(0.0..=1_000.0).contains(&max_depth) || !(1.0..=1_000.0).contains(&samples) {
             return Err(self.error(format!(
                 "maxdepth {max_depth} and nsamples {samples}: expected 0 to 1000 and 1 to 1000"
             )));
         }
-        if !(-1.0 < g && g < 1.0) {
-            return Err(self.error(format!("g {g}: must lie strictly between -1 and 1")));
+        if let Some(g) = g.as_constant().map(|g| g.x) {
+            if !(-1.0 < g && g < 1.0) {
+                return Err(self.error(format!("g {g}: must lie strictly between -1 and 1")));
+            }
         }
+        let albedo = match albedo.as_constant() {
+            Some(a) => TextureDesc::Constant(a.clamp(Rgb::ZERO, Rgb::ONE)),
+            None => albedo,
+        };
         Ok(MaterialDesc::Coated(Box::new(CoatedDesc {
             base,
             coat_eta,
             coat_alpha,
             thickness,
-            albedo: albedo.mean().clamp(Rgb::ZERO, Rgb::ONE),
+            albedo,
             g,
             max_depth: max_depth as u32,
             samples: samples as u32,

@@ -48,9 +48,10 @@ pub enum Base {
     Conductor(Conductor),
 }
 
-/// A coat over a base with a medium between them (see the module's description), all but the
-/// diffuse base's albedo: interned ([`LayerStack::interned`]) so that a [`Layered`] is a
-/// reference and a colour, and a BSDF holding one stays small.
+/// A coat over a base with a medium between them (see the module's description): interned
+/// ([`LayerStack::interned`]) so that a [`Layered`] holds a reference to it. What may vary
+/// over a surface (the diffuse base's albedo, the roughnesses, the medium) the [`Layered`]
+/// holds itself, starting from the stack's values.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LayerStack {
     /// The top interface.
@@ -117,6 +118,31 @@ pub struct Layered {
     pub coat_roughness: Option<Microfacet>,
     /// A conductor base's roughness here, as `coat_roughness` (unused over a diffuse base).
     pub base_roughness: Option<Microfacet>,
+    /// The layer's medium here: the stack's own unless the material's is textured.
+    pub medium: LayerMedium,
+}
+
+impl LayerMedium {
+    /// The medium of these parameters, kept in range: a thickness of at least the smallest
+    /// positive number, an albedo in [0, 1] and an asymmetry in [-0.99, 0.99].
+    pub fn new(thickness: f32, albedo: Rgb, g: f32) -> Self {
+        LayerMedium {
+            thickness: thickness.max(f32::MIN_POSITIVE),
+            albedo: albedo.clamp(Rgb::ZERO, Rgb::ONE),
+            g: g.clamp(-0.99, 0.99),
+        }
+    }
+}
+
+/// The medium between coat and base, as it may vary over the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LayerMedium {
+    /// Optical thickness of the layer (in units of the medium's mean free path).
+    pub thickness: f32,
+    /// Single-scattering albedo (zero: no medium, only absorption-free travel).
+    pub albedo: Rgb,
+    /// Henyey–Greenstein asymmetry.
+    pub g: f32,
 }
 
 /// Whether a walk carries radiance (from the camera) or importance (from a light): refraction
@@ -275,6 +301,11 @@ impl Layered {
                 Base::Conductor(c) => c.distribution,
                 Base::Diffuse => None,
             },
+            medium: LayerMedium {
+                thickness: stack.thickness,
+                albedo: stack.albedo,
+                g: stack.g,
+            },
             stack: stack.interned(),
             reflectance,
         }
@@ -300,11 +331,11 @@ impl Layered {
     }
 
     fn has_medium(&self) -> bool {
-        self.stack.albedo.max_element() > 0.0
+        self.medium.albedo.max_element() > 0.0
     }
 
     fn phase(&self) -> HenyeyGreenstein {
-        HenyeyGreenstein { g: self.stack.g }
+        HenyeyGreenstein { g: self.medium.g }
     }
 
     /// f(wo, wi): the coat's reflection plus the mean of `samples` random walks' estimates.
@@ -331,7 +362,7 @@ impl Layered {
         let (top, bottom) = (self.top(), self.bottom());
         // Fixed for the material: asked once, not at every event.
         let (top_specular, bottom_specular) = (top.specular(), bottom.specular());
-        let thickness = self.stack.thickness;
+        let thickness = self.medium.thickness;
         let exit_z = thickness;
         let mut r = || next(rng);
         let mut f = Rgb::ZERO;
@@ -373,7 +404,7 @@ impl Layered {
                         power_heuristic(1, wis.pdf, 1, phase.p(-w, -wis.wi))
                     };
                     f += beta
-                        * self.stack.albedo
+                        * self.medium.albedo
                         * phase.p(-w, -wis.wi)
                         * wt
                         * tr(zp - exit_z, wis.wi)
@@ -383,7 +414,7 @@ impl Layered {
                     if ps.p <= 0.0 || ps.wi.z == 0.0 {
                         continue;
                     }
-                    beta *= self.stack.albedo; // p / pdf = 1
+                    beta *= self.medium.albedo; // p / pdf = 1
                     w = ps.wi;
                     z = zp;
                     if (z < exit_z && w.z > 0.0 || z > exit_z && w.z < 0.0) && !top_specular {
@@ -481,7 +512,7 @@ impl Layered {
         let mut f = entry.f * entry.wi.z.abs();
         let mut pdf = entry.pdf;
         let mut w = entry.wi;
-        let thickness = self.stack.thickness;
+        let thickness = self.medium.thickness;
         let mut z = thickness;
         let phase = self.phase();
         for depth in 0..self.stack.max_depth {
@@ -507,7 +538,7 @@ impl Layered {
                     if ps.p <= 0.0 || ps.wi.z == 0.0 {
                         return None;
                     }
-                    f *= self.stack.albedo * ps.p;
+                    f *= self.medium.albedo * ps.p;
                     pdf *= ps.p;
                     w = ps.wi;
                     z = zp;
