@@ -689,3 +689,50 @@ Shape "sphere"
     let (a, b) = (render_film(&textured, 256, 5), render_film(&plain, 256, 6));
     pathlab_testkit::render::assert_same_image("textured against plain layer medium", &a, &b);
 }
+
+#[test]
+fn mix_materials_blend_by_a_number_or_a_texture() {
+    use pathlab_render::desc::{MaterialDesc, TextureDesc};
+    let materials = r#"MakeNamedMaterial "dark" "string type" "diffuse" "rgb reflectance" [ 0.2 0.2 0.2 ]
+MakeNamedMaterial "light" "string type" "diffuse" "rgb reflectance" [ 0.8 0.8 0.8 ]
+Texture "quarter" "float" "bilerp" "float v00" 0.25 "float v01" 0.25 "float v10" 0.25 "float v11" 0.25
+"#;
+    let scene = |mix: &str| {
+        FURNACE.to_string()
+            + materials
+            + &format!(
+                "MakeNamedMaterial \"mix\" \"string type\" \"mix\" \"string materials\" [ \"dark\" \"light\" ] {mix}\nNamedMaterial \"mix\"\nShape \"sphere\"\n"
+            )
+    };
+    let weight = |mix: &str, tag: &str| {
+        let desc = load_text(tag, &[("s.pbrt", &scene(mix))]).unwrap();
+        assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+        match desc.materials.last() {
+            Some(MaterialDesc::Blend { weight, .. }) => (weight.clone(), desc),
+            other => panic!("not a blend: {other:?}"),
+        }
+    };
+    // A number: the second material's weight, kept in [0, 1].
+    assert_eq!(
+        weight(r#""float amount" 0.3"#, "mix-number").0,
+        TextureDesc::value(0.3)
+    );
+    assert_eq!(
+        weight(r#""float amount" 1.7"#, "mix-clamped").0,
+        TextureDesc::value(1.0)
+    );
+    // A texture, read at each point: a quarter of the light one renders as their mean.
+    let (w, textured) = weight(r#""texture amount" "quarter""#, "mix-texture");
+    assert!(w.as_constant().is_none());
+    let plain = load_text(
+        "mix-plain",
+        &[(
+            "s.pbrt",
+            &(FURNACE.to_string()
+                + "Material \"diffuse\" \"rgb reflectance\" [ 0.35 0.35 0.35 ]\nShape \"sphere\"\n"),
+        )],
+    )
+    .unwrap();
+    let (a, b) = (render_film(&textured, 64, 1), render_film(&plain, 64, 2));
+    pathlab_testkit::render::assert_same_image("mix by texture against its mean", &a, &b);
+}

@@ -511,11 +511,14 @@ impl Builder {
                 .ok_or_else(|| self.error(format!("mix: no material named \"{n}\"")))
         };
         let (first, second) = (pick(&names[0])?, pick(&names[1])?);
-        // pbrt-v4 picks the second with probability `amount`: the same expectation
-        // as a blend.
-        let amount = self.float_value(params, "amount", 0.5)?;
+        // pbrt-v4 picks the second with probability `amount` (a number or a texture, read at
+        // each point and kept in [0, 1] there): the same expectation as a blend.
+        let weight = match self.float_texture(params, "amount", 0.5)? {
+            TextureDesc::Constant(a) => TextureDesc::Constant(a.clamp(Rgb::ZERO, Rgb::ONE)),
+            t => t,
+        };
         Ok(MaterialDesc::Blend {
-            weight: TextureDesc::value(amount.clamp(0.0, 1.0) as f32),
+            weight,
             first: Box::new(first),
             second: Box::new(second),
         })
