@@ -129,6 +129,7 @@ impl Camera {
 
     /// The ray through film position `film` (pixels), through the lens point chosen by
     /// `u_lens` when the camera has an aperture. The direction has unit length.
+    #[inline]
     pub fn generate_ray(&self, film: Vec2, u_lens: Vec2) -> Ray {
         let mut ndc = Vec2::new(
             2.0 * film.x / self.resolution[0] as f32 - 1.0,
