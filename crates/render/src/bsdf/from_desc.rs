@@ -135,7 +135,8 @@ fn numbers_or_textures(
 }
 
 /// A coated material: a fixed layered model where nothing is textured or anisotropic; else a
-/// model whose base albedo, coat roughness and base roughness are read at each point.
+/// model whose textured parameters (base albedo, roughnesses, the medium) are read at each
+/// point.
 fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material {
     let roughness = |alpha: &Result<[Tex; 2], [f32; 2]>| match alpha {
         Err([au, av]) => Microfacet::unless_smooth(NormalDistribution::Ggx, *au, *av),

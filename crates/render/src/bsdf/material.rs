@@ -60,10 +60,9 @@ pub enum Model {
         /// Albedo of the transmission.
         transmittance: Tex,
     },
-    /// A layered model whose base albedo and coat roughness may be textured.
+    /// A layered model whose parameters may be textured: base albedo, roughnesses, medium.
     Coated {
-        /// The model, its base albedo and coat roughness replaced by the textures' where
-        /// there are some.
+        /// The model, each textured parameter replaced by its texture's value at the point.
         layered: Layered,
         /// The diffuse base's albedo.
         base_texture: Option<Tex>,
