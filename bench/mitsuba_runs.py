@@ -1,8 +1,8 @@
 """What bench/mitsuba_bench.py and bench/scenes.py share: Mitsuba's variant, its timed renders
 in processes of their own, and the RMSE of an image against a reference.
 
-Run as a script (`python3 bench/mitsuba_runs.py VARIANT SCENE MAX_DEPTH SPP OUT.npy`) it is
-one timed render: the first render compiles the kernels and is not timed; it prints the
+Run as a script (`python3 bench/mitsuba_runs.py VARIANT SCENE MAX_DEPTH SPP OUT.npy
+[NAME=VALUE ...]`) it is one timed render: the first render compiles the kernels and is not timed; it prints the
 seconds of the second and saves its image. Each Mitsuba measurement runs so, in a process
 that has exited before pathlab starts: after a render, Mitsuba's worker threads keep a core
 busy for seconds, which would slow whatever runs next."""
@@ -28,8 +28,47 @@ def render(variant, scene, max_depth, spp):
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "img.npy")
         cmd = [sys.executable, __file__, variant, scene, str(max_depth), str(spp), out]
-        seconds = float(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+        stdout = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+        seconds = float(stdout.splitlines()[0])
         return seconds, np.load(out)
+
+
+def render_file(variant, scene, spp, params):
+    """One timed Mitsuba render of a scene file with `$NAME` parameters `params` (a dict of
+    strings), in a process of its own, as `render`: (seconds, image, what was rendered). A
+    `moment` integrator (Mitsuba's test suite wraps its scenes' integrators in one, to record
+    second moments) is replaced by the integrator it wraps, with the same settings, so that
+    Mitsuba does only the work pathlab does."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "img.npy")
+        cmd = [sys.executable, __file__, variant, scene, "-", str(spp), out]
+        cmd += [f"{k}={v}" for k, v in params.items()]
+        lines = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.split("\n")
+        return float(lines[0]), np.load(out), lines[1]
+
+
+def unwrapped(integrator):
+    """The integrator a `moment` integrator wraps, rebuilt from its printed settings (Mitsuba
+    exposes them no other way), or `integrator` itself; and a line saying which."""
+    text = str(integrator)
+    if "integrators = [" not in text:
+        return integrator, text.split("[")[0]
+    inner = text.split("integrators = [", 1)[1]
+    name = inner.strip().split("[")[0]
+    kinds = {"PathIntegrator": "path", "DirectIntegrator": "direct",
+             "ParticleTracerIntegrator": "ptracer"}
+    if name not in kinds:
+        return integrator, f"moment({name}) as written"
+    settings = {"type": kinds[name]}
+    for line in inner.split("]")[0].splitlines():
+        if "=" in line:
+            key, value = (x.strip().rstrip(",") for x in line.split("=", 1))
+            try:
+                settings[key] = int(value)
+            except ValueError:
+                if value in ("true", "false", "1", "0"):
+                    settings[key] = value in ("true", "1")
+    return mi.load_dict(settings), f"{name}{ {k: v for k, v in settings.items() if k != 'type'} }"
 
 
 def rmse(img, ref):
@@ -37,13 +76,19 @@ def rmse(img, ref):
 
 
 if __name__ == "__main__":
-    _, variant, scene_path, max_depth, spp, out = sys.argv
+    # VARIANT SCENE MAX_DEPTH SPP OUT [NAME=VALUE ...]; MAX_DEPTH "-" leaves the file's.
+    variant, scene_path, max_depth, spp, out = sys.argv[1:6]
     mi.set_variant(variant)
-    scene = mi.load_file(scene_path, spp=int(spp), max_depth=int(max_depth))
+    params = dict(a.split("=", 1) for a in sys.argv[6:])
+    if max_depth != "-":
+        params["max_depth"] = int(max_depth)
+    scene = mi.load_file(scene_path, spp=int(spp), **params)
+    integrator, rendered = unwrapped(scene.integrator())
     # Seeds far from the small ones the reference images' 16 runs may have used, so that the
     # timed image is not one of the runs its error is measured against.
-    mi.render(scene, spp=int(spp), seed=1_000_001)  # compiles the kernels
+    mi.render(scene, integrator=integrator, spp=int(spp), seed=1_000_001)  # compiles kernels
     start = time.perf_counter()
-    img = np.array(mi.render(scene, spp=int(spp), seed=1_000_002))
+    img = np.array(mi.render(scene, integrator=integrator, spp=int(spp), seed=1_000_002))
     print(time.perf_counter() - start)
+    print(rendered)
     np.save(out, img)

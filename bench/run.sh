@@ -9,6 +9,7 @@
 #   bench/run.sh rays       # Embree only
 #   bench/run.sh render     # Mitsuba, the Cornell box in detail
 #   bench/run.sh scenes     # Mitsuba, every reference scene (speed and equal-time error)
+#   bench/run.sh suite      # Mitsuba, the scenes of Mitsuba's own test suite (the same)
 #   bench/run.sh python     # the Python module against the command line, same render
 #
 # Results go to target/bench/ (JSON per measurement) and a table on stdout.
@@ -81,6 +82,14 @@ if [ "$what" = all ] || [ "$what" = scenes ]; then
     DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/scenes.py" \
         --pathlab "$pathlab" --data "$root/tests/data" --work "$work" \
         --spp "${PATHLAB_BENCH_SPP:-256}" --reps "${PATHLAB_BENCH_REPS:-3}"
+fi
+
+if [ "$what" = all ] || [ "$what" = suite ]; then
+    mitsuba_venv
+    DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/suite.py" \
+        --pathlab "$pathlab" --suite "$root/tests/data/mitsuba-suite/tests/scenes" \
+        --work "$work/suite" --spp "${PATHLAB_BENCH_SUITE_SPP:-1024}" \
+        --reps "${PATHLAB_BENCH_REPS:-3}"
 fi
 
 if [ "$what" = all ] || [ "$what" = python ]; then

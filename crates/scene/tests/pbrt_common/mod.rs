@@ -32,3 +32,15 @@ pub fn render_film(desc: &pathlab_render::desc::SceneDesc, spp: u32, seed: u64) 
     let settings = RenderSettings::new(spp, seed, SamplerKind::Independent);
     render(&scene, &integrator, &settings, &|_| {}, &Default::default()).0
 }
+
+/// A furnace: a camera looking at the origin under a uniform sky of radiance 1, with paths as
+/// long as they need; the scene's shapes follow.
+// Used by the materials' tests; `pbrt.rs` includes this module without it.
+#[allow(dead_code)]
+pub const FURNACE: &str = r#"LookAt 0 0 4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+Integrator "path" "integer maxdepth" [ 1000 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+"#;
