@@ -46,8 +46,8 @@ variant = mitsuba_runs.pick_variant()
 rmse = mitsuba_runs.rmse
 
 
-def mitsuba_render(scene, max_depth, spp):
-    return mitsuba_runs.render(variant, scene, max_depth, spp)
+def mitsuba_render(scene, max_depth, spp, rep):
+    return mitsuba_runs.render(variant, scene, max_depth, spp, rep)
 
 
 def pathlab_render(scene, depth, extra, name):
@@ -74,8 +74,8 @@ for name, folder, depth, ref_depth in CASES:
     mitsuba_depth = -1 if depth == "inf" else int(depth) + 1
     tag = folder + ("" if depth == "inf" else f"-m{depth}")
     rates_m, rates_p, times_m, errs_m = [], [], [], []
-    for _ in range(args.reps):
-        t_m, img_m = mitsuba_render(scene, mitsuba_depth, args.spp)
+    for rep in range(args.reps):
+        t_m, img_m = mitsuba_render(scene, mitsuba_depth, args.spp, rep)
         rates_m.append(pixels * args.spp / t_m)
         times_m.append(t_m)
         errs_m.append(rmse(img_m, ref))

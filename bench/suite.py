@@ -67,9 +67,9 @@ for path in files:
         why = (e.stderr or "").strip().splitlines()[-1:] or ["no message"]
         print(f"{folder}/{stem:<40} Mitsuba cannot render it here: {why[0][-160:]}", flush=True)
         continue
-    for _ in range(args.reps):
+    for rep in range(args.reps):
         t_m, img_m, rendered = mitsuba_runs.render_file(variant, path, args.spp,
-                                                        {"integrator": integrator})
+                                                        {"integrator": integrator}, rep)
         rates_m.append(pixels * args.spp / t_m)
         times_m.append(t_m)
         errs_m.append(mitsuba_runs.rmse(img_m, ref))
