@@ -75,6 +75,43 @@ def unwrapped(integrator):
     return mi.load_dict(settings), f"{name}{ {k: v for k, v in settings.items() if k != 'type'} }"
 
 
+def compare(reps, spp, pixels, ref, mitsuba, pathlab, probe_spp):
+    """One scene measured both ways, as bench/scenes.py and bench/suite.py report it.
+
+    Speed: `reps` renders at `spp` by each renderer, taking turns (`mitsuba(rep)` gives
+    (seconds, image); `pathlab(flags, kind)` gives (its JSON statistics, image), pathlab with
+    the independent sampler as the scenes ask); each rate the median. Equal time: Mitsuba's
+    median time is the budget; pathlab, with its default settings, renders at the spp its own
+    rate at those settings (probed at `probe_spp`) allows, `reps` times with seeds 1, 2, ...
+    Errors are RMSE against `ref`, medians over the repetitions on each side: a scene's error
+    is heavy-tailed (a few bright pixels), so one image's RMSE says little."""
+    rates_m, rates_p, times_m, errs_m = [], [], [], []
+    for rep in range(reps):
+        t_m, img_m = mitsuba(rep)
+        rates_m.append(pixels * spp / t_m)
+        times_m.append(t_m)
+        errs_m.append(rmse(img_m, ref))
+        stats, _ = pathlab(["-s", str(spp), "--sampler", "independent"], "speed")
+        rates_p.append(stats["samples_per_second"])
+    rate_m, rate_p = float(np.median(rates_m)), float(np.median(rates_p))
+    t_m, e_m = float(np.median(times_m)), float(np.median(errs_m))
+    probe, _ = pathlab(["-s", str(probe_spp)], "probe")
+    spp_p = max(1, int(t_m * probe["samples_per_second"] / pixels))
+    errs_p, secs_p = [], []
+    for rep in range(reps):
+        stats, img = pathlab(["-s", str(spp_p), "--seed", str(rep + 1)], "equal-time")
+        errs_p.append(rmse(img, ref))
+        secs_p.append(stats["seconds"])
+    e_p = float(np.median(errs_p))
+    return {
+        "mitsuba_rate": rate_m, "pathlab_rate": rate_p, "ratio": rate_p / rate_m,
+        "mitsuba_runs": rates_m, "pathlab_runs": rates_p, "mitsuba_seconds": t_m,
+        "mitsuba_rmse": e_m, "mitsuba_rmses": errs_m, "pathlab_spp": spp_p,
+        "pathlab_seconds": float(np.median(secs_p)), "pathlab_rmse": e_p,
+        "pathlab_rmses": errs_p, "rmse_ratio": e_p / e_m if e_m > 0 else None,
+    }
+
+
 # Seeds far from the small ones the reference images' 16 runs may have used, so that a timed
 # image is not one of the runs its error is measured against.
 SEED = 1_000_002

@@ -43,9 +43,6 @@ args = ap.parse_args()
 variant = mitsuba_runs.pick_variant()
 
 
-rmse = mitsuba_runs.rmse
-
-
 def mitsuba_render(scene, max_depth, spp, rep):
     return mitsuba_runs.render(variant, scene, max_depth, spp, rep)
 
@@ -73,36 +70,13 @@ for name, folder, depth, ref_depth in CASES:
     pixels = ref.shape[0] * ref.shape[1]
     mitsuba_depth = -1 if depth == "inf" else int(depth) + 1
     tag = folder + ("" if depth == "inf" else f"-m{depth}")
-    rates_m, rates_p, times_m, errs_m = [], [], [], []
-    for rep in range(args.reps):
-        t_m, img_m = mitsuba_render(scene, mitsuba_depth, args.spp, rep)
-        rates_m.append(pixels * args.spp / t_m)
-        times_m.append(t_m)
-        errs_m.append(rmse(img_m, ref))
-        stats, _ = pathlab_render(scene, depth, ["-s", str(args.spp), "--sampler", "independent"], f"speed-{tag}")
-        rates_p.append(stats["samples_per_second"])
-    rate_m, rate_p = float(np.median(rates_m)), float(np.median(rates_p))
-    # Equal time: Mitsuba's median time is the budget; pathlab's default settings at the spp
-    # its own rate (measured at the default settings) allows.
-    t_m, e_m = float(np.median(times_m)), float(np.median(errs_m))
-    probe, _ = pathlab_render(scene, depth, ["-s", "16"], f"probe-{tag}")
-    spp_p = max(1, int(t_m * probe["samples_per_second"] / pixels))
-    # As many equal-time images as Mitsuba's, each with its own seed: a scene's error is
-    # heavy-tailed (a few bright pixels), so one image's RMSE says little; the medians compare.
-    errs_p, secs_p = [], []
-    for rep in range(args.reps):
-        stats, img = pathlab_render(scene, depth, ["-s", str(spp_p), "--seed", str(rep + 1)],
-                                    f"equal-time-{tag}")
-        errs_p.append(rmse(img, ref))
-        secs_p.append(stats["seconds"])
-    e_p = float(np.median(errs_p))
-    stats = {"seconds": float(np.median(secs_p))}
-    results["cases"][name] = {
-        "mitsuba_rate": rate_m, "pathlab_rate": rate_p, "ratio": rate_p / rate_m,
-        "mitsuba_runs": rates_m, "pathlab_runs": rates_p, "mitsuba_seconds": t_m,
-        "mitsuba_rmse": e_m, "pathlab_spp": spp_p, "pathlab_seconds": stats["seconds"],
-        "pathlab_rmse": e_p, "rmse_ratio": e_p / e_m,
-    }
-    print(f"{name:<18} {rate_m:12.3e} {rate_p:12.3e} {rate_p / rate_m:6.2f}   {e_m:12.5f}"
-          f" {spp_p:11d} {e_p:12.5f} {e_p / e_m:10.2f}", flush=True)
+    c = mitsuba_runs.compare(
+        args.reps, args.spp, pixels, ref,
+        lambda rep: mitsuba_render(scene, mitsuba_depth, args.spp, rep),
+        lambda flags, kind: pathlab_render(scene, depth, flags, f"{kind}-{tag}"),
+        probe_spp=16)
+    results["cases"][name] = c
+    print(f"{name:<18} {c['mitsuba_rate']:12.3e} {c['pathlab_rate']:12.3e} {c['ratio']:6.2f}"
+          f"   {c['mitsuba_rmse']:12.5f} {c['pathlab_spp']:11d} {c['pathlab_rmse']:12.5f}"
+          f" {c['rmse_ratio']:10.2f}", flush=True)
 json.dump(results, open(f"{args.work}/scenes.json", "w"), indent=1)

@@ -60,47 +60,31 @@ for path in files:
     ref = np.asarray(mi.Bitmap(ref_path), dtype=np.float64)[..., :3]
     pixels = ref.shape[0] * ref.shape[1]
     tag = f"suite-{folder}-{stem}"
-    rates_m, rates_p, times_m, errs_m = [], [], [], []
     try:
         mitsuba_runs.render_file(variant, path, 1, {"integrator": integrator})
     except subprocess.CalledProcessError as e:
         why = (e.stderr or "").strip().splitlines()[-1:] or ["no message"]
         print(f"{folder}/{stem:<40} Mitsuba cannot render it here: {why[0][-160:]}", flush=True)
         continue
-    for rep in range(args.reps):
-        t_m, img_m, rendered = mitsuba_runs.render_file(variant, path, args.spp,
-                                                        {"integrator": integrator}, rep)
-        rates_m.append(pixels * args.spp / t_m)
-        times_m.append(t_m)
-        errs_m.append(mitsuba_runs.rmse(img_m, ref))
-        stats, _ = pathlab_render(path, integrator,
-                                  ["-s", str(args.spp), "--sampler", "independent"],
-                                  f"{args.work}/speed-{tag}.exr")
-        rates_p.append(stats["samples_per_second"])
-    rate_m, rate_p = float(np.median(rates_m)), float(np.median(rates_p))
-    t_m, e_m = float(np.median(times_m)), float(np.median(errs_m))
-    probe, _ = pathlab_render(path, integrator, ["-s", "64"], f"{args.work}/probe-{tag}.exr")
-    spp_p = max(1, int(t_m * probe["samples_per_second"] / pixels))
-    # As many equal-time images as Mitsuba's, each with its own seed: these images' errors
-    # are heavy-tailed (a few pixels of glossy highlights), so one RMSE says little.
-    errs_p, secs_p = [], []
-    for rep in range(args.reps):
-        stats, img = pathlab_render(path, integrator, ["-s", str(spp_p), "--seed", str(rep + 1)],
-                                    f"{args.work}/equal-time-{tag}.exr")
-        errs_p.append(mitsuba_runs.rmse(img, ref))
-        secs_p.append(stats["seconds"])
-    e_p = float(np.median(errs_p))
-    stats = {"seconds": float(np.median(secs_p))}
+    rendered = []
+
+    def mitsuba(rep):
+        t, img, what = mitsuba_runs.render_file(variant, path, args.spp,
+                                                {"integrator": integrator}, rep)
+        rendered.append(what)
+        return t, img
+
+    c = mitsuba_runs.compare(
+        args.reps, args.spp, pixels, ref, mitsuba,
+        lambda flags, kind: pathlab_render(path, integrator, flags,
+                                           f"{args.work}/{kind}-{tag}.exr"),
+        probe_spp=64)
+    c["mitsuba_integrator"] = rendered[-1]
     label = f"{folder}/{stem}"
-    results["cases"][label] = {
-        "mitsuba_integrator": rendered, "mitsuba_rate": rate_m, "pathlab_rate": rate_p,
-        "ratio": rate_p / rate_m, "mitsuba_runs": rates_m, "pathlab_runs": rates_p,
-        "mitsuba_seconds": t_m, "mitsuba_rmse": e_m, "pathlab_spp": spp_p,
-        "pathlab_seconds": stats["seconds"], "pathlab_rmse": e_p,
-        "rmse_ratio": e_p / e_m if e_m > 0 else None,
-    }
-    print(f"{label:<52} {rate_m:11.3e} {rate_p:11.3e} {rate_p / rate_m:6.2f}   {e_m:12.5f}"
-          f" {spp_p:11d} {e_p:12.5f} {e_p / max(e_m, 1e-30):10.2f}   [{rendered}]", flush=True)
+    results["cases"][label] = c
+    print(f"{label:<52} {c['mitsuba_rate']:11.3e} {c['pathlab_rate']:11.3e} {c['ratio']:6.2f}"
+          f"   {c['mitsuba_rmse']:12.5f} {c['pathlab_spp']:11d} {c['pathlab_rmse']:12.5f}"
+          f" {c['rmse_ratio'] or float('nan'):10.2f}   [{rendered[-1]}]", flush=True)
 json.dump(results, open(f"{args.work}/suite.json", "w"), indent=1)
 ratios = [c["ratio"] for c in results["cases"].values()]
 if ratios:
