@@ -124,19 +124,6 @@ impl Builder {
         ))
     }
 
-    /// A number that may be a texture: `"texture NAME"` or a `float`.
-    fn float_texture(
-        &mut self,
-        params: &ParamList,
-        name: &str,
-        default: f64,
-    ) -> Result<TextureDesc, Error> {
-        if let Some(t) = self.texture_param(params, name)? {
-            return Ok(t);
-        }
-        Ok(TextureDesc::value(self.float(params, name, default)? as f32))
-    }
-
     /// A number that may be a texture; textures other than constants are used by their mean
     /// (with a warning).
     fn float_value(&mut self, params: &ParamList, name: &str, default: f64) -> Result<f64, Error> {
@@ -459,9 +446,9 @@ impl Builder {
     ) -> Result<MaterialDesc, Error> {
         // Thickness, albedo and g may be textures (read at each point, kept in range there);
         // numbers are checked here.
-        let thickness = self.float_texture(params, "thickness", 0.01)?;
+        let thickness = self.texture_or_value(params, "thickness", "float", 0.01)?;
         let albedo = self.color_texture(params, "albedo", Rgb::ZERO)?;
-        let g = self.float_texture(params, "g", 0.0)?;
+        let g = self.texture_or_value(params, "g", "float", 0.0)?;
         let max_depth = self.float(params, "maxdepth", 10.0)?;
         let samples = self.float(params, "nsamples", 1.0)?;
         if let Some(t) = thickness.as_constant().map(|t| t.x) {
@@ -513,7 +500,7 @@ impl Builder {
         let (first, second) = (pick(&names[0])?, pick(&names[1])?);
         // pbrt-v4 picks the second with probability `amount` (a number or a texture, read at
         // each point and kept in [0, 1] there): the same expectation as a blend.
-        let weight = match self.float_texture(params, "amount", 0.5)? {
+        let weight = match self.texture_or_value(params, "amount", "float", 0.5)? {
             TextureDesc::Constant(a) => TextureDesc::Constant(a.clamp(Rgb::ZERO, Rgb::ONE)),
             t => t,
         };

@@ -124,7 +124,7 @@ impl Builder {
     }
 
     /// A texture parameter or a value of the texture's type (`default` where absent).
-    fn texture_or_value(
+    pub(super) fn texture_or_value(
         &mut self,
         params: &ParamList,
         name: &str,
