@@ -106,7 +106,7 @@ impl LayerStack {
 }
 
 /// A layered BSDF: a [`LayerStack`] and what may vary over the surface: a diffuse base's
-/// albedo and the coat's roughness.
+/// albedo, the coat's and a conductor base's roughness, and the layer's medium.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Layered {
     /// Coat, base and medium.
@@ -122,6 +122,17 @@ pub struct Layered {
     pub medium: LayerMedium,
 }
 
+/// The medium between coat and base, as it may vary over the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LayerMedium {
+    /// Optical thickness of the layer (in units of the medium's mean free path).
+    pub thickness: f32,
+    /// Single-scattering albedo (zero: no medium, only absorption-free travel).
+    pub albedo: Rgb,
+    /// Henyey–Greenstein asymmetry.
+    pub g: f32,
+}
+
 impl LayerMedium {
     /// The medium of these parameters, kept in range: a thickness of at least the smallest
     /// positive number, an albedo in [0, 1] and an asymmetry in [-0.99, 0.99].
@@ -132,17 +143,6 @@ impl LayerMedium {
             g: g.clamp(-0.99, 0.99),
         }
     }
-}
-
-/// The medium between coat and base, as it may vary over the surface.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LayerMedium {
-    /// Optical thickness of the layer (in units of the medium's mean free path).
-    pub thickness: f32,
-    /// Single-scattering albedo (zero: no medium, only absorption-free travel).
-    pub albedo: Rgb,
-    /// Henyey–Greenstein asymmetry.
-    pub g: f32,
 }
 
 /// Whether a walk carries radiance (from the camera) or importance (from a light): refraction
