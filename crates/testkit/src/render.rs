@@ -57,8 +57,7 @@ pub fn assert_mean(name: &str, film: &Film, truth: DVec3) {
 
 /// Per-pixel two-sample z-tests of two independent renders of one image: at most 0.1% of
 /// pixel channels beyond [`MAX_Z`] (rounded up to 1; differences within single-precision
-/// rounding are none), and image means within 3 combined
-/// standard errors.
+/// rounding are none), and image means within 3 combined standard errors.
 pub fn assert_same_image(name: &str, a: &Film, b: &Film) {
     let mut outliers = 0;
     for (p, q) in a.pixels().iter().zip(b.pixels()) {

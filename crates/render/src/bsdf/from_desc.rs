@@ -142,30 +142,24 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
         Err([au, av]) => Microfacet::unless_smooth(NormalDistribution::Ggx, *au, *av),
         Ok(_) => None,
     };
-    let mut base_alpha = Ok(None);
-    let (base, reflectance, base_texture) = match &c.base {
+    let (base, reflectance, base_texture, base_alpha, base_anisotropic) = match &c.base {
         CoatedBase::Diffuse(t) => {
             let reflectance = t
                 .as_constant()
                 .unwrap_or(Rgb::ZERO)
                 .clamp(Vec3::ZERO, Vec3::ONE);
             let texture = t.as_constant().is_none().then(|| tex(t));
-            (Base::Diffuse, reflectance, texture)
+            (Base::Diffuse, reflectance, texture, None, false)
         }
         CoatedBase::Conductor { eta, k, alpha } => {
-            let alpha = numbers_or_textures(alpha, tex);
-            let distribution = roughness(&alpha);
-            base_alpha = alpha.map(Some);
-            (
-                Base::Conductor(Conductor {
-                    eta: *eta,
-                    k: *k,
-                    specular: Rgb::ONE,
-                    distribution,
-                }),
-                Rgb::ZERO,
-                None,
-            )
+            let textures = numbers_or_textures(alpha, tex);
+            let base = Base::Conductor(Conductor {
+                eta: *eta,
+                k: *k,
+                specular: Rgb::ONE,
+                distribution: roughness(&textures),
+            });
+            (base, Rgb::ZERO, None, textures.ok(), alpha[0] != alpha[1])
         }
     };
     let coat_alpha = numbers_or_textures(&c.coat_alpha, tex);
@@ -189,19 +183,13 @@ fn coated(c: &CoatedDesc, tex: &mut impl FnMut(&TextureDesc) -> Tex) -> Material
             roughness: roughness(&coat_alpha),
         },
         base,
-        thickness: medium.thickness,
-        albedo: medium.albedo,
-        g: medium.g,
+        medium,
         max_depth: c.max_depth.min(u16::MAX as u32) as u16,
         samples: c.samples.clamp(1, u16::MAX as u32) as u16,
     };
     let layered = Layered::new(stack, reflectance);
-    let base_anisotropic = match &c.base {
-        CoatedBase::Conductor { alpha, .. } => alpha[0] != alpha[1],
-        CoatedBase::Diffuse(_) => false,
-    };
     let anisotropic = base_anisotropic || c.coat_alpha[0] != c.coat_alpha[1];
-    let (coat_alpha, base_alpha) = (coat_alpha.ok(), base_alpha.ok().flatten());
+    let coat_alpha = coat_alpha.ok();
     if base_texture.is_none()
         && coat_alpha.is_none()
         && base_alpha.is_none()

@@ -444,8 +444,8 @@ impl Builder {
         coat_eta: f32,
         coat_alpha: [TextureDesc; 2],
     ) -> Result<MaterialDesc, Error> {
-        // Thickness, albedo and g may be textures (read at each point, kept in range there);
-        // numbers are checked here.
+        // Thickness, albedo and g may be textures (read at each point and kept in range there,
+        // by `LayerMedium::new`, as numbers are); numbers are checked here.
         let thickness = self.texture_or_value(params, "thickness", "float", 0.01)?;
         let albedo = self.color_texture(params, "albedo", Rgb::ZERO)?;
         let g = self.texture_or_value(params, "g", "float", 0.0)?;
@@ -466,10 +466,6 @@ impl Builder {
                 return Err(self.error(format!("g {g}: must lie strictly between -1 and 1")));
             }
         }
-        let albedo = match albedo.as_constant() {
-            Some(a) => TextureDesc::Constant(a.clamp(Rgb::ZERO, Rgb::ONE)),
-            None => albedo,
-        };
         Ok(MaterialDesc::Coated(Box::new(CoatedDesc {
             base,
             coat_eta,

@@ -58,12 +58,9 @@ pub struct LayerStack {
     pub coat: Coat,
     /// The bottom interface.
     pub base: Base,
-    /// Optical thickness of the layer (in units of the medium's mean free path).
-    pub thickness: f32,
-    /// Single-scattering albedo of the medium (zero: no medium, only absorption-free travel).
-    pub albedo: Rgb,
-    /// Henyey–Greenstein asymmetry of the medium.
-    pub g: f32,
+    /// The medium between them (where a material's is textured, each [`Layered`] holds its
+    /// own).
+    pub medium: LayerMedium,
     /// Most scattering events a walk follows.
     pub max_depth: u16,
     /// Walks averaged by each `f` and `pdf` estimate.
@@ -78,12 +75,12 @@ impl LayerStack {
         let bits = |c: Rgb| [c.x, c.y, c.z].map(f32::to_bits);
         let mut key = vec![
             self.coat.eta.to_bits(),
-            self.thickness.to_bits(),
-            self.g.to_bits(),
+            self.medium.thickness.to_bits(),
+            self.medium.g.to_bits(),
             self.max_depth as u32,
             self.samples as u32,
         ];
-        key.extend(bits(self.albedo));
+        key.extend(bits(self.medium.albedo));
         let facets = |m: Option<Microfacet>| match m {
             None => [0, 0, 0],
             Some(m) => [1 + m.kind as u32, m.alpha.to_bits(), m.alpha_y.to_bits()],
@@ -301,11 +298,7 @@ impl Layered {
                 Base::Conductor(c) => c.distribution,
                 Base::Diffuse => None,
             },
-            medium: LayerMedium {
-                thickness: stack.thickness,
-                albedo: stack.albedo,
-                g: stack.g,
-            },
+            medium: stack.medium,
             stack: stack.interned(),
             reflectance,
         }

@@ -13,9 +13,11 @@ fn stack(roughness: Option<f32>, max_depth: u16) -> LayerStack {
             roughness: roughness.map(|a| Microfacet::new(NormalDistribution::Ggx, a)),
         },
         base: Base::Diffuse,
-        thickness: f32::MIN_POSITIVE,
-        albedo: Rgb::ZERO,
-        g: 0.0,
+        medium: LayerMedium {
+            thickness: f32::MIN_POSITIVE,
+            albedo: Rgb::ZERO,
+            g: 0.0,
+        },
         max_depth,
         samples: 1,
     }
@@ -101,9 +103,11 @@ fn sampling_and_evaluation_estimate_the_same_albedo() {
         coated_diffuse(Rgb::new(0.7, 0.4, 0.2), Some(0.3), 100),
         Layered::new(
             LayerStack {
-                albedo: Rgb::new(0.8, 0.6, 0.3),
-                g: 0.4,
-                thickness: 0.3,
+                medium: LayerMedium {
+                    albedo: Rgb::new(0.8, 0.6, 0.3),
+                    g: 0.4,
+                    thickness: 0.3,
+                },
                 ..stack(Some(0.15), 100)
             },
             Rgb::splat(0.5),
@@ -153,8 +157,11 @@ fn sampling_and_evaluation_estimate_the_same_albedo() {
 fn estimates_are_fixed_functions_of_their_arguments_and_both_sides_alike() {
     let b = Layered::new(
         LayerStack {
-            albedo: Rgb::splat(0.5),
-            thickness: 0.2,
+            medium: LayerMedium {
+                albedo: Rgb::splat(0.5),
+                thickness: 0.2,
+                g: 0.0,
+            },
             ..stack(Some(0.3), 10)
         },
         Rgb::splat(0.6),
