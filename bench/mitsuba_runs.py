@@ -4,12 +4,17 @@ its timed renders in processes of their own, and the RMSE of an image against a 
 Run as a script (`python3 bench/mitsuba_runs.py VARIANT SCENE MAX_DEPTH SPP OUT.npy [SEED=N]
 [NAME=VALUE ...]`) it is one timed render: the first render compiles the kernels and is not
 timed; it prints the seconds of the second (and what integrator it rendered) and saves its
-image. Each Mitsuba measurement runs so, in a process
-that has exited before pathlab starts: after a render, Mitsuba's worker threads keep a core
-busy for seconds, which would slow whatever runs next."""
+image. Each Mitsuba measurement runs so, in a process that has exited before pathlab starts:
+after a render, Mitsuba's worker threads keep a core busy for seconds, which would slow
+whatever runs next."""
 import os, subprocess, sys, tempfile, time
 import numpy as np
 import mitsuba as mi
+
+# Seeds far from the small ones the reference images' 16 runs may have used, so that a timed
+# image is not one of the runs its error is measured against.
+SEED = 1_000_002
+
 
 
 def pick_variant():
@@ -27,27 +32,26 @@ def pick_variant():
 def render(variant, scene, max_depth, spp, rep=0):
     """One timed Mitsuba render in a process of its own: (seconds, image). Repetition `rep`
     renders with a seed of its own, so that repeated renders are different images."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "img.npy")
-        cmd = [sys.executable, __file__, variant, scene, str(max_depth), str(spp), out,
-               f"SEED={SEED + rep}"]
-        stdout = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-        seconds = float(stdout.splitlines()[0])
-        return seconds, np.load(out)
+    seconds, img, _ = timed(variant, scene, str(max_depth), spp, {}, rep)
+    return seconds, img
 
 
 def render_file(variant, scene, spp, params, rep=0):
     """One timed Mitsuba render of a scene file with `$NAME` parameters `params` (a dict of
-    strings), in a process of its own, as `render` (`rep` as there): (seconds, image, what was
-    rendered). A
-    `moment` integrator (Mitsuba's test suite wraps its scenes' integrators in one, to record
-    second moments) is replaced by the integrator it wraps, with the same settings, so that
-    Mitsuba does only the work pathlab does."""
+    strings), its own depth, as `render` (`rep` as there): (seconds, image, what was
+    rendered). A `moment` integrator (Mitsuba's test suite wraps its scenes' integrators in
+    one, to record second moments) is replaced by the integrator it wraps, with the same
+    settings, so that Mitsuba does only the work pathlab does."""
+    return timed(variant, scene, "-", spp, params, rep)
+
+
+def timed(variant, scene, max_depth, spp, params, rep):
+    """This file run as a script (see above) in a process of its own."""
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "img.npy")
-        cmd = [sys.executable, __file__, variant, scene, "-", str(spp), out, f"SEED={SEED + rep}"]
-        cmd += [f"{k}={v}" for k, v in params.items()]
-        lines = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.split("\n")
+        cmd = [sys.executable, __file__, variant, scene, max_depth, str(spp), out,
+               f"SEED={SEED + rep}"] + [f"{k}={v}" for k, v in params.items()]
+        lines = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.splitlines()
         return float(lines[0]), np.load(out), lines[1]
 
 
@@ -112,17 +116,13 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, probe_spp):
     }
 
 
-# Seeds far from the small ones the reference images' 16 runs may have used, so that a timed
-# image is not one of the runs its error is measured against.
-SEED = 1_000_002
-
-
 def rmse(img, ref):
     return float(np.sqrt(np.mean((np.asarray(img, dtype=np.float64)[..., :3] - ref) ** 2)))
 
 
 if __name__ == "__main__":
-    # VARIANT SCENE MAX_DEPTH SPP OUT [NAME=VALUE ...]; MAX_DEPTH "-" leaves the file's.
+    # VARIANT SCENE MAX_DEPTH SPP OUT [SEED=N] [NAME=VALUE ...]; MAX_DEPTH "-" leaves the
+    # file's.
     variant, scene_path, max_depth, spp, out = sys.argv[1:6]
     mi.set_variant(variant)
     params = dict(a.split("=", 1) for a in sys.argv[6:])

@@ -60,12 +60,6 @@ for path in files:
     ref = np.asarray(mi.Bitmap(ref_path), dtype=np.float64)[..., :3]
     pixels = ref.shape[0] * ref.shape[1]
     tag = f"suite-{folder}-{stem}"
-    try:
-        mitsuba_runs.render_file(variant, path, 1, {"integrator": integrator})
-    except subprocess.CalledProcessError as e:
-        why = (e.stderr or "").strip().splitlines()[-1:] or ["no message"]
-        print(f"{folder}/{stem:<40} Mitsuba cannot render it here: {why[0][-160:]}", flush=True)
-        continue
     rendered = []
 
     def mitsuba(rep):
@@ -74,11 +68,19 @@ for path in files:
         rendered.append(what)
         return t, img
 
-    c = mitsuba_runs.compare(
-        args.reps, args.spp, pixels, ref, mitsuba,
-        lambda flags, kind: pathlab_render(path, integrator, flags,
-                                           f"{args.work}/{kind}-{tag}.exr"),
-        probe_spp=64)
+    # Mitsuba renders first, so a scene it cannot load fails before pathlab runs.
+    try:
+        c = mitsuba_runs.compare(
+            args.reps, args.spp, pixels, ref, mitsuba,
+            lambda flags, kind: pathlab_render(path, integrator, flags,
+                                               f"{args.work}/{kind}-{tag}.exr"),
+            probe_spp=64)
+    except subprocess.CalledProcessError as e:
+        if rendered:  # Mitsuba rendered it: the failure is pathlab's
+            raise
+        why = (e.stderr or "").strip().splitlines()[-1:] or ["no message"]
+        print(f"{folder}/{stem:<40} Mitsuba cannot render it here: {why[0][-160:]}", flush=True)
+        continue
     c["mitsuba_integrator"] = rendered[-1]
     label = f"{folder}/{stem}"
     results["cases"][label] = c
