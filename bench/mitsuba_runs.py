@@ -7,7 +7,7 @@ timed; it prints the seconds of the second (and what integrator it rendered) and
 image. Each Mitsuba measurement runs so, in a process that has exited before pathlab starts:
 after a render, Mitsuba's worker threads keep a core busy for seconds, which would slow
 whatever runs next."""
-import os, subprocess, sys, tempfile, time
+import json, os, subprocess, sys, tempfile, time
 import numpy as np
 import mitsuba as mi
 
@@ -53,6 +53,13 @@ def timed(variant, scene, max_depth, spp, params, rep):
                f"SEED={SEED + rep}"] + [f"{k}={v}" for k, v in params.items()]
         lines = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.splitlines()
         return float(lines[0]), np.load(out), lines[1]
+
+
+def pathlab_render(pathlab, scene, flags, out):
+    """`pathlab render SCENE FLAGS -o OUT` (quiet, JSON): its statistics and the image."""
+    cmd = [pathlab, "render", scene, "-q", "--json", "-o", out] + flags
+    stats = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+    return stats, np.asarray(mi.Bitmap(out), dtype=np.float64)[..., :3]
 
 
 def unwrapped(integrator):

@@ -14,7 +14,7 @@ Mitsuba's variant is llvm_ad_rgb (JIT-compiled, as wide as the CPU's vectors: 16
 AVX-512); its first render of each configuration compiles kernels and is not timed. Each
 Mitsuba measurement runs in a process of its own, gone before pathlab starts (after a render
 Mitsuba's worker threads keep a core busy for seconds)."""
-import argparse, json, os, subprocess
+import argparse, json, os
 import numpy as np
 import mitsuba as mi
 import mitsuba_runs
@@ -48,11 +48,8 @@ def mitsuba_render(scene, max_depth, spp, rep):
 
 
 def pathlab_render(scene, depth, extra, name):
-    out = f"{args.work}/{name}.exr"
-    cmd = [args.pathlab, "render", scene, "-m", depth, "-q", "--json", "-o", out] + extra
-    stats = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
-    img = np.asarray(mi.Bitmap(out), dtype=np.float64)[..., :3]
-    return stats, img
+    return mitsuba_runs.pathlab_render(args.pathlab, scene, ["-m", depth] + extra,
+                                       f"{args.work}/{name}.exr")
 
 
 print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; pathlab on all threads; {args.spp} spp;"

@@ -35,10 +35,8 @@ variant = mitsuba_runs.pick_variant()
 
 
 def pathlab_render(scene, integrator, extra, out):
-    cmd = [args.pathlab, "render", scene, "-D", f"integrator={integrator}", "-q", "--json",
-           "-o", out] + extra
-    stats = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
-    return stats, np.asarray(mi.Bitmap(out), dtype=np.float64)[..., :3]
+    return mitsuba_runs.pathlab_render(args.pathlab, scene,
+                                       ["-D", f"integrator={integrator}"] + extra, out)
 
 
 files = sorted(glob.glob(os.path.join(args.suite, "*", "*.xml")))
