@@ -1,10 +1,13 @@
 //! `pathlab compare`: the arguments and the table of [`pathlab_lab::compare`] (one scene with
 //! several strategies, side by side, with the numbers that say which converges fastest).
 
+use crate::flags::{self, SceneArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use pathlab_lab::compare::{compare, rows_json, rows_table, strategy, write_side_by_side};
-use pathlab_lab::images::{depth_text, read_reference};
+use pathlab_lab::compare::{
+    compare, reference_warning, rows_json, rows_table, strategies, write_side_by_side,
+};
+use pathlab_lab::images::read_reference;
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::render::RenderSettings;
 use pathlab_render::scene::Scene;
@@ -14,11 +17,8 @@ use std::path::PathBuf;
 /// Raw command-line arguments of `pathlab compare`.
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// The scene: a file (.xml Mitsuba 3, .pbrt pbrt-v4, .dae the course's COLLADA, .obj, .ply,
-    /// .gltf, .glb) or
-    /// a built-in scene's name (cornell-box).
-    #[arg(default_value = "cornell-box")]
-    pub scene: String,
+    #[command(flatten)]
+    pub scene: SceneArgs,
     /// Strategies to compare, comma-separated: hemisphere, cosine, light, mis (direct lighting)
     /// and path, path-bsdf, path-light (path tracing at --max-depth with MIS, BSDF sampling
     /// only, light sampling only).
@@ -32,14 +32,11 @@ pub struct CompareArgs {
     #[arg(short = 's', long, default_value_t = 16)]
     pub spp: u32,
     /// Largest bounce for the path strategy.
-    #[arg(short = 'm', long, default_value = "1", value_parser = crate::render_cmd::parse_depth_arg)]
+    #[arg(short = 'm', long, default_value = "1", value_parser = flags::max_depth_arg)]
     pub max_depth: u32,
     /// A reference image (linear EXR of the same size) for RMSE.
     #[arg(long = "ref", value_name = "REF.exr")]
     pub reference: Option<PathBuf>,
-    /// Image size (default: the scene's).
-    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"])]
-    pub resolution: Option<Vec<u32>>,
     /// Sampler: independent (the default here, so that variances are exact), stratified, sobol.
     #[arg(long, default_value = "independent")]
     pub sampler: SamplerKind,
@@ -59,20 +56,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     if args.spp == 0 {
         bail!("--spp must be at least 1");
     }
-    if args.strategies.is_empty() {
-        bail!("--strategies: name at least one");
-    }
-    let strategies = args
-        .strategies
-        .iter()
-        .map(|s| {
-            let name = s.trim().to_string();
-            let integrator = strategy(&name, args.max_depth).context("--strategies")?;
-            Ok((name, integrator))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let mut desc = pathlab_scene::load(&args.scene)?;
-    pathlab_lab::render::apply_resolution(&mut desc, crate::image_size(&args.resolution))?;
+    let strategies = strategies(&args.strategies, args.max_depth).context("--strategies")?;
+    let desc = args.scene.load()?;
     let [w, h] = desc.resolution;
     let reference = args
         .reference
@@ -82,22 +67,15 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let settings = RenderSettings::new(args.spp, args.seed, args.sampler);
     let rows = compare(&scene, &strategies, &settings, reference.as_deref());
-    if let (Some(r), Some(p), Some(best)) = (
-        &reference,
-        &args.reference,
-        rows.iter().min_by(|a, b| a.variance.total_cmp(&b.variance)),
-    ) {
-        // Direct-lighting strategies stop at the first bounce; path strategies at -m.
-        let path = args.strategies.iter().any(|s| s.trim().starts_with("path"));
-        let depth = depth_text(if path { args.max_depth } else { 1 });
-        if let Some(w) = pathlab_lab::images::reference_mismatch(&best.film, r, p, &depth) {
+    if let (Some(r), Some(p)) = (&reference, &args.reference) {
+        if let Some(w) = reference_warning(&rows, r, p, args.max_depth) {
             eprintln!("warning: {w}");
         }
     }
     write_side_by_side(&rows, &args.output)?;
     if args.json {
         let out = json!({
-            "scene": args.scene,
+            "scene": args.scene.name,
             "spp": args.spp,
             "sampler": args.sampler.name(),
             "image": args.output,
@@ -108,7 +86,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     }
     println!(
         "{} at {w}x{h}, {} spp, {} sampler",
-        args.scene,
+        args.scene.name,
         args.spp,
         args.sampler.name()
     );

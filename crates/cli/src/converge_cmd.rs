@@ -2,6 +2,7 @@
 //! against a reference falls with samples and with time, for independent and Sobol sampling and
 //! for uniform and error-driven sample allocation).
 
+use crate::flags::{self, SceneArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use pathlab_lab::images::{depth_text, read_reference};
@@ -14,23 +15,17 @@ use std::path::PathBuf;
 /// Raw command-line arguments of `pathlab converge`.
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
-    /// The scene: a file (.xml Mitsuba 3, .pbrt pbrt-v4, .dae the course's COLLADA, .obj, .ply,
-    /// .gltf, .glb) or
-    /// a built-in scene's name (cornell-box).
-    #[arg(default_value = "cornell-box")]
-    pub scene: String,
+    #[command(flatten)]
+    pub scene: SceneArgs,
     /// The reference image: a linear EXR of the scene at the render's resolution.
     #[arg(long = "ref", value_name = "REF.exr")]
     pub reference: PathBuf,
     /// Largest bounce (default 1: direct lighting).
-    #[arg(short = 'm', long, default_value = "1", value_parser = crate::render_cmd::parse_depth_arg)]
+    #[arg(short = 'm', long, default_value = "1", value_parser = flags::max_depth_arg)]
     pub max_depth: u32,
     /// Largest samples per pixel (powers of two from 1 up to this).
     #[arg(long, default_value_t = 256)]
     pub max_spp: u32,
-    /// Image size (default: the scene's).
-    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"])]
-    pub resolution: Option<Vec<u32>>,
     /// Seed.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -51,8 +46,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let format = plot::Format::from_path(&args.output)?;
-    let mut desc = pathlab_scene::load(&args.scene)?;
-    pathlab_lab::render::apply_resolution(&mut desc, crate::image_size(&args.resolution))?;
+    let desc = args.scene.load()?;
     let reference = read_reference(&args.reference, desc.resolution)?;
     let scene = Scene::build(&desc).context("cannot build the scene")?;
     let integrator = IntegratorKind::Path(PathIntegrator {
@@ -70,22 +64,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     ) {
         eprintln!("warning: {w}");
     }
-    let name = |p: &std::path::Path| {
-        p.file_name().map_or_else(
-            || p.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        )
-    };
-    let title = format!(
-        "{}: -m {}, error against {}",
-        name(std::path::Path::new(&args.scene)),
-        args.max_depth,
-        name(&args.reference)
-    );
-    plot::rmse_curves(&args.output, format, &title, &study.curves)?;
+    let (scene, depth) = (&args.scene.name, args.max_depth);
+    study.write_plot(&args.output, format, scene, depth, &args.reference)?;
     if args.json {
         let out = json!({
-            "scene": args.scene,
+            "scene": args.scene.name,
             "reference": args.reference,
             "plot": args.output,
             "curves": study.curves_json(),
@@ -93,7 +76,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
-    println!("{} against {}", args.scene, args.reference.display());
+    println!("{} against {}", args.scene.name, args.reference.display());
     println!("{}", study.curves_text());
     println!("  plot written to {}", args.output.display());
     Ok(())

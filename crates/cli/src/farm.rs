@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use clap::Args;
-use pathlab_render::film_file;
+use pathlab_render::{film_file, limits};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -50,6 +50,7 @@ pub struct MergeArgs {
 /// Runs `pathlab merge`: checks that the parts are of one render and cover its samples once,
 /// then adds them (exactly: the result is the single render's film to the bit).
 pub fn run_merge(args: &MergeArgs) -> Result<()> {
+    crate::flags::within("--exposure", Some(args.exposure), limits::exposure)?;
     let mut parts = Vec::new();
     for p in &args.parts {
         let (h, film) = film_file::read(p)?;

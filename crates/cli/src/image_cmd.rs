@@ -1,11 +1,11 @@
 //! `pathlab convert` and `pathlab diff`: the images pathlab writes, re-encoded and compared.
 
-use crate::render_cmd::ToneMapName;
+use crate::flags::within;
 use anyhow::{bail, Result};
 use clap::Args;
-use pathlab_lab::images::{diff_files, FileDifference};
-use pathlab_render::image_io::{read_rgb, write_exr, write_png_with};
-use serde_json::json;
+use pathlab_lab::images::diff_files;
+use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, ToneMap};
+use pathlab_render::limits;
 use std::path::{Path, PathBuf};
 
 /// Raw command-line arguments of `pathlab convert`.
@@ -19,8 +19,8 @@ pub struct ConvertArgs {
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
     /// PNG encoding: srgb, or cs184 (the course's: times √2, half a stop up, then gamma 2.2).
-    #[arg(long, value_enum, default_value_t = ToneMapName::Srgb)]
-    pub tonemap: ToneMapName,
+    #[arg(long, default_value = "srgb")]
+    pub tonemap: ToneMap,
 }
 
 /// Raw command-line arguments of `pathlab diff`.
@@ -58,18 +58,13 @@ fn check_extension(path: &Path, allowed: &[&str]) -> Result<String> {
 
 /// Runs `pathlab convert`.
 pub fn run_convert(args: &ConvertArgs) -> Result<()> {
-    if !args.exposure.is_finite() {
-        bail!(
-            "--exposure {}: must be a finite number of stops",
-            args.exposure
-        );
-    }
+    within("--exposure", Some(args.exposure), limits::exposure)?;
     let ext = check_extension(&args.output, &["png", "exr"])?;
     let (w, h, px) = read_rgb(&args.input, true)?;
     if ext == "exr" {
         write_exr(&args.output, w, h, &px, &[])?;
     } else {
-        write_png_with(&args.output, w, h, &px, args.exposure, args.tonemap.into())?;
+        write_png_with(&args.output, w, h, &px, args.exposure, args.tonemap)?;
     }
     eprintln!(
         "{}: {w}x{h}; wrote {}",
@@ -84,39 +79,16 @@ pub fn run_diff(args: &DiffArgs) -> Result<()> {
     if let Some(o) = &args.output {
         check_extension(o, &["png", "exr"])?;
     }
-    let FileDifference {
-        resolution: [wa, ha],
-        difference: d,
-        heat_top,
-    } = diff_files(&args.a, &args.b, args.output.as_deref())?;
-    let (e, rel, largest, ma, mb) = (d.rmse, d.relative_mse, d.max_abs, d.mean_a, d.mean_b);
-    if let Some(top) = heat_top {
+    let diff = diff_files(&args.a, &args.b, args.output.as_deref())?;
+    if let Some(top) = diff.heat_top {
         eprintln!(
             "difference image: black 0 to white {top:.4} (the 99th percentile of |A - B|, luminance)"
         );
     }
     if args.json {
-        let out = json!({
-            "a": args.a,
-            "b": args.b,
-            "resolution": [wa, ha],
-            "rmse": e,
-            "relative_mse": rel,
-            "max_abs_difference": largest,
-            "mean_a": [ma.x, ma.y, ma.z],
-            "mean_b": [mb.x, mb.y, mb.z],
-            "output": args.output,
-        });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        println!("{}", serde_json::to_string_pretty(&diff.json())?);
     } else {
-        println!(
-            "{wa}x{ha}: RMSE {e:.6}, relative MSE {rel:.6}, largest difference {largest:.6}; mean {:.5} vs {:.5}{}",
-            ma.element_sum() / 3.0,
-            mb.element_sum() / 3.0,
-            args.output
-                .as_ref()
-                .map_or(String::new(), |o| format!("; wrote {}", o.display()))
-        );
+        println!("{}", diff.text());
     }
     Ok(())
 }

@@ -4,10 +4,8 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use pathlab_lab::expr::parse_constant;
-use pathlab_lab::integrate::{convergence, Integral, IntegrateReport};
-use pathlab_lab::plot;
+use pathlab_lab::integrate::{convergence_plot, Integral, IntegrateReport};
 use pathlab_mc::sampler::SamplerKind;
-use serde_json::Value;
 use std::path::PathBuf;
 
 /// Raw command-line arguments of `pathlab integrate`.
@@ -78,13 +76,6 @@ fn parse_domain(text: &str) -> Result<(f64, f64)> {
 
 /// Runs `pathlab integrate`.
 pub fn run(args: &IntegrateArgs) -> Result<()> {
-    if args.samples == 0 || args.samples > u32::MAX as u64 {
-        bail!(
-            "-n must be between 1 and {}, got {}",
-            u32::MAX,
-            args.samples
-        );
-    }
     if args.reps == 0 {
         bail!("--reps must be at least 1");
     }
@@ -95,7 +86,7 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
             args.samples
         );
     }
-    let n = args.samples as u32;
+    let n = crate::flags::sample_count(args.samples)?;
     let exact = args
         .exact
         .as_deref()
@@ -127,7 +118,7 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
         }
     }
     let convergence = match &args.convergence {
-        Some(path) => Some(convergence_report(
+        Some(path) => Some(convergence_plot(
             &problem,
             n,
             args.reps.max(4),
@@ -160,20 +151,4 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// The convergence study of the three samplers, plotted to `path`, as JSON.
-fn convergence_report(
-    problem: &Integral,
-    n: u32,
-    reps: u32,
-    seed: u64,
-    exact: Option<f64>,
-    path: &std::path::Path,
-) -> Result<Value> {
-    let format = plot::Format::from_path(path)?;
-    let study = convergence(problem, n, reps, seed, exact);
-    let title = format!("∫ {} over {}", problem.f.text(), problem.domain_text());
-    plot::convergence(path, format, &title, &study.series, exact, exact.is_some())?;
-    Ok(study.json(reps, exact.is_some()))
 }

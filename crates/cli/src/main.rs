@@ -3,6 +3,7 @@
 mod compare_cmd;
 mod converge_cmd;
 mod farm;
+mod flags;
 mod image_cmd;
 mod info_cmd;
 mod integrate;
@@ -76,11 +77,6 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-/// A `-r W H` flag (clap takes exactly two values) as a size.
-pub(crate) fn image_size(resolution: &Option<Vec<u32>>) -> Option<[u32; 2]> {
-    resolution.as_deref().map(|r| [r[0], r[1]])
 }
 
 /// The first paragraph of clap's message as one line: "the following required arguments were

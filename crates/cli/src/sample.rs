@@ -121,14 +121,7 @@ fn distribution(a: &SampleArgs) -> Result<Distribution> {
 }
 
 pub fn run(args: &SampleArgs) -> Result<()> {
-    if args.samples == 0 || args.samples > u32::MAX as u64 {
-        bail!(
-            "-n must be between 1 and {}, got {}",
-            u32::MAX,
-            args.samples
-        );
-    }
-    let n = args.samples as u32;
+    let n = crate::flags::sample_count(args.samples)?;
     let format = args
         .plot
         .as_deref()
@@ -136,14 +129,8 @@ pub fn run(args: &SampleArgs) -> Result<()> {
         .transpose()?;
     let dist = distribution(args)?;
     let report = pathlab_lab::sample::run(&dist, args.sampler, n, args.seed, format.is_some());
-    if let (Some(path), Some(format), Some(p)) = (&args.plot, format, &report.plot) {
-        let title = format!(
-            "{} ({} samples, {})",
-            report.description,
-            n,
-            args.sampler.name()
-        );
-        plot::samples(path, format, &title, p)?;
+    if let (Some(path), Some(format)) = (&args.plot, format) {
+        report.write_plot(path, format)?;
     }
 
     if args.json {

@@ -548,3 +548,66 @@ fn integrate_warns_of_heavy_tails() {
     let v = json_of(&pathlab(&["integrate", "x^2", "-d", "0,1", "--json"]));
     assert_eq!(v["heavy_tailed"], false);
 }
+
+#[test]
+fn compare_and_converge_take_scene_parameters_and_say_what_the_loader_warns() {
+    // A Mitsuba scene whose film width is a parameter: `-D` sets it, and a parameter the
+    // scene does not use is the loader's warning, printed.
+    let scene = scratch("param_sphere.xml");
+    std::fs::write(
+        &scene,
+        r#"<scene version="3.0.0">
+  <default name="w" value="8"/>
+  <sensor type="perspective">
+    <float name="fov" value="30"/>
+    <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="$w"/><integer name="height" value="4"/></film>
+  </sensor>
+  <shape type="sphere"><bsdf type="diffuse"/></shape>
+  <emitter type="constant"/>
+</scene>
+"#,
+    )
+    .unwrap();
+    let scene = scene.to_str().unwrap();
+    let out = scratch("param_compare.png");
+    let o = pathlab(&[
+        "compare",
+        scene,
+        "-D",
+        "w=6",
+        "-D",
+        "unused=1",
+        "-s",
+        "2",
+        "--strategies",
+        "cosine",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(o.status.success(), "{stderr}");
+    assert!(stdout.contains("at 6x4"), "{stdout}");
+    assert!(
+        stderr.contains("warning:") && stderr.contains("'unused'"),
+        "{stderr}"
+    );
+    assert_one_line_error(&pathlab(&["compare", scene, "-D", "novalue"]), "-D novalue");
+    // converge reads its reference at the size -D gives the scene.
+    let reference = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/cornell-box/mean-maxdepth-2.exr");
+    assert_one_line_error(
+        &pathlab(&[
+            "converge",
+            scene,
+            "-D",
+            "w=6",
+            "--ref",
+            reference.to_str().unwrap(),
+        ]),
+        "6x4",
+    );
+}

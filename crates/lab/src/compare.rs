@@ -3,7 +3,7 @@
 //! against a reference and efficiency 1 / (variance × time). The experiment of
 //! `pathlab compare`.
 
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use glam::Vec3;
 use pathlab_render::film::Film;
 use pathlab_render::image_io::{write_rgb8, ToneMap};
@@ -42,6 +42,34 @@ pub fn strategy(name: &str, max_depth: u32) -> Result<IntegratorKind> {
         samples: 1,
         ..Default::default()
     }))
+}
+
+/// Every strategy `names` lists (at least one), each by [`strategy`].
+pub fn strategies(names: &[String], max_depth: u32) -> Result<Vec<(String, IntegratorKind)>> {
+    if names.is_empty() {
+        bail!("name at least one");
+    }
+    names
+        .iter()
+        .map(|n| Ok((n.trim().to_string(), strategy(n.trim(), max_depth)?)))
+        .collect()
+}
+
+/// The warning when `reference` (read from `path`) seems not to be an image of what the rows
+/// render ([`crate::images::reference_mismatch`] on the render of least variance), at the depth
+/// they render: 1 for direct lighting, `max_depth` when a path strategy is among them.
+pub fn reference_warning(
+    rows: &[Row],
+    reference: &[Vec3],
+    path: &Path,
+    max_depth: u32,
+) -> Option<String> {
+    let best = rows
+        .iter()
+        .min_by(|a, b| a.variance.total_cmp(&b.variance))?;
+    let traces_paths = rows.iter().any(|r| r.name.starts_with("path"));
+    let depth = crate::images::depth_text(if traces_paths { max_depth } else { 1 });
+    crate::images::reference_mismatch(&best.film, reference, path, &depth)
 }
 
 /// One strategy's render and its numbers.

@@ -4,7 +4,7 @@
 //! reference and the fitted order of convergence. The experiment of `pathlab converge`.
 
 use crate::images::film_rmse;
-use crate::plot::RmseCurve;
+use crate::plot::{self, RmseCurve};
 use glam::Vec3;
 use pathlab_mc::estimator::loglog_slope;
 use pathlab_mc::sampler::SamplerKind;
@@ -14,6 +14,7 @@ use pathlab_render::progressive::{render_progressive, StopRule};
 use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
 use serde_json::{json, Value};
+use std::path::Path;
 
 /// What a convergence study found.
 pub struct Study {
@@ -37,6 +38,30 @@ impl Study {
                 "rmse": c.points.iter().map(|p| p.2).collect::<Vec<_>>(),
             }))
             .collect::<Vec<_>>())
+    }
+
+    /// Plots the curves to `path` (PNG or SVG, as `format` says), titled with the scene's and
+    /// the reference's file names and the depth.
+    pub fn write_plot(
+        &self,
+        path: &Path,
+        format: plot::Format,
+        scene: &str,
+        max_depth: u32,
+        reference: &Path,
+    ) -> anyhow::Result<()> {
+        let name = |p: &Path| {
+            p.file_name().map_or_else(
+                || p.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            )
+        };
+        let title = format!(
+            "{}: -m {max_depth}, error against {}",
+            name(Path::new(scene)),
+            name(reference)
+        );
+        plot::rmse_curves(path, format, &title, &self.curves)
     }
 
     /// A line per curve: its fitted order and its error at the most samples.

@@ -5,7 +5,7 @@ use anyhow::{bail, Result};
 use glam::Vec3;
 use pathlab_render::film::Film;
 use pathlab_render::image_io::{read_exr_rgb, read_rgb, write_exr};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The reference image at `path` (a linear EXR), checked to be of `resolution`.
 pub fn read_reference(path: &Path, resolution: [u32; 2]) -> Result<Vec<Vec3>> {
@@ -146,6 +146,12 @@ pub fn reference_mismatch(
 
 /// Two image files of one size compared.
 pub struct FileDifference {
+    /// The image judged.
+    pub a: PathBuf,
+    /// The image it is compared with.
+    pub b: PathBuf,
+    /// Where the difference image was written.
+    pub output: Option<PathBuf>,
     /// Their size.
     pub resolution: [u32; 2],
     /// How they differ.
@@ -180,10 +186,49 @@ pub fn diff_files(a: &Path, b: &Path, output: Option<&Path>) -> Result<FileDiffe
         }
     }
     Ok(FileDifference {
+        a: a.to_path_buf(),
+        b: b.to_path_buf(),
+        output: output.map(Path::to_path_buf),
         resolution: [wa, ha],
         difference: ImageDifference::of(&pa, &pb),
         heat_top,
     })
+}
+
+impl FileDifference {
+    /// The numbers as JSON.
+    pub fn json(&self) -> serde_json::Value {
+        let d = &self.difference;
+        let rgb = |c: Vec3| [c.x, c.y, c.z];
+        serde_json::json!({
+            "a": self.a,
+            "b": self.b,
+            "resolution": self.resolution,
+            "rmse": d.rmse,
+            "relative_mse": d.relative_mse,
+            "max_abs_difference": d.max_abs,
+            "mean_a": rgb(d.mean_a),
+            "mean_b": rgb(d.mean_b),
+            "output": self.output,
+        })
+    }
+
+    /// The numbers as one line of text.
+    pub fn text(&self) -> String {
+        let ([w, h], d) = (self.resolution, &self.difference);
+        let written = self
+            .output
+            .as_ref()
+            .map_or(String::new(), |o| format!("; wrote {}", o.display()));
+        format!(
+            "{w}x{h}: RMSE {:.6}, relative MSE {:.6}, largest difference {:.6}; mean {:.5} vs {:.5}{written}",
+            d.rmse,
+            d.relative_mse,
+            d.max_abs,
+            d.mean_a.element_sum() / 3.0,
+            d.mean_b.element_sum() / 3.0,
+        )
+    }
 }
 
 /// |difference| in luminance as grey levels: black at zero, white at the 99th percentile (the

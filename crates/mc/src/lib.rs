@@ -45,6 +45,7 @@ pub mod distribution;
 pub mod error;
 pub mod estimator;
 pub mod exact;
+pub mod named;
 pub mod quadrature;
 pub mod rng;
 pub mod sampler;

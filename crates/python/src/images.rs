@@ -6,6 +6,7 @@ use numpy::ndarray::Array3;
 use numpy::IntoPyArray;
 use pathlab_render::color::Rgb;
 use pathlab_render::image_io::{encode_rgb8, read_rgb, write_exr, write_rgb8, ToneMap};
+use pathlab_render::limits;
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -69,11 +70,8 @@ fn write(
     image: &Bound<'_, PyAny>,
     exposure: f32,
 ) -> PyResult<()> {
-    if !exposure.is_finite() {
-        return Err(PyValueError::new_err(format!(
-            "exposure {exposure}: must be a finite number of stops"
-        )));
-    }
+    limits::exposure(exposure)
+        .map_err(|e| PyValueError::new_err(format!("exposure {exposure}: {e}")))?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())

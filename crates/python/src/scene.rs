@@ -5,6 +5,7 @@
 use crate::SceneError;
 use pathlab_render::camera::Camera;
 use pathlab_render::desc::SceneDesc;
+use pathlab_render::limits;
 use pathlab_render::scene::Scene as BuiltScene;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -163,32 +164,12 @@ impl Scene {
                 "target" => c.target = vector(&value)?,
                 "up" => c.up = vector(&value)?,
                 "fov" => {
-                    let deg: f32 = value.extract()?;
-                    if !(deg.is_finite() && deg > 0.0 && deg < 180.0) {
-                        return Err(PyValueError::new_err(format!(
-                            "camera['fov'] {deg}: must be an angle between 0 and 180 degrees"
-                        )));
-                    }
-                    c.fov_degrees = deg;
+                    c.fov_degrees = within(&key, value.extract()?, limits::fov_degrees)?;
                     c.focal_pixels = None;
                 }
-                "lens_radius" => {
-                    let r: f32 = value.extract()?;
-                    if !(r.is_finite() && r >= 0.0) {
-                        return Err(PyValueError::new_err(format!(
-                            "camera['lens_radius'] {r}: must be a finite number >= 0"
-                        )));
-                    }
-                    c.lens_radius = r;
-                }
+                "lens_radius" => c.lens_radius = within(&key, value.extract()?, limits::lens_radius)?,
                 "focal_distance" => {
-                    let d: f32 = value.extract()?;
-                    if !(d.is_finite() && d > 0.0) {
-                        return Err(PyValueError::new_err(format!(
-                            "camera['focal_distance'] {d}: must be a positive distance"
-                        )));
-                    }
-                    c.focal_distance = d;
+                    c.focal_distance = within(&key, value.extract()?, limits::focal_distance)?
                 }
                 other => {
                     return Err(PyValueError::new_err(format!(
@@ -253,12 +234,14 @@ impl Scene {
 
 /// A `(width, height)` of 1 to 16384 pixels each.
 pub fn checked_resolution((w, h): (i64, i64)) -> PyResult<[u32; 2]> {
-    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
-        return Err(PyValueError::new_err(format!(
-            "resolution ({w}, {h}): width and height must be between 1 and 16384"
-        )));
-    }
-    Ok([w as u32, h as u32])
+    let side = |n: i64| u32::try_from(n).unwrap_or(0);
+    limits::resolution([side(w), side(h)])
+        .map_err(|e| PyValueError::new_err(format!("resolution ({w}, {h}): {e}")))
+}
+
+/// A camera value by its rule in [`limits`], or a `ValueError` naming its key.
+fn within(key: &str, value: f32, rule: fn(f32) -> Result<f32, limits::Expected>) -> PyResult<f32> {
+    rule(value).map_err(|e| PyValueError::new_err(format!("camera['{key}'] {value}: {e}")))
 }
 
 fn finite(v: &[f32], key: &str) -> PyResult<()> {

@@ -221,6 +221,14 @@ def test_scenes_that_cannot_be_read_raise_scene_errors(tmp_path):
         scene.camera = {"zoom": 2}
     with pytest.raises(ValueError, match="between 1 and 16384"):
         scene.resolution = (-4, 4)
+    with pytest.raises(ValueError, match=r"camera\['fov'\] 200: must be an angle"):
+        scene.camera = {"fov": 200.0}
+    with pytest.raises(ValueError, match=r"camera\['lens_radius'\] -1: must be"):
+        scene.camera = {"lens_radius": -1.0}
+    with pytest.raises(ValueError, match=r"camera\['focal_distance'\] 0: must be"):
+        scene.camera = {"focal_distance": 0.0}
+    with pytest.raises(ValueError, match="exposure NaN: must be a finite"):
+        pathlab.write(tmp_path / "x.png", np.zeros((2, 2, 3), dtype=np.float32), exposure=float("nan"))
 
 
 def test_images_are_read_and_written(tmp_path):

@@ -196,6 +196,17 @@ pub enum ToneMap {
 }
 
 impl ToneMap {
+    /// Both tone maps.
+    pub const ALL: [ToneMap; 2] = [ToneMap::Srgb, ToneMap::Cs184];
+
+    /// The name used on command lines.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMap::Srgb => "srgb",
+            ToneMap::Cs184 => "cs184",
+        }
+    }
+
     /// The encoded value in [0, 1] of a linear value, after `scale` (2^exposure).
     #[inline]
     pub fn encode(self, v: f32, scale: f32) -> f32 {
@@ -209,6 +220,13 @@ impl ToneMap {
                 .powf(1.0 / 2.2)
                 .min(1.0),
         }
+    }
+}
+
+impl std::str::FromStr for ToneMap {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        pathlab_mc::named::by_name(s, &ToneMap::ALL, ToneMap::name, "tone map")
     }
 }
 

@@ -51,6 +51,7 @@ pub mod geometry;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
+pub mod limits;
 /// Environment maps (in [`light`]), by their old path.
 pub use light::envmap;
 pub mod progressive;

@@ -1,11 +1,13 @@
 //! `pathlab render`'s flags, and their checks before anything is loaded.
 
+use crate::flags::{self, within, SceneArgs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use pathlab_lab::render::{ProgressiveStop, RenderRequest, SceneEdits, Shard};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::image_io::ToneMap;
 use pathlab_render::integrator::{DirectStrategy, IntegratorChoice, PathLighting};
+use pathlab_render::limits;
 use pathlab_render::render::{Adaptive, AdaptiveRule};
 use std::path::PathBuf;
 
@@ -24,24 +26,6 @@ pub enum RuleName {
     Neyman,
 }
 
-/// PNG tone maps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ToneMapName {
-    /// Exposure, clamp, sRGB transfer function.
-    Srgb,
-    /// The CS184 course's renderer: clamp((√2 c)^(1/2.2)), √2 being half a stop up.
-    Cs184,
-}
-
-impl From<ToneMapName> for ToneMap {
-    fn from(name: ToneMapName) -> ToneMap {
-        match name {
-            ToneMapName::Srgb => ToneMap::Srgb,
-            ToneMapName::Cs184 => ToneMap::Cs184,
-        }
-    }
-}
-
 /// Extra outputs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Aov {
@@ -49,17 +33,6 @@ pub enum Aov {
     Variance,
     /// Samples per pixel.
     Samples,
-}
-
-/// `--lighting` values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum LightingName {
-    /// Light sampling and BSDF sampling with MIS.
-    Mis,
-    /// BSDF sampling only.
-    Bsdf,
-    /// Light sampling only.
-    Light,
 }
 
 /// `--fresnel` values.
@@ -74,11 +47,8 @@ pub enum FresnelName {
 /// Raw command-line arguments of `pathlab render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The scene: a file (.xml Mitsuba 3, .pbrt pbrt-v4, .dae the course's COLLADA, .obj, .ply,
-    /// .gltf, .glb) or
-    /// a built-in scene's name (cornell-box).
-    #[arg(default_value = "cornell-box")]
-    pub scene: String,
+    #[command(flatten)]
+    pub scene: SceneArgs,
     /// Samples per pixel (default: the scene file's, else 64).
     #[arg(short = 's', long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
@@ -101,11 +71,6 @@ pub struct RenderArgs {
     /// Worker threads (0: all cores).
     #[arg(short = 't', long, default_value_t = 0, allow_negative_numbers = true, value_parser = threads_arg)]
     pub threads: usize,
-    /// Image size in pixels (default: the scene's). The view is scaled to fit, except for the
-    /// course's .dae scenes, whose camera keeps the course viewer's pixel scale: a smaller
-    /// size shows a centred crop, a larger one more around it (use --scale to resize those).
-    #[arg(short = 'r', long, num_args = 2, value_names = ["W", "H"], allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub resolution: Option<Vec<u32>>,
     /// The scene's own view at F times its resolution (any format; the .dae scenes' way to
     /// change their size without cropping).
     #[arg(long, value_name = "F", allow_negative_numbers = true)]
@@ -159,15 +124,11 @@ pub struct RenderArgs {
     /// nodes visited per camera ray). Default: the one the scene file names, else path.
     #[arg(long)]
     pub integrator: Option<IntegratorName>,
-    /// A scene parameter, NAME=VALUE, for the `$NAME` references of a Mitsuba scene (its
-    /// `<default>`s give the others). Repeat for several.
-    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
-    pub define: Vec<String>,
     /// How the path tracer finds light at each vertex: mis (light and BSDF sampling combined),
     /// bsdf (BSDF sampling only) or light (light sampling only). Default: mis. Path tracer
     /// only.
-    #[arg(long, value_enum)]
-    pub lighting: Option<LightingName>,
+    #[arg(long)]
+    pub lighting: Option<PathLighting>,
     /// Light the scene with this environment map (equirectangular .exr, .hdr, .png or .jpg, in
     /// Mitsuba's convention), in place of the scene's own environment.
     #[arg(short = 'e', long, value_name = "FILE")]
@@ -204,8 +165,8 @@ pub struct RenderArgs {
     pub exposure: f32,
     /// PNG encoding: srgb (exposure, clamp, the sRGB curve), or cs184 (the course's renderer:
     /// radiance times √2, which is half a stop up, then gamma 2.2 and clamp).
-    #[arg(long, value_enum, default_value_t = ToneMapName::Srgb)]
-    pub tonemap: ToneMapName,
+    #[arg(long, default_value = "srgb")]
+    pub tonemap: ToneMap,
     /// Extra outputs, comma-separated: variance, samples (EXR channels, or files next to a PNG).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub aov: Vec<Aov>,
@@ -251,21 +212,6 @@ fn threads_arg(text: &str) -> std::result::Result<usize, String> {
         .map_err(|_| format!("'{text}' is not a number of threads (0 for all cores, 1, 2, ...)"))
 }
 
-/// [`parse_max_depth`] as a clap value parser.
-pub fn parse_depth_arg(text: &str) -> std::result::Result<u32, String> {
-    parse_max_depth(text).map_err(|e| e.to_string())
-}
-
-/// A `--max-depth` value: a number of bounces or `inf` (also `-1`).
-pub fn parse_max_depth(text: &str) -> Result<u32> {
-    if text.eq_ignore_ascii_case("inf") || text == "-1" {
-        return Ok(u32::MAX);
-    }
-    text.parse::<u32>().with_context(|| {
-        format!("--max-depth {text}: expected a number of bounces (0, 1, 2, ...) or inf")
-    })
-}
-
 fn parse_adaptive(values: &[String], rule: Option<RuleName>) -> Result<Adaptive> {
     let batch = match values.first() {
         Some(b) => b.parse::<u32>().ok().filter(|&b| b > 0).with_context(|| {
@@ -296,15 +242,9 @@ fn parse_adaptive(values: &[String], rule: Option<RuleName>) -> Result<Adaptive>
     })
 }
 
-/// Flags that contradict each other or a value no image can show: an error, before anything
-/// is loaded; flags that the chosen integrator does not read: a warning each (returned).
+/// Flags that contradict each other: an error, before anything is loaded; flags that the
+/// chosen integrator does not read: a warning each (returned).
 fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>> {
-    if !args.exposure.is_finite() {
-        bail!(
-            "--exposure {}: must be a finite number of stops",
-            args.exposure
-        );
-    }
     if let (Some(k), Some(m)) = (args.only_bounce, cli_depth) {
         if k > m {
             bail!("--only-bounce {k} is beyond --max-depth {m}: the image would be black");
@@ -348,26 +288,14 @@ pub(super) struct Checked {
 /// Checks every flag that needs no scene (an error names the flag and what was expected),
 /// and makes the request of them.
 pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
-    let cli_depth = args.max_depth.as_deref().map(parse_max_depth).transpose()?;
+    let cli_depth = args
+        .max_depth
+        .as_deref()
+        .map(flags::max_depth)
+        .transpose()?;
     let warnings = check_flags(args, cli_depth)?;
-    check_view(args)?;
-    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
-        bail!(
-            "--checkpoint-every {}: must be a number of seconds >= 0",
-            args.checkpoint_every
-        );
-    }
-    let params = parse_defines(&args.define)?;
-    if let Some(e) = args.target_error {
-        if !(e.is_finite() && e > 0.0) {
-            bail!("--target-error {e}: must be a positive number such as 0.02");
-        }
-    }
-    if let Some(t) = args.time {
-        if !(t.is_finite() && t > 0.0) {
-            bail!("--time {t}: must be a positive number of seconds");
-        }
-    }
+    check_values(args)?;
+    let params = args.scene.params()?;
     let progressive =
         (args.target_error.is_some() || args.time.is_some()).then_some(ProgressiveStop {
             target_error: args.target_error,
@@ -395,14 +323,14 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
         bail!("--checkpoint and --resume: the course and neyman adaptive rules decide on every sample a pixel has drawn, which a film does not keep; use the default two-stage rule");
     }
     let request = RenderRequest {
-        scene: args.scene.clone(),
+        scene: args.scene.name.clone(),
         params,
         edits: SceneEdits {
             lens_radius: args.lens_radius,
             focal_distance: args.focal_distance,
             envmap: args.envmap.clone().map(|e| (e, args.envmap_scale)),
             schlick_fresnel: args.fresnel == FresnelName::Schlick,
-            resolution: crate::image_size(&args.resolution),
+            resolution: args.scene.size(),
             scale: args.scale,
             fov: args.fov,
         },
@@ -415,11 +343,7 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
             rr_depth: args.rr_depth,
             only_bounce: args.only_bounce,
             light_samples: args.light_samples,
-            lighting: match args.lighting.unwrap_or(LightingName::Mis) {
-                LightingName::Mis => PathLighting::Mis,
-                LightingName::Bsdf => PathLighting::Bsdf,
-                LightingName::Light => PathLighting::Light,
-            },
+            lighting: args.lighting.unwrap_or_default(),
             direct: args.direct,
         },
         neyman: adaptive.is_some() && args.adaptive_rule == Some(RuleName::Neyman),
@@ -432,18 +356,17 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
     Ok(Checked { request, warnings })
 }
 
-/// The camera's and the environment's flags: values no scene could take.
-fn check_view(args: &RenderArgs) -> Result<()> {
-    if let Some(b) = args.lens_radius.filter(|b| !(b.is_finite() && *b >= 0.0)) {
-        bail!("--lens-radius {b}: must be a finite number >= 0");
-    }
-    if let Some(d) = args.focal_distance.filter(|d| !(d.is_finite() && *d > 0.0)) {
-        bail!("--focal-distance {d}: must be a positive distance");
-    }
-    let scale = args.envmap_scale;
-    if args.envmap.is_some() && !(scale.is_finite() && scale >= 0.0) {
-        bail!("--envmap-scale {scale}: must be a number >= 0");
-    }
+/// Values no scene could take, each by its rule in [`limits`].
+fn check_values(args: &RenderArgs) -> Result<()> {
+    within("--exposure", Some(args.exposure), limits::exposure)?;
+    within("--lens-radius", args.lens_radius, limits::lens_radius)?;
+    within(
+        "--focal-distance",
+        args.focal_distance,
+        limits::focal_distance,
+    )?;
+    let envmap_scale = args.envmap.as_ref().map(|_| args.envmap_scale);
+    within("--envmap-scale", envmap_scale, limits::radiance_scale)?;
     if let Some(c) = args
         .crop
         .as_deref()
@@ -457,15 +380,12 @@ fn check_view(args: &RenderArgs) -> Result<()> {
             c[3]
         );
     }
-    if let Some(f) = args.scale.filter(|f| !(f.is_finite() && *f > 0.0)) {
-        bail!("--scale {f}: must be a positive factor such as 0.5 or 2");
-    }
-    if let Some(deg) = args
-        .fov
-        .filter(|d| !(d.is_finite() && *d > 0.0 && *d < 180.0))
-    {
-        bail!("--fov {deg}: must be an angle between 0 and 180 degrees");
-    }
+    within("--scale", args.scale, limits::image_scale)?;
+    within("--fov", args.fov, limits::fov_degrees)?;
+    within("--target-error", args.target_error, limits::target_error)?;
+    within("--time", args.time, limits::render_seconds)?;
+    let every = Some(args.checkpoint_every);
+    within("--checkpoint-every", every, limits::checkpoint_seconds)?;
     Ok(())
 }
 
@@ -476,15 +396,4 @@ fn parse_shard(text: &str) -> Result<Shard> {
         .and_then(|(a, b)| Some((a.trim().parse::<u64>().ok()?, b.trim().parse::<u64>().ok()?)))
         .with_context(|| format!("--shard {text}: expected I/N, such as 0/4"))?;
     Ok(Shard { index, count })
-}
-
-/// `-D NAME=VALUE` scene parameters.
-pub fn parse_defines(define: &[String]) -> Result<Vec<(String, String)>> {
-    define
-        .iter()
-        .map(|d| match d.split_once('=') {
-            Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.to_string())),
-            _ => bail!("-D {d}: expected NAME=VALUE"),
-        })
-        .collect()
 }

@@ -10,7 +10,7 @@ mod args;
 mod outputs;
 mod report;
 
-pub use args::{parse_defines, parse_depth_arg, RenderArgs, ToneMapName};
+pub use args::RenderArgs;
 
 use anyhow::{Context, Result};
 use args::{Aov, IntegratorName};
@@ -70,7 +70,7 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
     let options = ImageOptions {
         variance: args.aov.contains(&Aov::Variance),
         samples: args.aov.contains(&Aov::Samples),
-        tonemap: args.tonemap.into(),
+        tonemap: args.tonemap,
         exposure: args.exposure,
     };
     let written = write_all(
@@ -86,7 +86,7 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
     report::summary(
         args,
         &Summary {
-            scene: &args.scene,
+            scene: &args.scene.name,
             outputs: &outputs,
             plan: &plan,
             film,
@@ -150,9 +150,10 @@ fn render(plan: &Plan, args: &RenderArgs, cancel: &AtomicBool) -> Result<JobOutc
 /// when nothing listens there.
 fn connect_display(args: &RenderArgs, film: &Film) -> Option<TevDisplay> {
     let addr = args.display.as_deref()?;
-    let name = std::path::Path::new(&args.scene)
+    let scene = &args.scene.name;
+    let name = std::path::Path::new(scene)
         .file_name()
-        .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
+        .map_or_else(|| scene.clone(), |n| n.to_string_lossy().into_owned());
     let layers = Layers {
         variance: args.aov.contains(&Aov::Variance),
         samples: args.aov.contains(&Aov::Samples),

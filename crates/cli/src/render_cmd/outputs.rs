@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 /// checkpoint's.
 pub(super) fn checked_outputs(args: &RenderArgs) -> Result<(Vec<PathBuf>, Vec<OutputFormat>)> {
     let outputs = if args.output.is_empty() {
-        let stem = Path::new(&args.scene)
+        let stem = Path::new(&args.scene.name)
             .file_stem()
             .and_then(|s| s.to_str())
             .unwrap_or("render");

@@ -6,7 +6,7 @@
 
 mod report;
 
-pub use report::IntegrateReport;
+pub use report::{convergence_plot, IntegrateReport};
 
 use crate::expr::{Expression, MAX_DIMS};
 use crate::plot::{fitted_slope, ConvergencePoint, ConvergenceSeries};

@@ -6,6 +6,24 @@ use super::{Convergence, Integral, IntegralRun};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_mc::stats::z_test;
 use serde_json::{json, Value};
+use std::path::Path;
+
+/// The convergence study of the three samplers ([`super::convergence`]), plotted to `path`
+/// (PNG or SVG by its extension), as the JSON of `pathlab integrate --json`.
+pub fn convergence_plot(
+    problem: &Integral,
+    n: u32,
+    reps: u32,
+    seed: u64,
+    exact: Option<f64>,
+    path: &Path,
+) -> anyhow::Result<Value> {
+    let format = crate::plot::Format::from_path(path)?;
+    let study = super::convergence(problem, n, reps, seed, exact);
+    let title = format!("∫ {} over {}", problem.f.text(), problem.domain_text());
+    crate::plot::convergence(path, format, &title, &study.series, exact, exact.is_some())?;
+    Ok(study.json(reps, exact.is_some()))
+}
 
 /// An integration as it was asked for and what it found.
 pub struct IntegrateReport<'a> {

@@ -2,15 +2,13 @@
 //! view or another field of view, a thin lens, an environment map, Schlick's Fresnel on glass.
 //!
 //! Values that need no scene to be judged (a negative lens radius, a field of view of 200°)
-//! are the caller's to refuse before loading; what depends on the scene (an orthographic
+//! are the caller's to refuse before loading, by [`pathlab_render::limits`]; what depends on the scene (an orthographic
 //! camera has no field of view; a scale that makes the image too large) is refused here.
 
 use anyhow::{bail, Result};
 use pathlab_render::desc::{FovAxis, FresnelModel, MaterialDesc, Projection, SceneDesc};
+use pathlab_render::limits::{self, MAX_IMAGE_SIDE};
 use std::path::PathBuf;
-
-/// Largest width or height of an image, in pixels.
-pub const MAX_IMAGE_SIDE: u32 = 16384;
 
 /// What changes in the scene before it is built.
 #[derive(Clone, Debug, Default)]
@@ -63,11 +61,8 @@ impl SceneEdits {
 /// Gives the scene another image size, checked.
 pub fn apply_resolution(desc: &mut SceneDesc, resolution: Option<[u32; 2]>) -> Result<()> {
     if let Some([w, h]) = resolution {
-        let side = 1..=MAX_IMAGE_SIDE;
-        if !side.contains(&w) || !side.contains(&h) {
-            bail!("--resolution {w} {h}: width and height must be between 1 and {MAX_IMAGE_SIDE}");
-        }
-        desc.resolution = [w, h];
+        desc.resolution =
+            limits::resolution([w, h]).map_err(|e| anyhow::anyhow!("--resolution {w} {h}: {e}"))?;
     }
     Ok(())
 }

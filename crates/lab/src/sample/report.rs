@@ -4,8 +4,24 @@
 use super::{verdict, SampleReport};
 use pathlab_mc::sampler::SamplerKind;
 use serde_json::{json, Value};
+use std::path::Path;
 
 impl SampleReport {
+    /// Plots the samples against the pdf to `path` (PNG or SVG, as `format` says), when the
+    /// run kept the plot's data.
+    pub fn write_plot(&self, path: &Path, format: crate::plot::Format) -> anyhow::Result<()> {
+        if let Some(p) = &self.plot {
+            let title = format!(
+                "{} ({} samples, {})",
+                self.description,
+                self.samples,
+                self.sampler.name()
+            );
+            crate::plot::samples(path, format, &title, p)?;
+        }
+        Ok(())
+    }
+
     /// Samples drawn per second.
     fn rate(&self) -> f64 {
         self.samples as f64 / self.seconds.max(1e-9)

@@ -113,12 +113,7 @@ impl SamplerKind {
 impl std::str::FromStr for SamplerKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        SamplerKind::ALL
-            .into_iter()
-            .find(|k| k.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| {
-                format!("unknown sampler '{s}' (expected independent, stratified or sobol)")
-            })
+        crate::named::by_name(s, &SamplerKind::ALL, SamplerKind::name, "sampler")
     }
 }
 

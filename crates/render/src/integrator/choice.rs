@@ -7,6 +7,7 @@ use super::{
     PathLighting,
 };
 use crate::desc::{IntegratorHint, RenderHints};
+use pathlab_mc::named::by_name;
 
 /// The integrators by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,14 +53,7 @@ impl IntegratorName {
 impl std::str::FromStr for IntegratorName {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        IntegratorName::ALL
-            .into_iter()
-            .find(|k| k.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| {
-                format!(
-                    "unknown integrator '{s}' (expected path, bdpt, direct, normals, depth or bvh)"
-                )
-            })
+        by_name(s, &IntegratorName::ALL, IntegratorName::name, "integrator")
     }
 }
 

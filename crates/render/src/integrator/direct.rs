@@ -8,6 +8,7 @@ use crate::geometry::Frame;
 use crate::geometry::{spawn_ray, Ray};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::{Vec2, Vec3};
+use pathlab_mc::named::by_name;
 use pathlab_mc::sampler::{AnySampler, Sampler};
 use pathlab_mc::warp::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere,
@@ -50,10 +51,8 @@ impl DirectStrategy {
 impl std::str::FromStr for DirectStrategy {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        DirectStrategy::ALL
-            .into_iter()
-            .find(|k| k.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown direct-lighting strategy '{s}' (expected hemisphere, cosine, light or mis)"))
+        let what = "direct-lighting strategy";
+        by_name(s, &DirectStrategy::ALL, DirectStrategy::name, what)
     }
 }
 
@@ -272,14 +271,8 @@ impl SampleStrategy {
 impl std::str::FromStr for SampleStrategy {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        SampleStrategy::ALL
-            .into_iter()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| {
-                format!(
-                    "unknown sampling strategy '{s}' (expected hemisphere, cosine, bsdf or light)"
-                )
-            })
+        let what = "sampling strategy";
+        by_name(s, &SampleStrategy::ALL, SampleStrategy::name, what)
     }
 }
 

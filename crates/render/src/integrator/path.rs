@@ -57,6 +57,28 @@ pub enum PathLighting {
     Light,
 }
 
+impl PathLighting {
+    /// Every way, MIS first.
+    pub const ALL: [PathLighting; 3] = [PathLighting::Mis, PathLighting::Bsdf, PathLighting::Light];
+
+    /// The name used on command lines.
+    pub fn name(self) -> &'static str {
+        match self {
+            PathLighting::Mis => "mis",
+            PathLighting::Bsdf => "bsdf",
+            PathLighting::Light => "light",
+        }
+    }
+}
+
+impl std::str::FromStr for PathLighting {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let what = "lighting";
+        pathlab_mc::named::by_name(s, &PathLighting::ALL, PathLighting::name, what)
+    }
+}
+
 impl Default for PathIntegrator {
     fn default() -> Self {
         PathIntegrator {
