@@ -14,6 +14,7 @@ cases=(
     "default|-r 96 96 -s 32"
     "independent|-r 96 96 -s 32 --sampler independent"
     "direct-hemisphere|-r 96 96 -s 16 --integrator direct --direct hemisphere"
+    "path-bsdf-only|-r 64 64 -s 16 --lighting bsdf"
     "adaptive-two-stage|-r 64 64 -a -s 256"
     "adaptive-course|-r 64 64 -a -s 256 --adaptive-rule course"
     "adaptive-neyman|-r 64 64 -a -s 256 --adaptive-rule neyman"
