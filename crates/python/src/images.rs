@@ -55,23 +55,31 @@ fn pixels(array: &Bound<'_, PyAny>) -> PyResult<(u32, u32, Vec<Rgb>)> {
     Ok((w as u32, h as u32, px))
 }
 
-/// 8-bit sRGB bytes of linear pixels scaled by 2^`exposure`.
-fn srgb_bytes(px: &[Rgb], exposure: f32) -> Vec<u8> {
-    encode_rgb8(px, exposure, ToneMap::Srgb)
+/// How linear values become 8-bit ones: 2^`exposure`, then the tone map `tonemap` names
+/// (`"srgb"` or `"cs184"`, as `pathlab render --tonemap`), checked.
+fn encoding(exposure: f32, tonemap: &str) -> PyResult<(f32, ToneMap)> {
+    limits::exposure(exposure)
+        .map_err(|e| PyValueError::new_err(format!("exposure {exposure}: {e}")))?;
+    let tonemap = tonemap
+        .parse::<ToneMap>()
+        .map_err(|e| PyValueError::new_err(format!("tonemap: {e}")))?;
+    Ok((exposure, tonemap))
 }
 
 /// Write an image of linear values, shape (H, W, 3) or (H, W): OpenEXR (float32, exact) for a
-/// `.exr` path, an 8-bit sRGB PNG after scaling by 2^exposure for `.png`.
+/// `.exr` path; for `.png`, 8-bit values after scaling by 2^exposure, by the tone map
+/// `tonemap` names: "srgb" (clamp, the sRGB curve) or "cs184" (the course's renderer: times
+/// √2, gamma 2.2, clamp).
 #[pyfunction]
-#[pyo3(signature = (path, image, exposure=0.0))]
+#[pyo3(signature = (path, image, exposure=0.0, tonemap="srgb"))]
 fn write(
     py: Python<'_>,
     path: std::path::PathBuf,
     image: &Bound<'_, PyAny>,
     exposure: f32,
+    tonemap: &str,
 ) -> PyResult<()> {
-    limits::exposure(exposure)
-        .map_err(|e| PyValueError::new_err(format!("exposure {exposure}: {e}")))?;
+    let (exposure, tonemap) = encoding(exposure, tonemap)?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -91,23 +99,26 @@ fn write(
         if exr {
             write_exr(&path, w, h, &px, &[])
         } else {
-            write_rgb8(&path, w, h, &srgb_bytes(&px, exposure))
+            write_rgb8(&path, w, h, &encode_rgb8(&px, exposure, tonemap))
         }
     })
     .map_err(|e| PyOSError::new_err(e.to_string()))
 }
 
-/// The image (linear values, (H, W, 3) or (H, W)) as the bytes of an 8-bit sRGB PNG file,
-/// after scaling by 2^exposure: what a notebook shows.
+/// The image (linear values, (H, W, 3) or (H, W)) as the bytes of an 8-bit PNG file, after
+/// scaling by 2^exposure and the tone map `tonemap` names (as [`write`]): what a notebook
+/// shows.
 #[pyfunction]
-#[pyo3(signature = (image, exposure=0.0))]
+#[pyo3(signature = (image, exposure=0.0, tonemap="srgb"))]
 fn png_bytes<'py>(
     py: Python<'py>,
     image: &Bound<'py, PyAny>,
     exposure: f32,
+    tonemap: &str,
 ) -> PyResult<Bound<'py, PyBytes>> {
+    let (exposure, tonemap) = encoding(exposure, tonemap)?;
     let (w, h, px) = pixels(image)?;
-    let bytes = srgb_bytes(&px, exposure);
+    let bytes = encode_rgb8(&px, exposure, tonemap);
     let mut out = std::io::Cursor::new(Vec::new());
     image::write_buffer_with_format(
         &mut out,

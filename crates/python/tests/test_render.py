@@ -243,6 +243,18 @@ def test_images_are_read_and_written(tmp_path):
     assert np.allclose(back[..., 0], grey, atol=0.01)
     png = pathlab.Image._repr_png_(image.view(pathlab.Image))
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    # The course's tone map, as `pathlab render --tonemap cs184`: 0.5 becomes (√2 · 0.5)^(1/2.2)
+    # in 8 bits, which reads back through the sRGB curve.
+    half = np.full((2, 2), 0.5)
+    pathlab.write(tmp_path / "c.png", half, tonemap="cs184")
+    byte = round(255 * (np.sqrt(2) * 0.5) ** (1 / 2.2)) / 255
+    srgb_decoded = ((byte + 0.055) / 1.055) ** 2.4
+    assert np.allclose(pathlab.read(tmp_path / "c.png"), srgb_decoded, atol=1e-3)
+    assert pathlab.png_bytes(half, tonemap="cs184") == (tmp_path / "c.png").read_bytes()
+    with pytest.raises(ValueError, match="unknown tone map 'aces'"):
+        pathlab.write(tmp_path / "c.png", half, tonemap="aces")
+    with pytest.raises(ValueError, match="exposure inf"):
+        pathlab.png_bytes(half, exposure=float("inf"))
     with pytest.raises(ValueError, match="unknown image format"):
         pathlab.write(tmp_path / "a.tiff", image)
     with pytest.raises(ValueError, match="shape"):

@@ -79,11 +79,19 @@ def render(
 def read(path: Union[str, PathLike]) -> Image:
     """An image (EXR, PNG, JPEG, HDR, BMP) as float32 (H, W, 3) linear values."""
 
-def write(path: Union[str, PathLike], image: ArrayLike, exposure: float = 0.0) -> None:
-    """Write (H, W, 3) or (H, W) linear values: OpenEXR for .exr, else sRGB PNG."""
+def write(
+    path: Union[str, PathLike],
+    image: ArrayLike,
+    exposure: float = 0.0,
+    tonemap: Literal["srgb", "cs184"] = "srgb",
+) -> None:
+    """Write (H, W, 3) or (H, W) linear values: OpenEXR for .exr, else an 8-bit PNG after
+    2^exposure and the tone map (srgb, or cs184: the course's renderer's)."""
 
-def png_bytes(image: ArrayLike, exposure: float = 0.0) -> bytes:
-    """The image as the bytes of an sRGB PNG file."""
+def png_bytes(
+    image: ArrayLike, exposure: float = 0.0, tonemap: Literal["srgb", "cs184"] = "srgb"
+) -> bytes:
+    """The image as the bytes of an 8-bit PNG file (exposure and tone map as write's)."""
 
 def uniform_points(n: int, dims: int, sampler: SamplerName = ..., seed: int = ...) -> F64:
     """n points (n, dims) of [0, 1)^dims from the sampler: point i is its sample i."""
