@@ -140,6 +140,30 @@ impl Film {
         }
     }
 
+    /// An empty film, or an error saying how much memory it needs when that cannot be had
+    /// (where [`Film::new`] would abort the program).
+    pub fn try_new(width: u32, height: u32) -> Result<Self, String> {
+        let n = width as usize * height as usize;
+        let mut pixels = Vec::new();
+        pixels.try_reserve_exact(n).map_err(|_| {
+            let gib = (n as f64 * std::mem::size_of::<PixelStats>() as f64) / (1u64 << 30) as f64;
+            format!(
+                "a {width}x{height} film needs {gib:.1} GiB of memory ({} bytes a pixel: each \
+                 pixel's exact sums), which cannot be allocated here; render a smaller \
+                 image (-r or --scale)",
+                std::mem::size_of::<PixelStats>()
+            )
+        })?;
+        pixels.resize(n, PixelStats::default());
+        Ok(Film {
+            width,
+            height,
+            pixels,
+            splats: Vec::new(),
+            light_paths: 0,
+        })
+    }
+
     /// Adds radiance splatted on pixel (x, y) by a light path.
     pub fn add_splat(&mut self, x: u32, y: u32, v: Rgb) {
         if self.splats.is_empty() {

@@ -101,7 +101,10 @@ pub struct TileDone<'a> {
     pub pixels: &'a [PixelStats],
 }
 
-struct TileResult {
+/// Radiance that light traced to the lens brings to a film position (pixels).
+type Splat = (glam::Vec2, crate::desc::Rgb);
+
+pub(crate) struct TileResult {
     x0: u32,
     y0: u32,
     w: u32,
@@ -111,7 +114,7 @@ struct TileResult {
     nonfinite: u64,
     pilot: u64,
     /// Radiance that light traced to the lens brought to film positions (pixels).
-    splats: Vec<(glam::Vec2, crate::desc::Rgb)>,
+    splats: Vec<Splat>,
     /// Light paths traced for them.
     light_paths: u64,
 }
@@ -300,19 +303,60 @@ impl<'a> Frame<'a> {
         (w, h, out)
     }
 
-    /// Adds each tile's samples to the film and its counts to the statistics.
-    fn merge(film: &mut Film, stats: &mut RenderStats, results: Vec<TileResult>) {
-        for t in &results {
-            for (i, p) in t.pixels.iter().enumerate() {
-                let (x, y) = (t.x0 + i as u32 % t.w, t.y0 + i as u32 / t.w);
-                film.pixel_mut(x, y).merge(p);
-            }
-            stats.samples += t.samples;
-            stats.nonfinite_samples += t.nonfinite;
-            stats.pilot_samples += t.pilot;
-            stats.rays += t.path.rays;
-            stats.nodes_visited += t.path.nodes_visited;
+    /// Adds a tile's samples to the film and its counts to the statistics.
+    fn merge_tile(film: &mut Film, stats: &mut RenderStats, t: &TileResult) {
+        for (i, p) in t.pixels.iter().enumerate() {
+            let (x, y) = (t.x0 + i as u32 % t.w, t.y0 + i as u32 / t.w);
+            film.pixel_mut(x, y).merge(p);
         }
+        stats.samples += t.samples;
+        stats.nonfinite_samples += t.nonfinite;
+        stats.pilot_samples += t.pilot;
+        stats.rays += t.path.rays;
+        stats.nodes_visited += t.path.nodes_visited;
+    }
+
+    /// Runs `tile` on every tile on the thread pool and returns what each gives besides its
+    /// samples, in tile order. `tile(x0, y0, held)` is given the sample counts its pixels hold
+    /// as it starts (row-major; only this tile adds to them). Each tile's samples go into
+    /// `film` (its counts into `stats`) as soon as it is done, so a pass holds a tile per
+    /// thread besides the film, not a second film; the film's sums are exact, so the order in
+    /// which tiles finish does not change them. Light traced to the lens lands anywhere: the
+    /// tiles' splats are added at the end, in tile order.
+    pub(crate) fn run_tiles<R: Send>(
+        &self,
+        film: &mut Film,
+        stats: &mut RenderStats,
+        tile: impl Fn(u32, u32, &[u64]) -> (TileResult, R) + Sync,
+    ) -> Vec<R> {
+        let shared = std::sync::Mutex::new((film, stats));
+        let lock = || shared.lock().unwrap_or_else(|e| e.into_inner());
+        let done: Vec<(Vec<Splat>, u64, R)> = self
+            .tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                let w = TILE_SIZE.min(self.window[2] - x0);
+                let h = TILE_SIZE.min(self.window[3] - y0);
+                let held: Vec<u64> = {
+                    let g = lock();
+                    (0..w * h)
+                        .map(|k| g.0.pixel(x0 + k % w, y0 + k / w).count())
+                        .collect()
+                };
+                let (t, extra) = tile(x0, y0, &held);
+                let mut g = lock();
+                let (film, stats) = &mut *g;
+                Self::merge_tile(film, stats, &t);
+                (t.splats, t.light_paths, extra)
+            })
+            .collect();
+        let (film, _) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
+        done.into_iter()
+            .map(|(splats, light_paths, extra)| {
+                self.add_splats(film, &splats, light_paths);
+                extra
+            })
+            .collect()
     }
 
     /// One whole-frame pass: pixel `[x, y]` holding `held` samples takes the sample indices
@@ -329,85 +373,76 @@ impl<'a> Frame<'a> {
     ) {
         let first = self.settings.sample_range.map_or(0, |r| r[0]);
         let splatting = self.integrator.splats(self.scene);
-        let film_now = &*film;
-        let results: Vec<TileResult> = self
-            .tiles
-            .par_iter()
-            .map(|&(x0, y0)| {
-                let (w, h, mut out) = self.new_tile(x0, y0);
-                let mut sampler = self
-                    .settings
-                    .sampler
-                    .build(self.settings.spp, self.settings.seed);
-                // The tile's pixels one after another, each from the samples it holds to its
-                // end, so that an integrator following several paths at once keeps them all
-                // busy to the tile's end.
-                let mut samples = (0..w * h).flat_map(|tag| {
-                    let pixel = [x0 + tag % w, y0 + tag / w];
-                    let held = film_now.pixel(pixel[0], pixel[1]).count();
-                    let to = end(pixel[0], pixel[1], held);
-                    let from = (first as u64 + held).min(to as u64) as u32;
-                    (from..to)
-                        .take_while(|_| !cancel.load(Ordering::Relaxed))
-                        .map(move |index| SampleRef { pixel, index, tag })
-                });
-                let (mut ok, mut bad) = (0, 0);
-                let pixels = &mut out.pixels;
-                if splatting {
-                    // One sample after another, each tracing light to the lens too.
-                    for s in &mut samples {
-                        let (ray, weight) = camera_ray(self.scene, &mut sampler, s);
-                        let l = self.integrator.li_splat(
-                            self.scene,
-                            ray,
-                            &mut sampler,
-                            &mut out.path,
-                            &mut |x, v| out.splats.push((x, v)),
-                        );
-                        add_sample(&mut pixels[s.tag as usize], l * weight, &mut ok, &mut bad);
-                        out.light_paths += 1;
-                    }
-                } else {
-                    self.integrator.li_samples(
+        self.run_tiles(film, stats, |x0, y0, held| {
+            let (w, h, mut out) = self.new_tile(x0, y0);
+            let mut sampler = self
+                .settings
+                .sampler
+                .build(self.settings.spp, self.settings.seed);
+            // The tile's pixels one after another, each from the samples it holds to its
+            // end, so that an integrator following several paths at once keeps them all
+            // busy to the tile's end.
+            let mut samples = (0..w * h).flat_map(|tag| {
+                let pixel = [x0 + tag % w, y0 + tag / w];
+                let held = held[tag as usize];
+                let to = end(pixel[0], pixel[1], held);
+                let from = (first as u64 + held).min(to as u64) as u32;
+                (from..to)
+                    .take_while(|_| !cancel.load(Ordering::Relaxed))
+                    .map(move |index| SampleRef { pixel, index, tag })
+            });
+            let (mut ok, mut bad) = (0, 0);
+            let pixels = &mut out.pixels;
+            if splatting {
+                // One sample after another, each tracing light to the lens too.
+                for s in &mut samples {
+                    let (ray, weight) = camera_ray(self.scene, &mut sampler, s);
+                    let l = self.integrator.li_splat(
                         self.scene,
+                        ray,
                         &mut sampler,
-                        &mut samples,
-                        &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
                         &mut out.path,
+                        &mut |x, v| out.splats.push((x, v)),
                     );
+                    add_sample(&mut pixels[s.tag as usize], l * weight, &mut ok, &mut bad);
+                    out.light_paths += 1;
                 }
-                out.samples += ok;
-                out.nonfinite += bad;
-                progress(&TileDone {
-                    samples: ok + bad,
-                    x0,
-                    y0,
-                    w,
-                    pixels: &out.pixels,
-                });
-                out
-            })
-            .collect();
-        self.add_splats(film, &results);
-        Self::merge(film, stats, results);
+            } else {
+                self.integrator.li_samples(
+                    self.scene,
+                    &mut sampler,
+                    &mut samples,
+                    &mut |tag, l| add_sample(&mut pixels[tag as usize], l, &mut ok, &mut bad),
+                    &mut out.path,
+                );
+            }
+            out.samples += ok;
+            out.nonfinite += bad;
+            progress(&TileDone {
+                samples: ok + bad,
+                x0,
+                y0,
+                w,
+                pixels: &out.pixels,
+            });
+            (out, ())
+        });
     }
 
-    /// Adds the tiles' splats to the pixels of the window the filter gives them (exact sums:
-    /// the same in any order), and counts their light paths.
-    fn add_splats(&self, film: &mut Film, results: &[TileResult]) {
+    /// Adds a tile's splats to the pixels of the window the filter gives them (exact sums:
+    /// the same in any order), and counts its light paths.
+    fn add_splats(&self, film: &mut Film, splats: &[Splat], light_paths: u64) {
         let mut weights = Vec::new();
-        for t in results {
-            film.add_light_paths(t.light_paths);
-            for &(x, v) in &t.splats {
-                if !v.is_finite() {
-                    continue;
-                }
-                self.scene
-                    .camera()
-                    .splat_weights(x, self.window, &mut weights);
-                for &([px, py], w) in &weights {
-                    film.add_splat(px, py, v * w);
-                }
+        film.add_light_paths(light_paths);
+        for &(x, v) in splats {
+            if !v.is_finite() {
+                continue;
+            }
+            self.scene
+                .camera()
+                .splat_weights(x, self.window, &mut weights);
+            for &([px, py], w) in &weights {
+                film.add_splat(px, py, v * w);
             }
         }
     }

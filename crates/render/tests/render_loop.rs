@@ -9,6 +9,7 @@ use glam::{DVec3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::desc::{MeshDesc, SceneDesc};
 use pathlab_render::film::Film;
+use pathlab_render::integrator::{BdptIntegrator, IntegratorKind};
 use pathlab_render::render::{render, RenderSettings};
 use pathlab_render::scene::Scene;
 
@@ -327,4 +328,63 @@ fn one_pixels_sample_values_are_the_samples_its_film_pixel_sums() {
         );
         assert_eq!(later, values[20..]);
     }
+}
+
+#[test]
+fn adaptive_and_light_tracing_renders_are_the_same_for_any_thread_count() {
+    // Tiles add their samples to the film as each finishes, in whatever order the threads
+    // finish them, and the adaptive rules read the film between rounds: the film's exact sums
+    // keep the image the same. Light traced to the lens (bidirectional) lands on any tile.
+    use pathlab_render::render::{Adaptive, AdaptiveRule};
+    let scene = Scene::build(&big_light()).unwrap();
+    let mut cases: Vec<(String, IntegratorKind, RenderSettings)> = [
+        AdaptiveRule::TwoStage,
+        AdaptiveRule::Course,
+        AdaptiveRule::Neyman {
+            image_luminance: 0.5,
+        },
+    ]
+    .into_iter()
+    .map(|rule| {
+        let adaptive = Adaptive {
+            batch: 4,
+            min_samples: 8,
+            rule,
+            ..Adaptive::DEFAULT
+        };
+        let settings = RenderSettings {
+            adaptive: Some(adaptive),
+            ..RenderSettings::new(32, 5, SamplerKind::Independent)
+        };
+        (format!("adaptive {rule:?}"), path(u32::MAX), settings)
+    })
+    .collect();
+    let bdpt = IntegratorKind::Bdpt(BdptIntegrator::default());
+    let settings = RenderSettings::new(4, 5, SamplerKind::Independent);
+    cases.push(("bidirectional".to_string(), bdpt, settings));
+    for (name, integrator, settings) in &cases {
+        let with = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| render(&scene, integrator, settings, &|_| {}, &Default::default()).0)
+        };
+        let one = with(1);
+        assert!(
+            one == with(2) && one == with(3),
+            "{name}: the image depends on the thread count"
+        );
+        if matches!(integrator, IntegratorKind::Bdpt(_)) {
+            assert!(one.light_paths() > 0, "no light reached the lens");
+        }
+    }
+}
+
+#[test]
+fn a_film_too_large_to_allocate_is_an_error_that_says_its_size() {
+    assert!(Film::try_new(24, 16).unwrap() == Film::new(24, 16));
+    // 2^40 pixels: more memory than any machine has.
+    let e = Film::try_new(1 << 20, 1 << 20).err().unwrap();
+    assert!(e.contains("1048576x1048576") && e.contains("GiB"), "{e}");
 }

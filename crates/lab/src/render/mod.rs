@@ -199,7 +199,7 @@ impl Plan {
             Some(path) => resumed_film(path, &self.header),
             None => {
                 let [w, h] = self.resolution;
-                Ok(Film::new(w, h))
+                Film::try_new(w, h).map_err(anyhow::Error::msg)
             }
         }
     }

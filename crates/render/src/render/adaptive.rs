@@ -173,32 +173,25 @@ pub(super) fn render_adaptive(
     let two_stage = adaptive.rule == AdaptiveRule::TwoStage;
     let start = Instant::now();
     if two_stage {
-        let plans = pilot_plans(frame, adaptive, batch, progress, cancel);
-        let mut results = Vec::with_capacity(plans.len());
-        for (t, plan) in plans {
+        for (x0, y0, w, plan) in pilot_plans(frame, adaptive, batch, film, stats, progress, cancel)
+        {
             for (k, &n) in plan.iter().enumerate() {
-                let (x, y) = (t.x0 + k as u32 % t.w, t.y0 + k as u32 / t.w);
-                target[index(x, y)] = n;
+                target[index(x0 + k as u32 % w, y0 + k as u32 / w)] = n;
             }
-            results.push(t);
         }
-        Frame::merge(film, stats, results);
     }
     while !cancel.load(Ordering::Relaxed) {
-        let rounds = adaptive_round(frame, batch, film, &target, progress, cancel);
+        let rounds = adaptive_round(frame, batch, film, stats, &target, progress, cancel);
         let mut worked = false;
-        let mut results = Vec::with_capacity(rounds.len());
-        for (t, tile_fixed) in rounds {
-            for (k, p) in t.pixels.iter().enumerate() {
-                if p.count() > 0 {
+        for (x0, y0, w, tile_fixed) in rounds {
+            for (k, f) in tile_fixed.iter().enumerate() {
+                // Pixels that took samples this round.
+                if let Some(f) = f {
                     worked = true;
-                    let (x, y) = (t.x0 + k as u32 % t.w, t.y0 + k as u32 / t.w);
-                    fixed[index(x, y)] &= tile_fixed[k];
+                    fixed[index(x0 + k as u32 % w, y0 + k as u32 / w)] &= f;
                 }
             }
-            results.push(t);
         }
-        Frame::merge(film, stats, results);
         if !worked {
             break;
         }
@@ -224,49 +217,47 @@ fn pilot_plans(
     frame: &Frame,
     adaptive: Adaptive,
     batch: u32,
+    film: &mut Film,
+    stats: &mut RenderStats,
     progress: &(dyn Fn(&TileDone) + Sync),
     cancel: &AtomicBool,
-) -> Vec<(TileResult, Vec<u32>)> {
+) -> Vec<(u32, u32, u32, Vec<u32>)> {
     let settings = frame.settings;
-    frame
-        .tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let (w, h, mut out) = frame.new_tile(x0, y0);
-            let seed = settings.seed ^ Adaptive::PILOT_STREAM;
-            let mut pilot_sampler = settings.sampler.build(batch, seed);
-            let mut plan = vec![0u32; (w * h) as usize];
-            for k in 0..w * h {
-                if cancel.load(Ordering::Relaxed) {
-                    break;
-                }
-                let pixel = [x0 + k % w, y0 + k / w];
-                let mut pilot = PixelStats::default();
-                let before = out.path.random_vertices;
-                let (ok, bad) = sample_pixel(
-                    frame.scene,
-                    frame.integrator,
-                    &mut pilot_sampler,
-                    pixel,
-                    0..batch,
-                    &mut pilot,
-                    &mut out.path,
-                );
-                out.pilot += ok + bad;
-                let deterministic = out.path.random_vertices == before;
-                plan[k as usize] =
-                    adaptive.planned_samples(&pilot.luminance(), deterministic, settings.spp);
+    frame.run_tiles(film, stats, |x0, y0, _| {
+        let (w, h, mut out) = frame.new_tile(x0, y0);
+        let seed = settings.seed ^ Adaptive::PILOT_STREAM;
+        let mut pilot_sampler = settings.sampler.build(batch, seed);
+        let mut plan = vec![0u32; (w * h) as usize];
+        for k in 0..w * h {
+            if cancel.load(Ordering::Relaxed) {
+                break;
             }
-            progress(&TileDone {
-                samples: out.pilot,
-                x0,
-                y0,
-                w,
-                pixels: &[],
-            });
-            (out, plan)
-        })
-        .collect()
+            let pixel = [x0 + k % w, y0 + k / w];
+            let mut pilot = PixelStats::default();
+            let before = out.path.random_vertices;
+            let (ok, bad) = sample_pixel(
+                frame.scene,
+                frame.integrator,
+                &mut pilot_sampler,
+                pixel,
+                0..batch,
+                &mut pilot,
+                &mut out.path,
+            );
+            out.pilot += ok + bad;
+            let deterministic = out.path.random_vertices == before;
+            plan[k as usize] =
+                adaptive.planned_samples(&pilot.luminance(), deterministic, settings.spp);
+        }
+        progress(&TileDone {
+            samples: out.pilot,
+            x0,
+            y0,
+            w,
+            pixels: &[],
+        });
+        (out, (x0, y0, w, plan))
+    })
 }
 
 /// One adaptive round: every pixel below its `target` count takes up to `batch` more samples;
@@ -274,53 +265,53 @@ fn pilot_plans(
 fn adaptive_round(
     frame: &Frame,
     batch: u32,
-    film: &Film,
+    film: &mut Film,
+    stats: &mut RenderStats,
     target: &[u32],
     progress: &(dyn Fn(&TileDone) + Sync),
     cancel: &AtomicBool,
-) -> Vec<(TileResult, Vec<bool>)> {
+) -> Vec<(u32, u32, u32, Vec<Option<bool>>)> {
     let settings = frame.settings;
     let width = film.width();
     let index = |x: u32, y: u32| (y * width + x) as usize;
-    frame
-        .tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let (w, h, mut out) = frame.new_tile(x0, y0);
-            let mut sampler = settings.sampler.build(settings.spp, settings.seed);
-            let mut tile_fixed = vec![true; (w * h) as usize];
-            for k in 0..w * h {
-                if cancel.load(Ordering::Relaxed) {
-                    break;
-                }
-                let (x, y) = (x0 + k % w, y0 + k / w);
-                let held = film.pixel(x, y).count() as u32;
-                let end = held.saturating_add(batch).min(target[index(x, y)]);
-                if held >= end {
-                    continue;
-                }
-                let before = out.path.random_vertices;
-                let (ok, bad) = sample_pixel(
-                    frame.scene,
-                    frame.integrator,
-                    &mut sampler,
-                    [x, y],
-                    held..end,
-                    &mut out.pixels[k as usize],
-                    &mut out.path,
-                );
-                out.samples += ok;
-                out.nonfinite += bad;
-                tile_fixed[k as usize] = out.path.random_vertices == before;
+    frame.run_tiles(film, stats, |x0, y0, held| {
+        let (w, h, mut out) = frame.new_tile(x0, y0);
+        let mut sampler = settings.sampler.build(settings.spp, settings.seed);
+        let mut tile_fixed = vec![None; (w * h) as usize];
+        for k in 0..w * h {
+            if cancel.load(Ordering::Relaxed) {
+                break;
             }
-            progress(&TileDone {
-                samples: out.samples + out.nonfinite,
-                x0,
-                y0,
-                w,
-                pixels: &out.pixels,
-            });
-            (out, tile_fixed)
-        })
-        .collect()
+            let (x, y) = (x0 + k % w, y0 + k / w);
+            let held = held[k as usize] as u32;
+            let end = held.saturating_add(batch).min(target[index(x, y)]);
+            if held >= end {
+                continue;
+            }
+            let before = out.path.random_vertices;
+            let (ok, bad) = sample_pixel(
+                frame.scene,
+                frame.integrator,
+                &mut sampler,
+                [x, y],
+                held..end,
+                &mut out.pixels[k as usize],
+                &mut out.path,
+            );
+            out.samples += ok;
+            out.nonfinite += bad;
+            // As the film counts them: finite samples.
+            if ok > 0 {
+                tile_fixed[k as usize] = Some(out.path.random_vertices == before);
+            }
+        }
+        progress(&TileDone {
+            samples: out.samples + out.nonfinite,
+            x0,
+            y0,
+            w,
+            pixels: &out.pixels,
+        });
+        (out, (x0, y0, w, tile_fixed))
+    })
 }
