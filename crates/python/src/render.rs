@@ -14,7 +14,7 @@ use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::desc::RenderHints;
 use pathlab_render::film::Film;
 use pathlab_render::integrator::{
-    DirectStrategy, IntegratorChoice, IntegratorKind, IntegratorName,
+    DirectStrategy, IntegratorChoice, IntegratorKind, IntegratorName, PathLighting,
 };
 use pathlab_render::render::{render as render_scene, RenderSettings, RenderStats};
 use pathlab_render::scene::Scene as BuiltScene;
@@ -65,14 +65,21 @@ struct Request {
     aovs: Vec<(String, Aov)>,
 }
 
+/// The estimator's names as `render` takes them: the integrator, the direct-lighting
+/// strategy and the path tracer's lighting.
+struct Names<'a> {
+    integrator: Option<&'a str>,
+    direct: Option<&'a str>,
+    lighting: Option<&'a str>,
+}
+
 #[allow(clippy::too_many_arguments)]
 fn request(
     scene: &Scene,
     spp: Option<i64>,
     seed: u64,
     max_depth: Option<i64>,
-    integrator: Option<&str>,
-    direct: Option<&str>,
+    names: Names<'_>,
     sampler: Option<&str>,
     resolution: Option<(i64, i64)>,
     threads: i64,
@@ -92,12 +99,19 @@ fn request(
         Some(d) => Some(d.min(u32::MAX as i64 - 1) as u32),
         None => None,
     };
-    let name = integrator
+    let name = names
+        .integrator
         .map(|s| s.parse::<IntegratorName>())
         .transpose()
         .map_err(value_error)?;
-    let direct = direct
+    let direct = names
+        .direct
         .map(|s| s.parse::<DirectStrategy>())
+        .transpose()
+        .map_err(value_error)?;
+    let lighting = names
+        .lighting
+        .map(|s| s.parse::<PathLighting>())
         .transpose()
         .map_err(value_error)?;
     if direct.is_some() && name != Some(IntegratorName::Direct) {
@@ -109,9 +123,16 @@ fn request(
         name,
         max_depth,
         direct,
+        lighting: lighting.unwrap_or_default(),
         ..Default::default()
     };
     let (name, integrator) = choice.integrator(hints);
+    if lighting.is_some() && name != IntegratorName::Path {
+        return Err(PyValueError::new_err(format!(
+            "lighting: the path tracer's way of finding light; this render uses integrator=\"{}\"",
+            name.name()
+        )));
+    }
     let sampler = match sampler {
         Some(s) => s.parse::<SamplerKind>().map_err(value_error)?,
         None => hints.sampler_or_default(false),
@@ -160,7 +181,7 @@ fn request(
 /// Render a scene to a float32 array (H, W, 3) of linear radiance, or with `aovs` a dict of
 /// arrays; see `pathlab.render` for the arguments.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, sampler=None, resolution=None, threads=0, aovs=Vec::new()))]
+#[pyo3(signature = (scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, lighting=None, sampler=None, resolution=None, threads=0, aovs=Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
@@ -170,15 +191,21 @@ fn render<'py>(
     max_depth: Option<i64>,
     integrator: Option<&str>,
     direct: Option<&str>,
+    lighting: Option<&str>,
     sampler: Option<&str>,
     resolution: Option<(i64, i64)>,
     threads: i64,
     aovs: Vec<String>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let names = Names {
+        integrator,
+        direct,
+        lighting,
+    };
     let req = {
         let s = scene.borrow();
         request(
-            &s, spp, seed, max_depth, integrator, direct, sampler, resolution, threads, aovs,
+            &s, spp, seed, max_depth, names, sampler, resolution, threads, aovs,
         )?
     };
     let built = scene.borrow_mut().built_at(py, req.resolution)?;

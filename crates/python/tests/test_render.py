@@ -132,6 +132,24 @@ def test_direct_lighting_strategies_differ_in_variance_not_in_mean():
     assert v_l < v_h / 4, stats
 
 
+def test_the_path_tracers_ways_of_finding_light_differ_in_variance_not_in_mean():
+    scene = pathlab.load("cornell-box")
+    stats = {}
+    for lighting in ("mis", "bsdf", "light"):
+        out = pathlab.render(scene, spp=16, seed=7, max_depth=2, lighting=lighting,
+                             sampler="independent", resolution=(48, 48), aovs=("variance",))
+        n = 48 * 48
+        stats[lighting] = (out["image"].astype(np.float64).mean(),
+                           np.sqrt(out["variance"].astype(np.float64).sum() / 3) / n,
+                           out["variance"].mean())
+    m_mis, se_mis, v_mis = stats["mis"]
+    for other in ("bsdf", "light"):
+        m, se, _ = stats[other]
+        assert abs(m - m_mis) < 4 * np.hypot(se, se_mis), stats
+    # The box's light is small: BSDF sampling alone rarely finds it.
+    assert stats["bsdf"][2] > 2 * v_mis, stats
+
+
 def test_the_bidirectional_path_tracer_agrees_with_the_path_tracer():
     # Light traced to the lens lands on other pixels, so the standard error of the image mean
     # comes from independent renders (seeds).
@@ -198,6 +216,8 @@ def test_ctrl_c_stops_a_render_within_a_second():
         ({"aovs": ("depth",)}, "unknown output 'depth'"),
         ({"aovs": ("bounce:4",), "max_depth": 3}, "beyond the largest bounce 3"),
         ({"aovs": ("bounce:1",), "integrator": "direct"}, "needs the path tracer"),
+        ({"lighting": "nee"}, "unknown lighting 'nee' (expected mis, bsdf or light)"),
+        ({"lighting": "bsdf", "integrator": "direct"}, 'this render uses integrator="direct"'),
     ],
 )
 def test_bad_render_arguments_raise_value_errors(kwargs, message):

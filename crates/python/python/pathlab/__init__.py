@@ -81,8 +81,8 @@ def _image(array):
     return array.view(Image)
 
 
-def render(scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, sampler=None,
-           resolution=None, threads=0, aovs=()):
+def render(scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, lighting=None,
+           sampler=None, resolution=None, threads=0, aovs=()):
     """Render ``scene`` and return its linear radiance as a float32 array (H, W, 3).
 
     Arguments left as ``None`` take the scene file's setting, then pathlab's default:
@@ -96,6 +96,9 @@ def render(scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None
       ``"depth"``, ``"bvh"``;
     - ``direct``: with ``integrator="direct"``, the strategy ``"hemisphere"``, ``"cosine"``,
       ``"light"`` or ``"mis"`` (default);
+    - ``lighting``: how the path tracer finds light at each vertex: ``"mis"`` (light and BSDF
+      sampling combined, default), ``"bsdf"`` (BSDF sampling only) or ``"light"`` (light
+      sampling only);
     - ``sampler``: ``"independent"``, ``"stratified"`` or ``"sobol"`` (the file's, else sobol);
     - ``resolution``: ``(width, height)`` for this render (else ``scene.resolution``);
     - ``threads``: worker threads (0: every core);
@@ -109,7 +112,8 @@ def render(scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None
     fraction of a second and raises.
     """
     out = _pathlab.render(scene, spp=spp, seed=seed, max_depth=max_depth, integrator=integrator,
-                          direct=direct, sampler=sampler, resolution=resolution, threads=threads,
+                          direct=direct, lighting=lighting, sampler=sampler,
+                          resolution=resolution, threads=threads,
                           aovs=[aovs] if isinstance(aovs, str) else list(aovs))
     if isinstance(out, dict):
         return {k: (_image(v) if k == "image" or k.startswith("bounce:") else v)

@@ -49,6 +49,7 @@ def load(source: Union[str, PathLike], **params: object) -> Scene:
 IntegratorName = Literal["path", "bdpt", "direct", "normals", "depth", "bvh"]
 DirectName = Literal["hemisphere", "cosine", "light", "mis"]
 SamplerName = Literal["independent", "stratified", "sobol"]
+LightingName = Literal["mis", "bsdf", "light"]
 
 @overload
 def render(
@@ -58,6 +59,7 @@ def render(
     max_depth: Optional[int] = ...,
     integrator: Optional[IntegratorName] = ...,
     direct: Optional[DirectName] = ...,
+    lighting: Optional[LightingName] = ...,
     sampler: Optional[SamplerName] = ...,
     resolution: Optional[Tuple[int, int]] = ...,
     threads: int = ...,
@@ -71,6 +73,7 @@ def render(
     max_depth: Optional[int] = ...,
     integrator: Optional[IntegratorName] = ...,
     direct: Optional[DirectName] = ...,
+    lighting: Optional[LightingName] = ...,
     sampler: Optional[SamplerName] = ...,
     resolution: Optional[Tuple[int, int]] = ...,
     threads: int = ...,
