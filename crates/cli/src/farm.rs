@@ -1,7 +1,7 @@
 //! Renders that survive and scale: shards of a render, stopping on signals, and
 //! `pathlab merge` (a render's identity and checkpoints are [`pathlab_lab::job`]'s).
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
 use pathlab_render::{film_file, limits};
 use std::path::PathBuf;
@@ -51,17 +51,25 @@ pub struct MergeArgs {
 /// then adds them (exactly: the result is the single render's film to the bit).
 pub fn run_merge(args: &MergeArgs) -> Result<()> {
     crate::flags::within("--exposure", Some(args.exposure), limits::exposure)?;
-    let mut parts = Vec::new();
+    // A part at a time: the merge holds the sum and the part being added.
+    let mut merged: Option<film_file::Merge> = None;
     for p in &args.parts {
         let (h, film) = film_file::read(p)?;
-        parts.push((p.display().to_string(), h, film));
+        let name = p.display().to_string();
+        match &mut merged {
+            None => {
+                merged = Some(film_file::Merge::new(name, h, film).map_err(anyhow::Error::msg)?)
+            }
+            Some(m) => m.add(name, h, film).map_err(anyhow::Error::msg)?,
+        }
     }
-    let (header, film) = film_file::merge(&parts).map_err(anyhow::Error::msg)?;
+    let merged = merged.context("no parts to merge")?;
+    let (header, film) = merged.finish().map_err(anyhow::Error::msg)?;
     let (first, [w, h]) = (&header, header.resolution);
     pathlab_lab::outputs::write_film_image(&film, &args.output, &header, args.exposure)?;
     eprintln!(
         "merged {} parts ({} spp, {}x{}); wrote {}",
-        parts.len(),
+        args.parts.len(),
         first.spp,
         w,
         h,

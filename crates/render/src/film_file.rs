@@ -264,72 +264,111 @@ pub fn parse(bytes: &[u8]) -> Result<(FilmHeader, Film), String> {
 /// `parts` are (name for messages, header, film). The sums are exact, so the result is the
 /// single render's film to the bit; its header is the first part's with the whole range. An
 /// error says which part differs, which is incomplete, and which samples are missing or
-/// covered twice.
-pub fn merge(parts: &[(String, FilmHeader, Film)]) -> Result<(FilmHeader, Film), String> {
-    let Some((first_name, first, _)) = parts.first() else {
+/// covered twice. [`Merge`] does the same a part at a time.
+pub fn merge(
+    parts: impl IntoIterator<Item = (String, FilmHeader, Film)>,
+) -> Result<(FilmHeader, Film), String> {
+    let mut parts = parts.into_iter();
+    let Some((name, header, film)) = parts.next() else {
         return Err("no parts to merge".to_string());
     };
-    for (name, h, _) in &parts[1..] {
+    let mut merged = Merge::new(name, header, film)?;
+    for (name, header, film) in parts {
+        merged.add(name, header, film)?;
+    }
+    merged.finish()
+}
+
+/// [`merge`] one part at a time, so that a merge holds the sum and the part being added, not
+/// every part at once: [`Merge::new`] with the first part, [`Merge::add`] for each other as it
+/// is read, [`Merge::finish`] for the whole render's film once all are in.
+pub struct Merge {
+    first_name: String,
+    first: FilmHeader,
+    film: Film,
+    /// Each part's sample range and name.
+    ranges: Vec<(u32, u32, String)>,
+}
+
+impl Merge {
+    /// The sum of one part, checked whole.
+    pub fn new(name: String, header: FilmHeader, film: Film) -> Result<Merge, String> {
+        check_whole(&name, &header, &film)?;
+        Ok(Merge {
+            ranges: vec![(header.range[0], header.range[1], name.clone())],
+            first_name: name,
+            first: header,
+            film,
+        })
+    }
+
+    /// Adds a part, checked to be of the same render as the first and whole.
+    pub fn add(&mut self, name: String, h: FilmHeader, film: Film) -> Result<(), String> {
+        let first = &self.first;
         if h.key != first.key
             || h.resolution != first.resolution
             || h.seed != first.seed
             || h.spp != first.spp
         {
             return Err(format!(
-                "{name}: not a part of the same render as {first_name} ({} vs {})",
-                h.description, first.description
+                "{name}: not a part of the same render as {} ({} vs {})",
+                self.first_name, h.description, first.description
             ));
         }
-    }
-    for (name, h, film) in parts {
-        let want = (h.range[1] - h.range[0]) as u64;
-        if let Some(px) = film.pixels().iter().find(|px| px.count() != want) {
-            return Err(format!(
-                "{name}: incomplete (a pixel holds {} of its {want} samples); render it again",
-                px.count()
-            ));
-        }
-    }
-    let mut ranges: Vec<(u32, u32, &str)> = parts
-        .iter()
-        .map(|(name, h, _)| (h.range[0], h.range[1], name.as_str()))
-        .collect();
-    ranges.sort();
-    let mut problems = Vec::new();
-    let (mut at, mut last) = (0u32, "");
-    for &(a, b, name) in &ranges {
-        if a > at {
-            problems.push(format!("samples {at}..{a} are missing"));
-        } else if a < at {
-            problems.push(format!(
-                "{name} overlaps {last} (samples {a}..{})",
-                at.min(b)
-            ));
-        }
-        at = at.max(b);
-        last = name;
-    }
-    if at < first.spp {
-        problems.push(format!("samples {at}..{} are missing", first.spp));
-    }
-    if !problems.is_empty() {
-        return Err(format!(
-            "the parts do not cover the render's {} samples once: {}",
-            first.spp,
-            problems.join("; ")
-        ));
-    }
-    let [w, h] = first.resolution;
-    let mut film = Film::new(w, h);
-    for (_, _, f) in parts {
-        for (a, b) in film.pixels_mut().iter_mut().zip(f.pixels()) {
+        check_whole(&name, &h, &film)?;
+        for (a, b) in self.film.pixels_mut().iter_mut().zip(film.pixels()) {
             a.merge(b);
         }
-        film.merge_splats(f);
+        self.film.merge_splats(&film);
+        self.ranges.push((h.range[0], h.range[1], name));
+        Ok(())
     }
-    let mut header = first.clone();
-    header.range = [0, first.spp];
-    Ok((header, film))
+
+    /// The whole render's header and film, once the parts' ranges are checked to cover its
+    /// samples once.
+    pub fn finish(mut self) -> Result<(FilmHeader, Film), String> {
+        self.ranges.sort();
+        let mut problems = Vec::new();
+        let (mut at, mut last) = (0u32, "");
+        for (a, b, name) in &self.ranges {
+            let (a, b) = (*a, *b);
+            if a > at {
+                problems.push(format!("samples {at}..{a} are missing"));
+            } else if a < at {
+                problems.push(format!(
+                    "{name} overlaps {last} (samples {a}..{})",
+                    at.min(b)
+                ));
+            }
+            at = at.max(b);
+            last = name;
+        }
+        let spp = self.first.spp;
+        if at < spp {
+            problems.push(format!("samples {at}..{spp} are missing"));
+        }
+        if !problems.is_empty() {
+            return Err(format!(
+                "the parts do not cover the render's {spp} samples once: {}",
+                problems.join("; ")
+            ));
+        }
+        let mut header = self.first;
+        header.range = [0, spp];
+        Ok((header, self.film))
+    }
+}
+
+/// An error unless every pixel of a part holds its range's samples.
+fn check_whole(name: &str, h: &FilmHeader, film: &Film) -> Result<(), String> {
+    let want = (h.range[1] - h.range[0]) as u64;
+    match film.pixels().iter().find(|px| px.count() != want) {
+        Some(px) => Err(format!(
+            "{name}: incomplete (a pixel holds {} of its {want} samples); render it again",
+            px.count()
+        )),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
@@ -377,5 +416,51 @@ mod tests {
         b[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
         assert!(parse(&b).unwrap_err().contains("header of"));
         let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// A part of [`header`]'s render holding samples `range` of every pixel (values that
+    /// differ by pixel and sample).
+    fn part(range: [u32; 2]) -> (FilmHeader, Film) {
+        let mut film = Film::new(3, 2);
+        for (i, p) in film.pixels_mut().iter_mut().enumerate() {
+            for k in range[0]..range[1] {
+                p.add(glam::Vec3::new(0.1 * k as f32, i as f32, 1.0));
+            }
+        }
+        let h = FilmHeader {
+            range,
+            ..header()
+        };
+        (h, film)
+    }
+
+    #[test]
+    fn merging_a_part_at_a_time_checks_each_part_and_gives_the_whole_render() {
+        let named = |name: &str, range| {
+            let (h, f) = part(range);
+            (name.to_string(), h, f)
+        };
+        let (whole_header, whole) = part([0, 16]);
+        let (h, merged) =
+            merge([named("a", [0, 5]), named("b", [5, 12]), named("c", [12, 16])]).unwrap();
+        assert_eq!((h, merged), (whole_header.clone(), whole.clone()));
+        // In any order.
+        let (_, merged) =
+            merge([named("c", [12, 16]), named("a", [0, 5]), named("b", [5, 12])]).unwrap();
+        assert_eq!(merged, whole);
+        // A part missing, twice, of another render, or not whole.
+        let e = merge([named("a", [0, 5]), named("c", [12, 16])]).unwrap_err();
+        assert!(e.contains("samples 5..12 are missing"), "{e}");
+        let e = merge([named("a", [0, 12]), named("b", [5, 16])]).unwrap_err();
+        assert!(e.contains("b overlaps a (samples 5..12)"), "{e}");
+        let (mut other, f) = part([5, 16]);
+        other.seed += 1;
+        let e = merge([named("a", [0, 5]), ("o".to_string(), other, f)]).unwrap_err();
+        assert!(e.contains("o: not a part of the same render as a"), "{e}");
+        let (h, mut f) = part([5, 16]);
+        f.pixels_mut()[4] = crate::film::PixelStats::default();
+        let e = merge([named("a", [0, 5]), ("short".to_string(), h, f)]).unwrap_err();
+        assert!(e.contains("short: incomplete (a pixel holds 0 of its 11 samples)"), "{e}");
+        assert!(merge(std::iter::empty()).unwrap_err().contains("no parts"));
     }
 }

@@ -246,7 +246,7 @@ fn light_traced_to_the_lens_survives_shards_and_film_files_to_the_bit() {
             (path.display().to_string(), header, read)
         })
         .collect();
-    let (_, merged) = film_file::merge(&parts).unwrap();
+    let (_, merged) = film_file::merge(parts).unwrap();
     assert_eq!(merged, whole);
     std::fs::remove_dir_all(&dir).ok();
 }
