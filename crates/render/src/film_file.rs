@@ -66,12 +66,46 @@ pub enum FilmFileError {
 
 /// 64-bit FNV-1a.
 pub fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    fnv1a_more(FNV_OFFSET, bytes)
+}
+
+/// FNV-1a's starting value.
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// FNV-1a of what hashed to `h` followed by `bytes`: `fnv1a(a ++ b) == fnv1a_more(fnv1a(a), b)`.
+fn fnv1a_more(mut h: u64, bytes: &[u8]) -> u64 {
     for &b in bytes {
         h ^= b as u64;
         h = h.wrapping_mul(0x0100_0000_01b3);
     }
     h
+}
+
+/// A file written through a buffer of bounded size, hashing what passes through it.
+struct HashedFile {
+    file: std::fs::File,
+    buf: Vec<u8>,
+    hash: u64,
+}
+
+impl HashedFile {
+    /// Bytes gathered before they are hashed and written.
+    const CHUNK: usize = 1 << 16;
+
+    /// Hashes and writes what the buffer holds once it is a chunk or more.
+    fn maybe_flush(&mut self) -> std::io::Result<()> {
+        if self.buf.len() >= Self::CHUNK {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.hash = fnv1a_more(self.hash, &self.buf);
+        self.file.write_all(&self.buf)?;
+        self.buf.clear();
+        Ok(())
+    }
 }
 
 impl FilmHeader {
@@ -128,35 +162,39 @@ pub fn write(path: &Path, header: &FilmHeader, film: &Film) -> Result<(), FilmFi
         message: e.to_string(),
     };
     let text = header.to_text();
-    let mut bytes = Vec::with_capacity(32 + text.len() + film.pixels().len() * PIXEL_BYTES);
-    bytes.extend(MAGIC);
-    bytes.extend((text.len() as u32).to_le_bytes());
-    bytes.extend(text.as_bytes());
-    bytes.extend((film.pixels().len() as u64).to_le_bytes());
+    let mut tmp_name = path.as_os_str().to_owned();
+    tmp_name.push(".tmp");
+    let tmp = std::path::PathBuf::from(tmp_name);
+    // Written a chunk at a time (a film's bytes are as large as the film), hashed on the way.
+    let mut out = HashedFile {
+        file: std::fs::File::create(&tmp).map_err(io)?,
+        buf: Vec::with_capacity(HashedFile::CHUNK + PIXEL_BYTES),
+        hash: FNV_OFFSET,
+    };
+    out.buf.extend(MAGIC);
+    out.buf.extend((text.len() as u32).to_le_bytes());
+    out.buf.extend(text.as_bytes());
+    out.buf.extend((film.pixels().len() as u64).to_le_bytes());
     for p in film.pixels() {
-        p.to_bytes(&mut bytes);
+        p.to_bytes(&mut out.buf);
+        out.maybe_flush().map_err(io)?;
     }
     // Light traced to the lens, when there is any: the light paths, then each pixel's sums.
     if film.light_paths() > 0 {
-        bytes.extend(film.light_paths().to_le_bytes());
+        out.buf.extend(film.light_paths().to_le_bytes());
         let zero = [[0i128; 3]];
         let sums = film.splat_sums();
         for s in (0..film.pixels().len()).map(|i| sums.get(i).unwrap_or(&zero[0])) {
             for v in s {
-                bytes.extend(v.to_le_bytes());
+                out.buf.extend(v.to_le_bytes());
             }
+            out.maybe_flush().map_err(io)?;
         }
     }
-    let hash = fnv1a(&bytes);
-    bytes.extend(hash.to_le_bytes());
-    let mut tmp_name = path.as_os_str().to_owned();
-    tmp_name.push(".tmp");
-    let tmp = std::path::PathBuf::from(tmp_name);
-    {
-        let mut f = std::fs::File::create(&tmp).map_err(io)?;
-        f.write_all(&bytes).map_err(io)?;
-        f.sync_all().map_err(io)?;
-    }
+    out.flush().map_err(io)?;
+    out.file.write_all(&out.hash.to_le_bytes()).map_err(io)?;
+    out.file.sync_all().map_err(io)?;
+    drop(out);
     std::fs::rename(&tmp, path).map_err(io)
 }
 
@@ -427,10 +465,7 @@ mod tests {
                 p.add(glam::Vec3::new(0.1 * k as f32, i as f32, 1.0));
             }
         }
-        let h = FilmHeader {
-            range,
-            ..header()
-        };
+        let h = FilmHeader { range, ..header() };
         (h, film)
     }
 
@@ -441,12 +476,20 @@ mod tests {
             (name.to_string(), h, f)
         };
         let (whole_header, whole) = part([0, 16]);
-        let (h, merged) =
-            merge([named("a", [0, 5]), named("b", [5, 12]), named("c", [12, 16])]).unwrap();
+        let (h, merged) = merge([
+            named("a", [0, 5]),
+            named("b", [5, 12]),
+            named("c", [12, 16]),
+        ])
+        .unwrap();
         assert_eq!((h, merged), (whole_header.clone(), whole.clone()));
         // In any order.
-        let (_, merged) =
-            merge([named("c", [12, 16]), named("a", [0, 5]), named("b", [5, 12])]).unwrap();
+        let (_, merged) = merge([
+            named("c", [12, 16]),
+            named("a", [0, 5]),
+            named("b", [5, 12]),
+        ])
+        .unwrap();
         assert_eq!(merged, whole);
         // A part missing, twice, of another render, or not whole.
         let e = merge([named("a", [0, 5]), named("c", [12, 16])]).unwrap_err();
@@ -460,7 +503,10 @@ mod tests {
         let (h, mut f) = part([5, 16]);
         f.pixels_mut()[4] = crate::film::PixelStats::default();
         let e = merge([named("a", [0, 5]), ("short".to_string(), h, f)]).unwrap_err();
-        assert!(e.contains("short: incomplete (a pixel holds 0 of its 11 samples)"), "{e}");
+        assert!(
+            e.contains("short: incomplete (a pixel holds 0 of its 11 samples)"),
+            "{e}"
+        );
         assert!(merge(std::iter::empty()).unwrap_err().contains("no parts"));
     }
 }
