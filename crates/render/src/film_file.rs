@@ -198,100 +198,146 @@ pub fn write(path: &Path, header: &FilmHeader, film: &Film) -> Result<(), FilmFi
     std::fs::rename(&tmp, path).map_err(io)
 }
 
-/// Reads a film file.
+/// Reads a film file (a chunk at a time: it holds the film, not a copy of the file besides).
 pub fn read(path: &Path) -> Result<(FilmHeader, Film), FilmFileError> {
-    let bytes = std::fs::read(path).map_err(|e| FilmFileError::Io {
+    let io = |e: std::io::Error| FilmFileError::Io {
         path: path.display().to_string(),
         message: e.to_string(),
-    })?;
-    parse(&bytes).map_err(|message| FilmFileError::Invalid {
-        path: path.display().to_string(),
-        message,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    parse_from(std::io::BufReader::new(file), len).map_err(|e| match e {
+        Parse::Io(e) => io(e),
+        Parse::Invalid(message) => FilmFileError::Invalid {
+            path: path.display().to_string(),
+            message,
+        },
     })
 }
 
 /// [`read`] from bytes.
 pub fn parse(bytes: &[u8]) -> Result<(FilmHeader, Film), String> {
-    if bytes.len() < 8 || &bytes[..8] != MAGIC {
+    parse_from(bytes, bytes.len() as u64).map_err(|e| match e {
+        Parse::Io(_) => "truncated".to_string(),
+        Parse::Invalid(message) => message,
+    })
+}
+
+/// Why a film could not be read: the source failed, or its contents are not a film.
+enum Parse {
+    Io(std::io::Error),
+    Invalid(String),
+}
+
+impl From<String> for Parse {
+    fn from(message: String) -> Parse {
+        Parse::Invalid(message)
+    }
+}
+
+impl From<&str> for Parse {
+    fn from(message: &str) -> Parse {
+        Parse::Invalid(message.to_string())
+    }
+}
+
+/// What a film file holds, read from `source` of `len` bytes a record at a time, hashed on the
+/// way; the film is returned only if the hash at the end matches.
+fn parse_from(mut source: impl std::io::Read, len: u64) -> Result<(FilmHeader, Film), Parse> {
+    let mut hash = FNV_OFFSET;
+    // Reads exactly `n` bytes into `buf` and hashes them; a short source is "truncated".
+    let mut take = |buf: &mut Vec<u8>, n: usize, hash: &mut u64| -> Result<(), Parse> {
+        buf.resize(n, 0);
+        source.read_exact(buf).map_err(|e| match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => Parse::Invalid("truncated".into()),
+            _ => Parse::Io(e),
+        })?;
+        *hash = fnv1a_more(*hash, buf);
+        Ok(())
+    };
+    let mut buf = Vec::new();
+    if len < 12 {
         return Err("wrong magic (expected PLFILM01)".into());
     }
-    let u32_at = |at: usize| -> Result<u32, String> {
-        bytes
-            .get(at..at + 4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .ok_or_else(|| "truncated".to_string())
-    };
-    let u64_at = |at: usize| -> Result<u64, String> {
-        let b = bytes
-            .get(at..at + 8)
-            .ok_or_else(|| "truncated".to_string())?;
-        Ok(u64::from_le_bytes(b.try_into().map_err(|_| "truncated")?))
-    };
-    let header_len = u32_at(8)? as usize;
-    if header_len > MAX_HEADER {
-        return Err(format!("a header of {header_len} bytes"));
+    take(&mut buf, 12, &mut hash)?;
+    if &buf[..8] != MAGIC {
+        return Err("wrong magic (expected PLFILM01)".into());
     }
-    let header_bytes = bytes
-        .get(12..12 + header_len)
-        .ok_or_else(|| "truncated in its header".to_string())?;
-    let text = std::str::from_utf8(header_bytes).map_err(|_| "a header that is not text")?;
+    let header_len = u32::from_le_bytes([buf[8], buf[9], buf[10], buf[11]]) as usize;
+    if header_len > MAX_HEADER {
+        return Err(format!("a header of {header_len} bytes").into());
+    }
+    if len < 12 + header_len as u64 {
+        return Err("truncated in its header".into());
+    }
+    take(&mut buf, header_len, &mut hash)?;
+    let text = std::str::from_utf8(&buf).map_err(|_| "a header that is not text")?;
     let header = FilmHeader::from_text(text)?;
-    let at = 12 + header_len;
-    let count = u64_at(at)?;
+    take(&mut buf, 8, &mut hash)?;
+    let count = u64::from_le_bytes(buf[..8].try_into().map_err(|_| "truncated")?);
     let [w, h] = header.resolution;
     if count != w as u64 * h as u64 || w == 0 || h == 0 {
-        return Err(format!("{count} pixels for a {w} x {h} image"));
+        return Err(format!("{count} pixels for a {w} x {h} image").into());
     }
-    let body = at + 8;
-    let pixels_end = (count as usize)
-        .checked_mul(PIXEL_BYTES)
+    let body = 12 + header_len as u64 + 8;
+    let pixels_end = count
+        .checked_mul(PIXEL_BYTES as u64)
         .and_then(|n| n.checked_add(body))
         .ok_or("sizes out of range")?;
-    let splat_bytes = (count as usize)
-        .checked_mul(SPLAT_BYTES)
+    let splat_bytes = count
+        .checked_mul(SPLAT_BYTES as u64)
         .and_then(|n| n.checked_add(8))
         .ok_or("sizes out of range")?;
     // With or without the light traced to the lens.
-    let splats = bytes.len() == pixels_end + splat_bytes + 8;
+    let splats = len == pixels_end + splat_bytes + 8;
     let expected = pixels_end + if splats { splat_bytes } else { 0 } + 8;
-    if bytes.len() != expected {
-        return Err(format!(
-            "{} bytes where its sizes say {expected} (truncated or padded)",
-            bytes.len()
-        ));
-    }
-    let stored = u64_at(expected - 8)?;
-    if fnv1a(&bytes[..expected - 8]) != stored {
-        return Err("its contents do not match its checksum (corrupt)".into());
+    if len != expected {
+        return Err(
+            format!("{len} bytes where its sizes say {expected} (truncated or padded)").into(),
+        );
     }
     if header.range[0] > header.range[1] || header.range[1] > header.spp {
         return Err(format!(
             "sample range {}..{} outside 0..{}",
             header.range[0], header.range[1], header.spp
-        ));
+        )
+        .into());
     }
-    let mut film = Film::new(w, h);
-    for (p, chunk) in film
-        .pixels_mut()
-        .iter_mut()
-        .zip(bytes[body..pixels_end].chunks_exact(PIXEL_BYTES))
-    {
-        *p = PixelStats::from_bytes(chunk).ok_or("a pixel record of the wrong size")?;
+    let mut film = Film::try_new(w, h)?;
+    // Pixel records a chunk at a time.
+    let per_chunk = (HashedFile::CHUNK / PIXEL_BYTES).max(1);
+    for pixels in film.pixels_mut().chunks_mut(per_chunk) {
+        take(&mut buf, pixels.len() * PIXEL_BYTES, &mut hash)?;
+        for (p, record) in pixels.iter_mut().zip(buf.chunks_exact(PIXEL_BYTES)) {
+            *p = PixelStats::from_bytes(record).ok_or("a pixel record of the wrong size")?;
+        }
     }
     if splats {
-        let light_paths = u64_at(pixels_end)?;
-        let sums = bytes[pixels_end + 8..expected - 8]
-            .chunks_exact(SPLAT_BYTES)
-            .map(|c| {
+        take(&mut buf, 8, &mut hash)?;
+        let light_paths = u64::from_le_bytes(buf[..8].try_into().map_err(|_| "truncated")?);
+        let mut sums = Vec::with_capacity(count as usize);
+        let per_chunk = (HashedFile::CHUNK / SPLAT_BYTES).max(1) as u64;
+        let mut left = count;
+        while left > 0 {
+            let n = left.min(per_chunk);
+            take(&mut buf, n as usize * SPLAT_BYTES, &mut hash)?;
+            sums.extend(buf.chunks_exact(SPLAT_BYTES).map(|c| {
                 let v = |k: usize| {
                     let mut b = [0u8; 16];
                     b.copy_from_slice(&c[16 * k..16 * k + 16]);
                     i128::from_le_bytes(b)
                 };
                 [v(0), v(1), v(2)]
-            })
-            .collect();
+            }));
+            left -= n;
+        }
         film.set_splats(sums, light_paths);
+    }
+    let computed = hash;
+    take(&mut buf, 8, &mut hash)?;
+    let stored = u64::from_le_bytes(buf[..8].try_into().map_err(|_| "truncated")?);
+    if computed != stored {
+        return Err("its contents do not match its checksum (corrupt)".into());
     }
     Ok((header, film))
 }
@@ -449,6 +495,14 @@ mod tests {
             b[flip] ^= 0x10;
             assert!(parse(&b).is_err(), "flip {flip}");
         }
+        // The same from a file, read a chunk at a time.
+        let bad = dir.join("bad.plf");
+        let mut b = bytes.clone();
+        b[bytes.len() / 2] ^= 0x10;
+        std::fs::write(&bad, &b).unwrap();
+        assert!(matches!(read(&bad), Err(FilmFileError::Invalid { .. })));
+        std::fs::write(&bad, &bytes[..bytes.len() - 1]).unwrap();
+        assert!(matches!(read(&bad), Err(FilmFileError::Invalid { .. })));
         // A huge declared header or pixel count is refused before any allocation.
         let mut b = bytes.clone();
         b[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
