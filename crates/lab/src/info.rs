@@ -3,6 +3,7 @@
 //! experiment of `pathlab info`.
 
 use anyhow::{anyhow, Result};
+use pathlab_render::film::Film;
 use pathlab_scene::info::SceneInfo;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
@@ -67,6 +68,7 @@ impl SceneReport {
             },
             "bounds": info.bounds.map(|(lo, hi)| [lo.to_array(), hi.to_array()]),
             "geometry_bytes": self.geometry_bytes,
+            "film_bytes": Film::bytes_for(w, h),
             "bytes_per_triangle": self.bytes_per_triangle(),
             "load_seconds": self.load_seconds,
             "bvh_build_seconds": self.build_seconds,
@@ -107,8 +109,9 @@ impl SceneReport {
             ),
             format!("  bounds     {bounds}"),
             format!(
-                "  memory     {:.1} MiB of geometry and BVH{per_triangle}; loaded in {:.2} s, BVH built in {:.2} s",
+                "  memory     {:.1} MiB of geometry and BVH{per_triangle}, {:.1} MiB of film at {w}x{h}; loaded in {:.2} s, BVH built in {:.2} s",
                 self.geometry_bytes as f64 / (1 << 20) as f64,
+                Film::bytes_for(w, h) as f64 / (1 << 20) as f64,
                 self.load_seconds,
                 self.build_seconds
             ),

@@ -140,13 +140,18 @@ impl Film {
         }
     }
 
+    /// Bytes a film of this size holds in memory (its pixels' exact sums).
+    pub fn bytes_for(width: u32, height: u32) -> u64 {
+        width as u64 * height as u64 * std::mem::size_of::<PixelStats>() as u64
+    }
+
     /// An empty film, or an error saying how much memory it needs when that cannot be had
     /// (where [`Film::new`] would abort the program).
     pub fn try_new(width: u32, height: u32) -> Result<Self, String> {
         let n = width as usize * height as usize;
         let mut pixels = Vec::new();
         pixels.try_reserve_exact(n).map_err(|_| {
-            let gib = (n as f64 * std::mem::size_of::<PixelStats>() as f64) / (1u64 << 30) as f64;
+            let gib = Film::bytes_for(width, height) as f64 / (1u64 << 30) as f64;
             format!(
                 "a {width}x{height} film needs {gib:.1} GiB of memory ({} bytes a pixel: each \
                  pixel's exact sums), which cannot be allocated here; render a smaller \
