@@ -181,7 +181,7 @@ fn request(
 /// Render a scene to a float32 array (H, W, 3) of linear radiance, or with `aovs` a dict of
 /// arrays; see `pathlab.render` for the arguments.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, lighting=None, sampler=None, resolution=None, threads=0, aovs=Vec::new()))]
+#[pyo3(signature = (scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, sampler=None, resolution=None, threads=0, aovs=Vec::new(), lighting=None))]
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
@@ -191,11 +191,11 @@ fn render<'py>(
     max_depth: Option<i64>,
     integrator: Option<&str>,
     direct: Option<&str>,
-    lighting: Option<&str>,
     sampler: Option<&str>,
     resolution: Option<(i64, i64)>,
     threads: i64,
     aovs: Vec<String>,
+    lighting: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let names = Names {
         integrator,

@@ -81,8 +81,8 @@ def _image(array):
     return array.view(Image)
 
 
-def render(scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, lighting=None,
-           sampler=None, resolution=None, threads=0, aovs=()):
+def render(scene, spp=None, seed=0, max_depth=None, integrator=None, direct=None, sampler=None,
+           resolution=None, threads=0, aovs=(), lighting=None):
     """Render ``scene`` and return its linear radiance as a float32 array (H, W, 3).
 
     Arguments left as ``None`` take the scene file's setting, then pathlab's default:

@@ -59,11 +59,11 @@ def render(
     max_depth: Optional[int] = ...,
     integrator: Optional[IntegratorName] = ...,
     direct: Optional[DirectName] = ...,
-    lighting: Optional[LightingName] = ...,
     sampler: Optional[SamplerName] = ...,
     resolution: Optional[Tuple[int, int]] = ...,
     threads: int = ...,
     aovs: Tuple[()] = ...,
+    lighting: Optional[LightingName] = ...,
 ) -> Image: ...
 @overload
 def render(
@@ -73,11 +73,11 @@ def render(
     max_depth: Optional[int] = ...,
     integrator: Optional[IntegratorName] = ...,
     direct: Optional[DirectName] = ...,
-    lighting: Optional[LightingName] = ...,
     sampler: Optional[SamplerName] = ...,
     resolution: Optional[Tuple[int, int]] = ...,
     threads: int = ...,
     aovs: Sequence[str] = ...,
+    lighting: Optional[LightingName] = ...,
 ) -> dict[str, np.ndarray]: ...
 def read(path: Union[str, PathLike]) -> Image:
     """An image (EXR, PNG, JPEG, HDR, BMP) as float32 (H, W, 3) linear values."""
