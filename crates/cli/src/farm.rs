@@ -1,7 +1,7 @@
 //! Renders that survive and scale: shards of a render, stopping on signals, and
 //! `pathlab merge` (a render's identity and checkpoints are [`pathlab_lab::job`]'s).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use pathlab_render::{film_file, limits};
 use std::path::PathBuf;
@@ -52,18 +52,12 @@ pub struct MergeArgs {
 pub fn run_merge(args: &MergeArgs) -> Result<()> {
     crate::flags::within("--exposure", Some(args.exposure), limits::exposure)?;
     // A part at a time: the merge holds the sum and the part being added.
-    let mut merged: Option<film_file::Merge> = None;
+    let mut merged = film_file::Merge::default();
     for p in &args.parts {
         let (h, film) = film_file::read(p)?;
         let name = p.display().to_string();
-        match &mut merged {
-            None => {
-                merged = Some(film_file::Merge::new(name, h, film).map_err(anyhow::Error::msg)?)
-            }
-            Some(m) => m.add(name, h, film).map_err(anyhow::Error::msg)?,
-        }
+        merged.add(name, h, film).map_err(anyhow::Error::msg)?;
     }
-    let merged = merged.context("no parts to merge")?;
     let (header, film) = merged.finish().map_err(anyhow::Error::msg)?;
     let (first, [w, h]) = (&header, header.resolution);
     pathlab_lab::outputs::write_film_image(&film, &args.output, &header, args.exposure)?;

@@ -76,6 +76,7 @@ fn parse_domain(text: &str) -> Result<(f64, f64)> {
 
 /// Runs `pathlab integrate`.
 pub fn run(args: &IntegrateArgs) -> Result<()> {
+    let n = crate::flags::sample_count(args.samples)?;
     if args.reps == 0 {
         bail!("--reps must be at least 1");
     }
@@ -86,7 +87,6 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
             args.samples
         );
     }
-    let n = crate::flags::sample_count(args.samples)?;
     let exact = args
         .exact
         .as_deref()

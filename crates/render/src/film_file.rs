@@ -352,11 +352,7 @@ fn parse_from(mut source: impl std::io::Read, len: u64) -> Result<(FilmHeader, F
 pub fn merge(
     parts: impl IntoIterator<Item = (String, FilmHeader, Film)>,
 ) -> Result<(FilmHeader, Film), String> {
-    let mut parts = parts.into_iter();
-    let Some((name, header, film)) = parts.next() else {
-        return Err("no parts to merge".to_string());
-    };
-    let mut merged = Merge::new(name, header, film)?;
+    let mut merged = Merge::default();
     for (name, header, film) in parts {
         merged.add(name, header, film)?;
     }
@@ -364,53 +360,51 @@ pub fn merge(
 }
 
 /// [`merge`] one part at a time, so that a merge holds the sum and the part being added, not
-/// every part at once: [`Merge::new`] with the first part, [`Merge::add`] for each other as it
-/// is read, [`Merge::finish`] for the whole render's film once all are in.
+/// every part at once: [`Merge::add`] each part as it is read, then [`Merge::finish`] for the
+/// whole render's film.
+#[derive(Default)]
 pub struct Merge {
-    first_name: String,
-    first: FilmHeader,
-    film: Film,
+    /// The first part's name and header, and the sum of the parts so far.
+    sum: Option<(String, FilmHeader, Film)>,
     /// Each part's sample range and name.
     ranges: Vec<(u32, u32, String)>,
 }
 
 impl Merge {
-    /// The sum of one part, checked whole.
-    pub fn new(name: String, header: FilmHeader, film: Film) -> Result<Merge, String> {
-        check_whole(&name, &header, &film)?;
-        Ok(Merge {
-            ranges: vec![(header.range[0], header.range[1], name.clone())],
-            first_name: name,
-            first: header,
-            film,
-        })
-    }
-
-    /// Adds a part, checked to be of the same render as the first and whole.
+    /// Adds a part, checked whole and (after the first) of the same render as the first.
     pub fn add(&mut self, name: String, h: FilmHeader, film: Film) -> Result<(), String> {
-        let first = &self.first;
-        if h.key != first.key
-            || h.resolution != first.resolution
-            || h.seed != first.seed
-            || h.spp != first.spp
-        {
-            return Err(format!(
-                "{name}: not a part of the same render as {} ({} vs {})",
-                self.first_name, h.description, first.description
-            ));
+        if let Some((first_name, first, _)) = &self.sum {
+            if h.key != first.key
+                || h.resolution != first.resolution
+                || h.seed != first.seed
+                || h.spp != first.spp
+            {
+                return Err(format!(
+                    "{name}: not a part of the same render as {first_name} ({} vs {})",
+                    h.description, first.description
+                ));
+            }
         }
         check_whole(&name, &h, &film)?;
-        for (a, b) in self.film.pixels_mut().iter_mut().zip(film.pixels()) {
-            a.merge(b);
+        self.ranges.push((h.range[0], h.range[1], name.clone()));
+        match &mut self.sum {
+            None => self.sum = Some((name, h, film)),
+            Some((_, _, sum)) => {
+                for (a, b) in sum.pixels_mut().iter_mut().zip(film.pixels()) {
+                    a.merge(b);
+                }
+                sum.merge_splats(&film);
+            }
         }
-        self.film.merge_splats(&film);
-        self.ranges.push((h.range[0], h.range[1], name));
         Ok(())
     }
 
     /// The whole render's header and film, once the parts' ranges are checked to cover its
     /// samples once.
     pub fn finish(mut self) -> Result<(FilmHeader, Film), String> {
+        let Some((_, first, film)) = self.sum else {
+            return Err("no parts to merge".to_string());
+        };
         self.ranges.sort();
         let mut problems = Vec::new();
         let (mut at, mut last) = (0u32, "");
@@ -427,7 +421,7 @@ impl Merge {
             at = at.max(b);
             last = name;
         }
-        let spp = self.first.spp;
+        let spp = first.spp;
         if at < spp {
             problems.push(format!("samples {at}..{spp} are missing"));
         }
@@ -437,9 +431,9 @@ impl Merge {
                 problems.join("; ")
             ));
         }
-        let mut header = self.first;
+        let mut header = first;
         header.range = [0, spp];
-        Ok((header, self.film))
+        Ok((header, film))
     }
 }
 

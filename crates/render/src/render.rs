@@ -101,6 +101,9 @@ pub struct TileDone<'a> {
     pub pixels: &'a [PixelStats],
 }
 
+/// Where a tile lies: `(x0, y0, width)`.
+pub(crate) type TileAt = (u32, u32, u32);
+
 /// Radiance that light traced to the lens brings to a film position (pixels).
 type Splat = (glam::Vec2, crate::desc::Rgb);
 
@@ -316,9 +319,10 @@ impl<'a> Frame<'a> {
         stats.nodes_visited += t.path.nodes_visited;
     }
 
-    /// Runs `tile` on every tile on the thread pool and returns what each gives besides its
-    /// samples, in tile order. `tile(x0, y0, held)` is given the sample counts its pixels hold
-    /// as it starts (row-major; only this tile adds to them). Each tile's samples go into
+    /// Runs `tile` on every tile on the thread pool and returns, in tile order, each tile's
+    /// `(x0, y0, width)` and what it gives besides its samples. `tile(out, height, held)` is
+    /// given the tile's empty result to fill ([`Frame::new_tile`]), its height, and the sample
+    /// counts its pixels hold as it starts (row-major; only this tile adds to them). Each tile's samples go into
     /// `film` (its counts into `stats`) as soon as it is done, so a pass holds a tile per
     /// thread besides the film, not a second film; the film's sums are exact, so the order in
     /// which tiles finish does not change them. Light traced to the lens lands anywhere: the
@@ -327,34 +331,33 @@ impl<'a> Frame<'a> {
         &self,
         film: &mut Film,
         stats: &mut RenderStats,
-        tile: impl Fn(u32, u32, &[u64]) -> (TileResult, R) + Sync,
-    ) -> Vec<R> {
+        tile: impl Fn(TileResult, u32, &[u64]) -> (TileResult, R) + Sync,
+    ) -> Vec<(TileAt, R)> {
         let shared = std::sync::Mutex::new((film, stats));
         let lock = || shared.lock().unwrap_or_else(|e| e.into_inner());
-        let done: Vec<(Vec<Splat>, u64, R)> = self
+        let done: Vec<(Vec<Splat>, u64, TileAt, R)> = self
             .tiles
             .par_iter()
             .map(|&(x0, y0)| {
-                let w = TILE_SIZE.min(self.window[2] - x0);
-                let h = TILE_SIZE.min(self.window[3] - y0);
+                let (w, h, out) = self.new_tile(x0, y0);
                 let held: Vec<u64> = {
                     let g = lock();
                     (0..w * h)
                         .map(|k| g.0.pixel(x0 + k % w, y0 + k / w).count())
                         .collect()
                 };
-                let (t, extra) = tile(x0, y0, &held);
+                let (t, extra) = tile(out, h, &held);
                 let mut g = lock();
                 let (film, stats) = &mut *g;
                 Self::merge_tile(film, stats, &t);
-                (t.splats, t.light_paths, extra)
+                (t.splats, t.light_paths, (x0, y0, w), extra)
             })
             .collect();
         let (film, _) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
         done.into_iter()
-            .map(|(splats, light_paths, extra)| {
+            .map(|(splats, light_paths, at, extra)| {
                 self.add_splats(film, &splats, light_paths);
-                extra
+                (at, extra)
             })
             .collect()
     }
@@ -373,8 +376,8 @@ impl<'a> Frame<'a> {
     ) {
         let first = self.settings.sample_range.map_or(0, |r| r[0]);
         let splatting = self.integrator.splats(self.scene);
-        self.run_tiles(film, stats, |x0, y0, held| {
-            let (w, h, mut out) = self.new_tile(x0, y0);
+        self.run_tiles(film, stats, |mut out, h, held| {
+            let (x0, y0, w) = (out.x0, out.y0, out.w);
             let mut sampler = self
                 .settings
                 .sampler

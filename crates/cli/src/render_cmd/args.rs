@@ -293,9 +293,14 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
         .as_deref()
         .map(flags::max_depth)
         .transpose()?;
+    within("--exposure", Some(args.exposure), limits::exposure)?;
     let warnings = check_flags(args, cli_depth)?;
-    check_values(args)?;
+    check_view(args)?;
+    let every = Some(args.checkpoint_every);
+    within("--checkpoint-every", every, limits::checkpoint_seconds)?;
     let params = args.scene.params()?;
+    within("--target-error", args.target_error, limits::target_error)?;
+    within("--time", args.time, limits::render_seconds)?;
     let progressive =
         (args.target_error.is_some() || args.time.is_some()).then_some(ProgressiveStop {
             target_error: args.target_error,
@@ -356,9 +361,9 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
     Ok(Checked { request, warnings })
 }
 
-/// Values no scene could take, each by its rule in [`limits`].
-fn check_values(args: &RenderArgs) -> Result<()> {
-    within("--exposure", Some(args.exposure), limits::exposure)?;
+/// The camera's and the environment's flags: values no scene could take, each by its rule in
+/// [`limits`].
+fn check_view(args: &RenderArgs) -> Result<()> {
     within("--lens-radius", args.lens_radius, limits::lens_radius)?;
     within(
         "--focal-distance",
@@ -382,10 +387,6 @@ fn check_values(args: &RenderArgs) -> Result<()> {
     }
     within("--scale", args.scale, limits::image_scale)?;
     within("--fov", args.fov, limits::fov_degrees)?;
-    within("--target-error", args.target_error, limits::target_error)?;
-    within("--time", args.time, limits::render_seconds)?;
-    let every = Some(args.checkpoint_every);
-    within("--checkpoint-every", every, limits::checkpoint_seconds)?;
     Ok(())
 }
 

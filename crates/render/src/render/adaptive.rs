@@ -173,7 +173,8 @@ pub(super) fn render_adaptive(
     let two_stage = adaptive.rule == AdaptiveRule::TwoStage;
     let start = Instant::now();
     if two_stage {
-        for (x0, y0, w, plan) in pilot_plans(frame, adaptive, batch, film, stats, progress, cancel)
+        for ((x0, y0, w), plan) in
+            pilot_plans(frame, adaptive, batch, film, stats, progress, cancel)
         {
             for (k, &n) in plan.iter().enumerate() {
                 target[index(x0 + k as u32 % w, y0 + k as u32 / w)] = n;
@@ -183,7 +184,7 @@ pub(super) fn render_adaptive(
     while !cancel.load(Ordering::Relaxed) {
         let rounds = adaptive_round(frame, batch, film, stats, &target, progress, cancel);
         let mut worked = false;
-        for (x0, y0, w, tile_fixed) in rounds {
+        for ((x0, y0, w), tile_fixed) in rounds {
             for (k, f) in tile_fixed.iter().enumerate() {
                 // Pixels that took samples this round.
                 if let Some(f) = f {
@@ -221,10 +222,10 @@ fn pilot_plans(
     stats: &mut RenderStats,
     progress: &(dyn Fn(&TileDone) + Sync),
     cancel: &AtomicBool,
-) -> Vec<(u32, u32, u32, Vec<u32>)> {
+) -> Vec<(TileAt, Vec<u32>)> {
     let settings = frame.settings;
-    frame.run_tiles(film, stats, |x0, y0, _| {
-        let (w, h, mut out) = frame.new_tile(x0, y0);
+    frame.run_tiles(film, stats, |mut out, h, _| {
+        let (x0, y0, w) = (out.x0, out.y0, out.w);
         let seed = settings.seed ^ Adaptive::PILOT_STREAM;
         let mut pilot_sampler = settings.sampler.build(batch, seed);
         let mut plan = vec![0u32; (w * h) as usize];
@@ -256,7 +257,7 @@ fn pilot_plans(
             w,
             pixels: &[],
         });
-        (out, (x0, y0, w, plan))
+        (out, plan)
     })
 }
 
@@ -270,12 +271,12 @@ fn adaptive_round(
     target: &[u32],
     progress: &(dyn Fn(&TileDone) + Sync),
     cancel: &AtomicBool,
-) -> Vec<(u32, u32, u32, Vec<Option<bool>>)> {
+) -> Vec<(TileAt, Vec<Option<bool>>)> {
     let settings = frame.settings;
     let width = film.width();
     let index = |x: u32, y: u32| (y * width + x) as usize;
-    frame.run_tiles(film, stats, |x0, y0, held| {
-        let (w, h, mut out) = frame.new_tile(x0, y0);
+    frame.run_tiles(film, stats, |mut out, h, held| {
+        let (x0, y0, w) = (out.x0, out.y0, out.w);
         let mut sampler = settings.sampler.build(settings.spp, settings.seed);
         let mut tile_fixed = vec![None; (w * h) as usize];
         for k in 0..w * h {
@@ -312,6 +313,6 @@ fn adaptive_round(
             w,
             pixels: &out.pixels,
         });
-        (out, (x0, y0, w, tile_fixed))
+        (out, tile_fixed)
     })
 }
