@@ -71,6 +71,15 @@ impl Aabb {
         }
     }
 
+    /// The box both hold (empty if they do not meet).
+    #[inline]
+    pub fn intersection(self, o: Aabb) -> Aabb {
+        Aabb {
+            min: self.min.max(o.min),
+            max: self.max.min(o.max),
+        }
+    }
+
     /// The smallest box holding this one and `p`.
     #[inline]
     pub fn grow(self, p: Vec3) -> Aabb {

@@ -41,6 +41,35 @@ impl Triangle {
         Aabb::point(self.p[0]).grow(self.p[1]).grow(self.p[2])
     }
 
+    /// The boxes of this triangle's parts inside `bounds` below and above the plane at `pos`
+    /// on `axis` (a spatial split's pieces: [`crate::accel::SplitPrim`]). Each box holds its
+    /// part: where an edge crosses the plane, the rounded crossing point is widened by its
+    /// possible error on the other axes.
+    pub fn split_bounds(&self, bounds: &Aabb, axis: usize, pos: f32) -> (Aabb, Aabb) {
+        let (mut below, mut above) = (Aabb::EMPTY, Aabb::EMPTY);
+        for i in 0..3 {
+            let (a, b) = (self.p[i], self.p[(i + 1) % 3]);
+            let (ca, cb) = (a[axis], b[axis]);
+            if ca <= pos {
+                below = below.grow(a);
+            }
+            if ca >= pos {
+                above = above.grow(a);
+            }
+            if (ca < pos && pos < cb) || (cb < pos && pos < ca) {
+                let x = a + (b - a) * ((pos - ca) / (cb - ca));
+                // A handful of roundings, each at most ε of the larger endpoint.
+                let pad = a.abs().max(b.abs()) * (16.0 * f32::EPSILON);
+                let (mut lo, mut hi) = (x - pad, x + pad);
+                lo[axis] = pos;
+                hi[axis] = pos;
+                below = below.grow(lo).grow(hi);
+                above = above.grow(lo).grow(hi);
+            }
+        }
+        (below.intersection(*bounds), above.intersection(*bounds))
+    }
+
     /// Area.
     pub fn area(&self) -> f32 {
         0.5 * (self.p[1] - self.p[0])
@@ -234,6 +263,59 @@ mod tests {
         assert!(tri.intersect(&short).is_none());
         assert_eq!(tri.normal(), Vec3::Z);
         assert!((tri.area() - 0.5).abs() < 1e-7);
+    }
+
+    #[test]
+    fn split_bounds_hold_every_point_of_their_parts() {
+        let mut rng = pathlab_mc::rng::Pcg32::new(31, 2);
+        let mut point = |scale: f32| {
+            Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * scale - 0.3 * scale
+        };
+        let mut split_pieces = 0;
+        for k in 0..300 {
+            // Large and far triangles too, where the crossing's rounding matters.
+            let scale = [1.0, 1e3, 1e-3][k % 3];
+            let tri = Triangle {
+                p: [point(scale), point(scale), point(scale)],
+            };
+            // The whole triangle, or the part of it in a smaller box (an earlier split's).
+            let whole = tri.bounds();
+            let bounds = if k % 2 == 0 {
+                whole
+            } else {
+                Aabb {
+                    min: whole.min + 0.2 * whole.extent(),
+                    max: whole.max,
+                }
+            };
+            let axis = k % 3;
+            let pos = whole.min[axis] + point(1.0).x.abs().min(1.0) * whole.extent()[axis];
+            let (below, above) = tri.split_bounds(&bounds, axis, pos);
+            let inside = |b: &Aabb, p: Vec3| b.min.cmple(p).all() && b.max.cmpge(p).all();
+            for j in 0..400 {
+                let (u, v) = ((j % 20) as f32 / 19.0, (j / 20) as f32 / 19.0);
+                let (u, v) = if u + v > 1.0 {
+                    (1.0 - u, 1.0 - v)
+                } else {
+                    (u, v)
+                };
+                let p = tri.p[0] + u * (tri.p[1] - tri.p[0]) + v * (tri.p[2] - tri.p[0]);
+                if !inside(&bounds, p) {
+                    continue;
+                }
+                if p[axis] <= pos {
+                    assert!(inside(&below, p), "{p} below {pos} outside {below:?}");
+                }
+                if p[axis] >= pos {
+                    assert!(inside(&above, p), "{p} above {pos} outside {above:?}");
+                }
+            }
+            split_pieces += usize::from(!below.is_empty() && !above.is_empty());
+            // Each piece keeps to its side of the plane.
+            assert!(below.is_empty() || below.max[axis] <= pos);
+            assert!(above.is_empty() || above.min[axis] >= pos);
+        }
+        assert!(split_pieces > 100);
     }
 
     #[test]

@@ -14,7 +14,10 @@ pub(crate) use tri_block::{
     nearest_for_rays_pair_avx512, Avx512Nearest, Avx512Rays, AvxNearest, AvxRays,
 };
 pub use tri_block::{BlockHit, Nearest, RayLanes, TriBlock, TRIS_PER_BLOCK};
-pub use wide::{BoxTest, Bvh4, Bvh8, Node, Portable, WideBvh, BVH_WIDTH, MAX_PRIMITIVES};
+pub use wide::{
+    split_box, BoxTest, Bvh4, Bvh8, Node, Portable, SplitPrim, WideBvh, BVH_WIDTH, MAX_PRIMITIVES,
+    SPLIT_BUDGET,
+};
 
 /// Test helpers shared by the BVHs' tests: random boxes as primitives.
 #[cfg(test)]

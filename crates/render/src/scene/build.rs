@@ -4,7 +4,7 @@
 //! lights at infinity, which need the scene's bounds.
 
 use super::{permute, Prim, Scene, SceneError, Voxel, NO_LIGHT};
-use crate::accel::{Bvh8, BvhParams, MAX_PRIMITIVES, TRIS_PER_BLOCK};
+use crate::accel::{split_box, Bvh8, BvhParams, MAX_PRIMITIVES, TRIS_PER_BLOCK};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::desc::{Emission, MeshAttribute, MeshDesc, SceneDesc, Visibility};
@@ -20,7 +20,7 @@ use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::trace::leaf_blocks;
+use super::trace::{leaf_blocks, SMALL_SCENE_BLOCKS};
 use super::BuildStats;
 
 impl Scene {
@@ -511,37 +511,45 @@ fn bvh_in_leaf_order(
             Prim::Voxel(i) => grids.voxel_bounds[i as usize],
         })
         .collect();
-    let mut bvh = Bvh8::build(
-        &bounds,
-        BvhParams {
-            leaf_block: TRIS_PER_BLOCK,
-            // Measured against 1.0: 0.25 keeps the walls of a room in separate leaves (the
-            // Cornell box renders 12-17% faster); the blobs and maxplanck trace as fast as
-            // before, a soup of random triangles (smaller leaves) about 15% slower.
-            leaf_split_cost: 0.25,
-            ..BvhParams::default()
-        },
-    );
+    let params = BvhParams {
+        leaf_block: TRIS_PER_BLOCK,
+        // Measured against 1.0: 0.25 keeps the walls of a room in separate leaves (the
+        // Cornell box renders 12-17% faster); the blobs and maxplanck trace as fast as
+        // before, a soup of random triangles (smaller leaves) about 15% slower.
+        leaf_split_cost: 0.25,
+        ..BvhParams::default()
+    };
+    // Spatial splits cut large triangles into the boxes of their parts; scenes small enough
+    // to test every primitive at once ([`Scene::nearest_of_rays`]) keep one reference each.
+    let split = |prim: u32, bounds: &Aabb, axis: usize, pos: f32| match prims[prim as usize] {
+        Prim::Triangle(i) => triangles[i as usize].split_bounds(bounds, axis, pos),
+        Prim::Sphere(_) | Prim::Voxel(_) => split_box(prim, bounds, axis, pos),
+    };
+    let mut bvh = if prims.len() > SMALL_SCENE_BLOCKS * TRIS_PER_BLOCK {
+        Bvh8::build_with_splits(&bounds, params, &split)
+    } else {
+        Bvh8::build(&bounds, params)
+    };
     let order = bvh.take_leaf_order();
+    // Triangles are numbered by their first leaf slot; a triangle that spatial splits put in
+    // several leaves keeps that one number.
+    let mut renamed = vec![u32::MAX; triangles.len()];
     let mut tri_order: Vec<u32> = Vec::with_capacity(triangles.len());
     let prims: Vec<Prim> = order
         .iter()
         .map(|&p| match prims[p as usize] {
             Prim::Triangle(t) => {
-                tri_order.push(t);
-                Prim::Triangle(tri_order.len() as u32 - 1)
+                if renamed[t as usize] == u32::MAX {
+                    renamed[t as usize] = tri_order.len() as u32;
+                    tri_order.push(t);
+                }
+                Prim::Triangle(renamed[t as usize])
             }
             shape => shape,
         })
         .collect();
-    if tri_order.len() < triangles.len() {
-        // Triangles the BVH left out (non-finite boxes) keep their data, unreachable.
-        let mut seen = vec![false; triangles.len()];
-        for &t in &tri_order {
-            seen[t as usize] = true;
-        }
-        tri_order.extend((0..triangles.len() as u32).filter(|&t| !seen[t as usize]));
-    }
+    // Triangles the BVH left out (non-finite boxes) keep their data, unreachable.
+    tri_order.extend((0..triangles.len() as u32).filter(|&t| renamed[t as usize] == u32::MAX));
     Ok((bvh, prims, tri_order))
 }
 

@@ -404,7 +404,7 @@ const SMALL_SCENE_SHAPES: u32 = 16;
 
 /// The most blocks of primitives a scene may have for [`Scene::nearest_of_rays`] (64):
 /// beyond a few dozen triangles the BVH culls more than testing them all costs.
-const SMALL_SCENE_BLOCKS: usize = 16;
+pub(super) const SMALL_SCENE_BLOCKS: usize = 16;
 
 /// Packs the primitives of each of `bvh`'s leaves into blocks of [`TRIS_PER_BLOCK`] and renames the
 /// leaves' ranges from leaf slots to blocks.

@@ -16,18 +16,20 @@
 //! four triangles).
 //!
 //! One concept per file: the node layout (`node`), the box tests (`box_test`), the traversal
-//! stack (`stack`), the build (`build`: binned SAH binary tree, collapsed into wide nodes) and
-//! the traversals (`traverse`).
+//! stack (`stack`), the build (`build`: binned SAH binary tree, collapsed into wide nodes), its
+//! spatial splits (`spatial`) and the traversals (`traverse`).
 
 mod box_test;
 mod build;
 mod node;
+mod spatial;
 mod stack;
 mod traverse;
 
 pub use box_test::{BoxTest, Portable};
 use node::{leaf_range, leaf_word, LEAF, MAX_LEAF};
 pub use node::{Node, MAX_PRIMITIVES};
+pub use spatial::{split_box, SplitPrim, SPLIT_BUDGET};
 
 use crate::geometry::Aabb;
 

@@ -217,3 +217,86 @@ fn axis_parallel_and_degenerate<const W: usize>() {
         0
     );
 }
+
+/// Small boxes among long slabs that cross the whole domain on each axis: where the best
+/// partition's two sides overlap, so that spatial splits cut the slabs (enough boxes for the
+/// nodes where splits are tried).
+fn boxes_with_slabs(seed: u64) -> Vec<Aabb> {
+    let mut boxes = random_boxes(3 * super::spatial::SPLIT_MIN_REFS, seed);
+    for k in 0..12 {
+        let (axis, at) = (k % 3, 1.0 + 0.7 * k as f32);
+        let mut min = Vec3::splat(at);
+        let mut max = Vec3::splat(at + 0.2);
+        min[axis] = -1.0;
+        max[axis] = 11.0;
+        boxes.push(Aabb { min, max });
+    }
+    boxes
+}
+
+#[test]
+fn spatial_splits_find_the_same_hits_as_brute_force() {
+    spatial_splits_match_brute_force::<4>();
+    spatial_splits_match_brute_force::<8>();
+}
+
+fn spatial_splits_match_brute_force<const W: usize>() {
+    for seed in [21, 22] {
+        let boxes = boxes_with_slabs(seed);
+        let n = boxes.len();
+        let bvh = WideBvh::<W>::build_with_splits(&boxes, BvhParams::default(), &split_box);
+        // The slabs were cut: more references than boxes, within the budget, every box
+        // referenced.
+        let refs = bvh.primitive_indices().len();
+        assert!(refs > n, "no spatial split in {refs} references");
+        assert!(refs <= n + (n as f32 * SPLIT_BUDGET) as usize);
+        let mut seen: Vec<u32> = bvh.primitive_indices().to_vec();
+        seen.sort();
+        seen.dedup();
+        assert_eq!(seen, (0..n as u32).collect::<Vec<u32>>());
+        check_against_brute_force(
+            &boxes,
+            2000,
+            (seed, 3),
+            |r, h| bvh.intersect(r, h),
+            |r, h| bvh.occluded(r, h),
+        );
+        // Fewer nodes visited than without the splits, on the same rays.
+        let plain = WideBvh::<W>::build(&boxes, BvhParams::default());
+        let visits = |tree: &WideBvh<W>| {
+            let mut rng = Pcg32::new(seed, 4);
+            (0..2000)
+                .map(|_| {
+                    let o = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), -2.0) * 10.0;
+                    let mut ray = Ray::new(o, Vec3::new(0.1, 0.2, 1.0));
+                    tree.intersect(&mut ray, box_hit(&boxes)).1 as u64
+                })
+                .sum::<u64>()
+        };
+        assert!(visits(&bvh) < visits(&plain));
+    }
+}
+
+#[test]
+fn spatial_splits_build_the_same_tree_on_any_number_of_threads() {
+    let boxes: Vec<Aabb> = (0..2).flat_map(boxes_with_slabs).collect();
+    let build = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| Bvh8::build_with_splits(&boxes, BvhParams::default(), &split_box))
+    };
+    let one = build(1);
+    for threads in [2, 3] {
+        let other = build(threads);
+        assert_eq!(one.primitive_indices(), other.primitive_indices());
+        assert_eq!(one.node_count(), other.node_count());
+        for (a, b) in one.nodes.iter().zip(&other.nodes) {
+            assert_eq!(a.child, b.child);
+            for lane in 0..8 {
+                assert_eq!(a.bounds(lane), b.bounds(lane));
+            }
+        }
+    }
+}

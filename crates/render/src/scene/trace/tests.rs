@@ -121,6 +121,16 @@ fn simd_traversal_finds_what_testing_every_shape_finds() {
         ..Default::default()
     };
     let scene = Scene::build(&desc).unwrap();
+    agrees_with_testing_every_shape(&scene, &desc, &mut point);
+}
+
+/// Checks 3000 rays from `point` (camera and indirect, nearest and any hit) against testing
+/// every shape.
+fn agrees_with_testing_every_shape(
+    scene: &Scene,
+    desc: &SceneDesc,
+    point: &mut dyn FnMut() -> Vec3,
+) {
     let mut hits = 0;
     for k in 0..3000 {
         let o = point() * 14.0 - 2.0;
@@ -130,7 +140,7 @@ fn simd_traversal_finds_what_testing_every_shape_finds() {
         } else {
             RayKind::Indirect
         };
-        let expected = brute_force(&desc, &ray, kind);
+        let expected = brute_force(desc, &ray, kind);
         let mut r = ray;
         let portable = scene.closest_hit_with(Portable, &mut r, kind);
         assert_eq!(portable.found().then_some(r.t_max), expected);
@@ -149,6 +159,47 @@ fn simd_traversal_finds_what_testing_every_shape_finds() {
         hits += usize::from(expected.is_some());
     }
     assert!(hits > 300, "{hits} rays hit");
+}
+
+#[test]
+fn spatial_splits_find_what_testing_every_shape_finds() {
+    // Small triangles among large ones that cross the whole scene (walls of a room), enough
+    // of them for spatial splits to cut the large ones; a sphere among them.
+    let mut rng = pathlab_mc::rng::Pcg32::new(23, 5);
+    let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+    let mut positions = Vec::new();
+    for _ in 0..6000 {
+        let c = point() * 10.0;
+        positions.extend([c, c + (point() - 0.5) * 0.3, c + (point() - 0.5) * 0.3]);
+    }
+    for k in 0..30 {
+        let (a, b) = (point() * 12.0 - 1.0, point() * 12.0 - 1.0);
+        let mut c = point() * 10.0;
+        c[k % 3] = if k % 2 == 0 { -1.0 } else { 11.0 };
+        positions.extend([a, b, c]);
+    }
+    let desc = SceneDesc {
+        meshes: vec![MeshDesc {
+            name: "room".into(),
+            indices: (0..positions.len() as u32).collect(),
+            positions,
+            ..Default::default()
+        }],
+        spheres: vec![crate::desc::SphereDesc {
+            center: Vec3::splat(5.0),
+            radius: 2.0,
+            material: 0,
+            emission: None,
+            ..Default::default()
+        }],
+        materials: vec![diffuse(Vec3::ONE, false)],
+        resolution: [4, 4],
+        ..Default::default()
+    };
+    let scene = Scene::build(&desc).unwrap();
+    // Some triangles sit in several leaves.
+    assert!(scene.prims.len() > scene.triangles.len() + 1);
+    agrees_with_testing_every_shape(&scene, &desc, &mut point);
 }
 
 /// A closed box of two-triangle quads with a smaller box inside: few enough triangles to
