@@ -1,12 +1,13 @@
 //! `pathlab convert` and `pathlab diff`: the images pathlab writes, re-encoded and compared.
 
 use crate::flags::within;
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
 use pathlab_lab::images::diff_files;
+use pathlab_lab::outputs::{image_format, OutputFormat};
 use pathlab_render::image_io::{read_rgb, write_exr, write_png_with, ToneMap};
 use pathlab_render::limits;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Raw command-line arguments of `pathlab convert`.
 #[derive(Args, Debug)]
@@ -39,29 +40,12 @@ pub struct DiffArgs {
     pub json: bool,
 }
 
-/// What `--output` may end in.
-fn check_extension(path: &Path, allowed: &[&str]) -> Result<String> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    if !allowed.contains(&ext.as_str()) {
-        bail!(
-            "{}: the output must end in .{}",
-            path.display(),
-            allowed.join(" or .")
-        );
-    }
-    Ok(ext)
-}
-
 /// Runs `pathlab convert`.
 pub fn run_convert(args: &ConvertArgs) -> Result<()> {
     within("--exposure", Some(args.exposure), limits::exposure)?;
-    let ext = check_extension(&args.output, &["png", "exr"])?;
+    let format = image_format(&args.output)?;
     let (w, h, px) = read_rgb(&args.input, true)?;
-    if ext == "exr" {
+    if format == OutputFormat::Exr {
         write_exr(&args.output, w, h, &px, &[])?;
     } else {
         write_png_with(&args.output, w, h, &px, args.exposure, args.tonemap)?;
@@ -77,7 +61,7 @@ pub fn run_convert(args: &ConvertArgs) -> Result<()> {
 /// Runs `pathlab diff`.
 pub fn run_diff(args: &DiffArgs) -> Result<()> {
     if let Some(o) = &args.output {
-        check_extension(o, &["png", "exr"])?;
+        image_format(o)?;
     }
     let diff = diff_files(&args.a, &args.b, args.output.as_deref())?;
     if let Some(top) = diff.heat_top {

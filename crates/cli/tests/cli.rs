@@ -493,6 +493,20 @@ fn one_render_writes_several_outputs_and_convert_and_diff_read_them() {
         &pathlab(&["render", "-o", "a.exr", "-o", "b.tiff"]),
         "must end in .exr or .png",
     );
+    // convert and diff write images, not films.
+    let film = scratch("converted.plf");
+    for args in [
+        vec!["convert", exr.to_str().unwrap(), film.to_str().unwrap()],
+        vec![
+            "diff",
+            exr.to_str().unwrap(),
+            exr.to_str().unwrap(),
+            "-o",
+            film.to_str().unwrap(),
+        ],
+    ] {
+        assert_one_line_error(&pathlab(&args), "must end in .png or .exr");
+    }
     // convert: EXR to PNG with exposure; PNG back to EXR.
     let converted = scratch("converted.png");
     let out = pathlab(&[

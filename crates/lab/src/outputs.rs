@@ -38,6 +38,15 @@ pub fn output_format(path: &Path) -> Result<OutputFormat> {
     }
 }
 
+/// The format of an image path that `convert` and `diff` write: .exr or .png (a film is not an
+/// image).
+pub fn image_format(path: &Path) -> Result<OutputFormat> {
+    match output_format(path) {
+        Ok(f) if f != OutputFormat::Film => Ok(f),
+        _ => bail!("{}: the output must end in .png or .exr", path.display()),
+    }
+}
+
 /// An output path that can be written: its folder exists and a file can be made there
 /// (checked before rendering, so that no render is lost to a typo).
 pub fn check_writable(path: &Path) -> Result<()> {
