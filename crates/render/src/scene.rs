@@ -1,13 +1,13 @@
 //! The renderable scene: flattened shapes, the BVH over them, materials, lights and camera.
 
-use crate::accel::{Bvh8, TriBlock};
+use crate::accel::{Bvh8, TriBlock, TRIS_PER_BLOCK};
 use crate::bsdf::{Material, ShadingPoint};
 use crate::camera::Camera;
 use crate::desc::{MaterialDesc, RayKind, Rgb};
 use crate::geometry::{Aabb, Ray};
 use crate::light::{sphere_uv, Light, LightSampler};
 use crate::sdf_grid::SdfGrid;
-use crate::shape::{Sphere, Triangle};
+use crate::shape::Sphere;
 use crate::texture::{AttributeTable, TexPoint};
 use glam::{Mat3, Vec2, Vec3};
 use thiserror::Error;
@@ -110,7 +110,10 @@ pub struct BuildStats {
 /// A scene ready to render.
 #[derive(Clone, Debug)]
 pub struct Scene {
-    triangles: Vec<Triangle>,
+    /// Where each triangle's vertices are: `block · TRIS_PER_BLOCK + lane` in `blocks` (of
+    /// its first copy; the BVH's leaf blocks are the one copy of the triangles the scene
+    /// keeps).
+    tri_slot: Vec<u32>,
     /// Unit geometric normal of each triangle (its winding's side), computed once.
     tri_ng: Vec<Vec3>,
     tri_material: Vec<u32>,
@@ -175,7 +178,7 @@ impl Scene {
     /// BVH), for memory reports.
     pub fn geometry_bytes(&self) -> usize {
         use std::mem::size_of_val;
-        size_of_val(self.triangles.as_slice())
+        size_of_val(self.tri_slot.as_slice())
             + size_of_val(self.tri_ng.as_slice())
             + size_of_val(self.tri_material.as_slice())
             + size_of_val(self.tri_light.as_slice())
@@ -248,13 +251,12 @@ impl Scene {
             return (to_world * dpdu, to_world * dpdv);
         }
         let i = si.prim as usize;
-        let p = self.triangles[i].p;
+        let [_, dp0, dp1] = self.triangle_corner_and_edges(i as u32);
         let uv = self
             .tri_uv
             .get(i)
             .copied()
             .unwrap_or([Vec2::ZERO, Vec2::X, Vec2::Y]);
-        let (dp0, dp1) = (p[1] - p[0], p[2] - p[0]);
         let (duv0, duv1) = (uv[1] - uv[0], uv[2] - uv[0]);
         let det = duv0.x * duv1.y - duv0.y * duv1.x;
         if det.abs() < 1e-12 {
@@ -375,11 +377,19 @@ impl Scene {
         }
     }
 
+    /// Triangle `i`'s first vertex and its edges to the second and third, from its leaf
+    /// block.
+    #[inline(always)]
+    fn triangle_corner_and_edges(&self, i: u32) -> [Vec3; 3] {
+        let slot = self.tri_slot[i as usize] as usize;
+        self.blocks[slot / TRIS_PER_BLOCK].corner_and_edges(slot % TRIS_PER_BLOCK)
+    }
+
     /// The surface interaction at barycentrics (b1, b2) of triangle `i`, at distance `t`.
     #[inline(always)]
     fn triangle_interaction(&self, i: u32, b1: f32, b2: f32, t: f32) -> SurfaceInteraction {
-        let tri = &self.triangles[i as usize];
-        let p = (1.0 - b1 - b2) * tri.p[0] + b1 * tri.p[1] + b2 * tri.p[2];
+        let [p0, e1, e2] = self.triangle_corner_and_edges(i);
+        let p = p0 + b1 * e1 + b2 * e2;
         let ng = self.tri_ng[i as usize];
         let light = self.tri_light[i as usize];
         let uv = match self.tri_uv.get(i as usize) {

@@ -55,8 +55,7 @@ impl Scene {
             .collect();
         let all_visible = prim_visibility.iter().all(|v| *v == Visibility::ALL);
         let only_triangles = spheres.spheres.is_empty() && grids.voxels.is_empty();
-        let (blocks, block_info) =
-            leaf_blocks(&mut bvh, &prims, &triangles.triangles, &prim_visibility);
+        let leaves = leaf_blocks(&mut bvh, &prims, &triangles.triangles, &prim_visibility);
         let stats = BuildStats {
             bvh_seconds,
             bvh_nodes: bvh.node_count(),
@@ -66,7 +65,7 @@ impl Scene {
         };
         Ok(Scene {
             tri_ng: triangles.triangles.iter().map(Triangle::normal).collect(),
-            triangles: triangles.triangles,
+            tri_slot: leaves.tri_slot,
             tri_material: triangles.material,
             tri_light: triangles.light,
             tri_uv: triangles.uv,
@@ -83,8 +82,8 @@ impl Scene {
             prims,
             all_visible,
             bvh,
-            blocks,
-            block_info,
+            blocks: leaves.blocks,
+            block_info: leaves.info,
             needs_tangents: materials.iter().map(Material::needs_tangents).collect(),
             materials,
             lights: lights.lights,

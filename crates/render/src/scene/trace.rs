@@ -406,16 +406,26 @@ const SMALL_SCENE_SHAPES: u32 = 16;
 /// beyond a few dozen triangles the BVH culls more than testing them all costs.
 pub(super) const SMALL_SCENE_BLOCKS: usize = 16;
 
-/// Packs the primitives of each of `bvh`'s leaves into blocks of [`TRIS_PER_BLOCK`] and renames the
-/// leaves' ranges from leaf slots to blocks.
+/// The blocks of a scene's BVH: the primitives of each leaf packed into blocks of
+/// [`TRIS_PER_BLOCK`] (the leaves' ranges renamed from leaf slots to blocks), what each
+/// block's lanes hold, and where each triangle sits (`block · TRIS_PER_BLOCK + lane` of its
+/// first copy; `u32::MAX` for a triangle the BVH left out).
+pub(super) struct LeafBlocks {
+    pub blocks: Vec<TriBlock>,
+    pub info: Vec<BlockInfo>,
+    pub tri_slot: Vec<u32>,
+}
+
+/// Packs the primitives of each of `bvh`'s leaves into blocks (see [`LeafBlocks`]).
 pub(super) fn leaf_blocks(
     bvh: &mut Bvh8,
     prims: &[Prim],
     triangles: &[Triangle],
     visibility: &[Visibility],
-) -> (Vec<TriBlock>, Vec<BlockInfo>) {
+) -> LeafBlocks {
     let mut blocks = Vec::with_capacity(prims.len() / 2 + 1);
     let mut info = Vec::with_capacity(prims.len() / 2 + 1);
+    let mut tri_slot = vec![u32::MAX; triangles.len()];
     bvh.remap_leaves(|start, count| {
         let first = blocks.len() as u32;
         for chunk_start in (start..start + count).step_by(TRIS_PER_BLOCK) {
@@ -430,7 +440,12 @@ pub(super) fn leaf_blocks(
             for (lane, slot) in chunk.enumerate() {
                 lanes.slots[lane] = slot;
                 match prims[slot as usize] {
-                    Prim::Triangle(t) => tris[lane] = triangles[t as usize],
+                    Prim::Triangle(t) => {
+                        tris[lane] = triangles[t as usize];
+                        if tri_slot[t as usize] == u32::MAX {
+                            tri_slot[t as usize] = (blocks.len() * TRIS_PER_BLOCK + lane) as u32;
+                        }
+                    }
                     Prim::Sphere(_) | Prim::Voxel(_) => lanes.shapes |= 1 << lane,
                 }
                 let v = visibility[slot as usize];
@@ -442,7 +457,11 @@ pub(super) fn leaf_blocks(
         }
         (first, blocks.len() as u32 - first)
     });
-    (blocks, info)
+    LeafBlocks {
+        blocks,
+        info,
+        tri_slot,
+    }
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@
 use crate::geometry::Ray;
 use crate::shape::Triangle;
 use crate::simd::lanes::{F8, V8};
+use glam::Vec3;
 
 /// Triangles per leaf block, tested against a ray at once (the BVH's width is `Bvh8`'s 8,
 /// the path tracer's [`pathlab_mc::simd::PATH_LANES`]).
@@ -70,6 +71,14 @@ impl TriBlock {
             }
         }
         b
+    }
+
+    /// Lane `lane`'s first vertex and its edges to the second and third, as the tests use
+    /// them (the scene's surface interactions read its triangles from here).
+    #[inline(always)]
+    pub fn corner_and_edges(&self, lane: usize) -> [Vec3; 3] {
+        let at = |a: &[[f32; TRIS_PER_BLOCK]; 3]| Vec3::new(a[0][lane], a[1][lane], a[2][lane]);
+        [at(&self.v0), at(&self.e1), at(&self.e2)]
     }
 
     /// Tests all four lanes: in SSE registers on x86-64 (the comparisons too, which the

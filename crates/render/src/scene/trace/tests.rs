@@ -198,7 +198,7 @@ fn spatial_splits_find_what_testing_every_shape_finds() {
     };
     let scene = Scene::build(&desc).unwrap();
     // Some triangles sit in several leaves.
-    assert!(scene.prims.len() > scene.triangles.len() + 1);
+    assert!(scene.prims.len() > scene.tri_slot.len() + 1);
     agrees_with_testing_every_shape(&scene, &desc, &mut point);
 }
 
@@ -295,10 +295,10 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
                 let Prim::Triangle(i) = scene.prims[slot as usize] else {
                     panic!("a shape other than the BVH's at lane {i}")
                 };
-                assert_eq!(
-                    scene.triangles[i as usize].intersect(ray).map(|h| h.t),
-                    Some(t)
-                );
+                let at = scene.tri_slot[i as usize] as usize;
+                let block = &scene.blocks[at / TRIS_PER_BLOCK];
+                let own = block.intersect(ray, 1 << (at % TRIS_PER_BLOCK));
+                assert_eq!(own.map(|h| h.t), Some(t));
                 ties += 1;
             }
         }
@@ -363,7 +363,7 @@ fn every_simd_level_finds_the_same_triangles_to_the_bit() {
     });
     let scene = Scene::build(&desc).unwrap();
     assert!(scene.tests_every_primitive());
-    assert_eq!(scene.triangles.len() % 2, 1);
+    assert_eq!(scene.tri_slot.len() % 2, 1);
     let mut rng = pathlab_mc::rng::Pcg32::new(11, 3);
     let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
     let bits = |n: &Nearest| [n.t, n.b1, n.b2, n.slot].map(|f| f.0.map(f32::to_bits));
