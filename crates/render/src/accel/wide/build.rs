@@ -215,7 +215,7 @@ fn build_binary(
         (Some(o), Some(split))
             if budget > 0
                 && n >= SPLIT_MIN_REFS
-                && o.overlap(prims, &centroids) > SPLIT_OVERLAP * builder.root_area =>
+                && o.overlap > SPLIT_OVERLAP * builder.root_area =>
         {
             find_spatial_split(prims, params, &bounds, split).filter(|s| s.cost < o.cost)
         }
@@ -293,7 +293,7 @@ fn build_binary(
 
 /// SAH cost of testing `n` primitives, in blocks of `params.leaf_block`.
 #[inline]
-pub(super) fn blocks(n: usize, params: &BvhParams) -> f32 {
+fn blocks(n: usize, params: &BvhParams) -> f32 {
     n.div_ceil(params.leaf_block.max(1)) as f32
 }
 
@@ -310,22 +310,8 @@ pub(super) struct ObjectSplit {
     bin: usize,
     /// SAH cost, relative to one leaf block test.
     pub(super) cost: f32,
-}
-
-impl ObjectSplit {
-    /// The surface area of the box where the two sides' boxes overlap.
-    fn overlap(&self, prims: &[BuildPrim], centroids: &Aabb) -> f32 {
-        let (lo, extent) = (centroids.min[self.axis], centroids.extent()[self.axis]);
-        let (mut left, mut right) = (Aabb::EMPTY, Aabb::EMPTY);
-        for p in prims {
-            if bin_of(p.centroid[self.axis], lo, extent) <= self.bin {
-                left = left.union(p.bounds);
-            } else {
-                right = right.union(p.bounds);
-            }
-        }
-        left.intersection(right).surface_area()
-    }
+    /// Surface area of the box where the two sides' boxes overlap.
+    overlap: f32,
 }
 
 /// The best SAH split of `prims` by their centroids' bins.
@@ -352,7 +338,15 @@ fn find_split(
         }
         let sweep = sah_sweep(&bin_bounds, &bin_count, &bin_count, params, area);
         if let Some((bin, cost)) = sweep.filter(|s| best.as_ref().is_none_or(|b| s.1 < b.cost)) {
-            best = Some(ObjectSplit { axis, bin, cost });
+            // The sides' boxes: the unions of their bins' boxes.
+            let side = |bins: &[Aabb]| bins.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+            let (left, right) = (side(&bin_bounds[..=bin]), side(&bin_bounds[bin + 1..]));
+            best = Some(ObjectSplit {
+                axis,
+                bin,
+                cost,
+                overlap: left.intersection(right).surface_area(),
+            });
         }
     }
     best

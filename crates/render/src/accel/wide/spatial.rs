@@ -131,12 +131,14 @@ pub(super) fn spatial_partition(
 ) -> Option<(usize, usize)> {
     let (axis, pos) = (s.axis, s.pos);
     let crosses = |p: &BuildPrim| p.bounds.min[axis] < pos && p.bounds.max[axis] > pos;
-    let crossing = refs[..n].iter().filter(|p| crosses(p)).count();
-    let below = refs[..n]
-        .iter()
-        .filter(|p| p.bounds.max[axis] <= pos)
-        .count();
-    if crossing > refs.len() - n || below + crossing >= n || n - below >= n {
+    let (mut below, mut crossing) = (0, 0);
+    for p in &refs[..n] {
+        below += usize::from(p.bounds.max[axis] <= pos);
+        crossing += usize::from(crosses(p));
+    }
+    // Every reference on the left (crossing ones included), or on the right (none wholly
+    // below), would make no progress.
+    if crossing > refs.len() - n || below + crossing >= n || below == 0 {
         return None;
     }
     let piece = |bounds: Aabb, index: u32| BuildPrim {
