@@ -56,6 +56,44 @@ enum Prim {
     Voxel(u32),
 }
 
+/// A triangle's material and light ([`NO_LIGHT`] for none).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct TriSurface {
+    material: u32,
+    light: u32,
+}
+
+/// A [`Prim`] in 32 bits, as the scene keeps one per BVH leaf slot: its kind in the top two
+/// bits and its index in the others (indices are below the BVH's
+/// [`crate::accel::MAX_PRIMITIVES`], 2²⁷).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct PackedPrim(u32);
+
+impl PackedPrim {
+    /// Bits of the index.
+    const INDEX_BITS: u32 = 30;
+
+    fn new(p: Prim) -> PackedPrim {
+        let (kind, i) = match p {
+            Prim::Triangle(i) => (0, i),
+            Prim::Sphere(i) => (1, i),
+            Prim::Voxel(i) => (2, i),
+        };
+        debug_assert!(i < 1 << Self::INDEX_BITS);
+        PackedPrim(kind << Self::INDEX_BITS | i)
+    }
+
+    #[inline(always)]
+    fn get(self) -> Prim {
+        let i = self.0 & ((1 << Self::INDEX_BITS) - 1);
+        match self.0 >> Self::INDEX_BITS {
+            0 => Prim::Triangle(i),
+            1 => Prim::Sphere(i),
+            _ => Prim::Voxel(i),
+        }
+    }
+}
+
 /// A voxel of an SDF grid: which grid, and the voxel's lower corner in its samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Voxel {
@@ -116,8 +154,11 @@ pub struct Scene {
     tri_slot: Vec<u32>,
     /// Unit geometric normal of each triangle (its winding's side), computed once.
     tri_ng: Vec<Vec3>,
-    tri_material: Vec<u32>,
-    tri_light: Vec<u32>,
+    /// Each triangle's material and light, as an index into `tri_surfaces`.
+    tri_surface: Vec<u32>,
+    /// The (material, light) pairs of the triangles: entry `m` is material `m` without a
+    /// light, then one entry per emitting triangle.
+    tri_surfaces: Vec<TriSurface>,
     /// Per-triangle vertex texture coordinates (empty when no mesh has any).
     tri_uv: Vec<[Vec2; 3]>,
     /// Per-triangle vertex normals for smooth shading (empty when no mesh has any; a mesh
@@ -135,7 +176,7 @@ pub struct Scene {
     only_triangles: bool,
     /// Mesh attributes read by textures, per triangle corner.
     attributes: Vec<AttributeTable>,
-    prims: Vec<Prim>,
+    prims: Vec<PackedPrim>,
     /// Whether every primitive is seen by every ray (the common case, checked once).
     all_visible: bool,
     /// The BVH, whose leaves name ranges of `blocks`.
@@ -180,8 +221,8 @@ impl Scene {
         use std::mem::size_of_val;
         size_of_val(self.tri_slot.as_slice())
             + size_of_val(self.tri_ng.as_slice())
-            + size_of_val(self.tri_material.as_slice())
-            + size_of_val(self.tri_light.as_slice())
+            + size_of_val(self.tri_surface.as_slice())
+            + size_of_val(self.tri_surfaces.as_slice())
             + size_of_val(self.tri_uv.as_slice())
             + size_of_val(self.tri_normals.as_slice())
             + size_of_val(self.spheres.as_slice())
@@ -370,7 +411,7 @@ impl Scene {
         b2: f32,
         si: &mut Option<SurfaceInteraction>,
     ) {
-        match self.prims[slot as usize] {
+        match self.prims[slot as usize].get() {
             Prim::Triangle(i) => *si = Some(self.triangle_interaction(i, b1, b2, t)),
             Prim::Sphere(i) => *si = Some(self.sphere_interaction(i, ray, t)),
             Prim::Voxel(i) => *si = Some(self.voxel_interaction(i, ray, t)),
@@ -391,7 +432,8 @@ impl Scene {
         let [p0, e1, e2] = self.triangle_corner_and_edges(i);
         let p = p0 + b1 * e1 + b2 * e2;
         let ng = self.tri_ng[i as usize];
-        let light = self.tri_light[i as usize];
+        let TriSurface { material, light } =
+            self.tri_surfaces[self.tri_surface[i as usize] as usize];
         let uv = match self.tri_uv.get(i as usize) {
             Some(uv) => (1.0 - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2],
             None => Vec2::new(b1, b2),
@@ -408,7 +450,7 @@ impl Scene {
             t,
             ng,
             ns,
-            material: self.tri_material[i as usize],
+            material,
             light: (light != NO_LIGHT).then_some(light),
             uv,
             prim: i,
@@ -496,6 +538,84 @@ mod tests {
             ..Default::default()
         };
         Scene::build(&desc).unwrap()
+    }
+
+    #[test]
+    fn packed_primitives_keep_their_kind_and_index() {
+        let max = (1 << PackedPrim::INDEX_BITS) - 1;
+        for p in [
+            Prim::Triangle(0),
+            Prim::Triangle(max),
+            Prim::Sphere(0),
+            Prim::Sphere(12345),
+            Prim::Voxel(1),
+            Prim::Voxel(max),
+        ] {
+            assert_eq!(PackedPrim::new(p).get(), p);
+        }
+    }
+
+    /// Quads side by side along x, each its own mesh with its own material; some emit.
+    fn quads(emitting: &[bool]) -> Scene {
+        let meshes = emitting
+            .iter()
+            .enumerate()
+            .map(|(k, &emits)| {
+                let x = 2.0 * k as f32;
+                MeshDesc {
+                    name: format!("quad {k}"),
+                    positions: vec![
+                        Vec3::new(x, 0.0, 0.0),
+                        Vec3::new(x + 1.0, 0.0, 0.0),
+                        Vec3::new(x + 1.0, 1.0, 0.0),
+                        Vec3::new(x, 1.0, 0.0),
+                    ],
+                    indices: vec![0, 1, 2, 0, 2, 3],
+                    material: k,
+                    emission: emits.then_some(crate::desc::Emission {
+                        radiance: Vec3::splat(1.0 + k as f32),
+                        two_sided: false,
+                    }),
+                    ..Default::default()
+                }
+            })
+            .collect();
+        let desc = SceneDesc {
+            meshes,
+            materials: (0..emitting.len())
+                .map(|k| diffuse(Vec3::splat(0.1 * k as f32), false))
+                .collect(),
+            resolution: [4, 4],
+            ..Default::default()
+        };
+        Scene::build(&desc).unwrap()
+    }
+
+    #[test]
+    fn each_triangle_reports_its_material_and_its_own_light() {
+        let emitting = [false, true, false, true, true, false];
+        let scene = quads(&emitting);
+        let mut lights_seen = Vec::new();
+        for (k, &emits) in emitting.iter().enumerate() {
+            // Both triangles of quad k.
+            for (dx, dy) in [(0.7, 0.2), (0.2, 0.7)] {
+                let o = Vec3::new(2.0 * k as f32 + dx, dy, 1.0);
+                let si = scene.intersect(&Ray::new(o, -Vec3::Z)).0.unwrap();
+                assert_eq!(si.material, k as u32, "quad {k}");
+                assert_eq!(si.light.is_some(), emits, "quad {k}");
+                if let Some(light) = si.light {
+                    assert!((light as usize) < scene.lights().len());
+                    lights_seen.push(light);
+                }
+            }
+        }
+        // Every emitting triangle is a light of its own.
+        let n = lights_seen.len();
+        lights_seen.sort_unstable();
+        lights_seen.dedup();
+        assert_eq!((n, lights_seen.len()), (6, 6));
+        // One table entry per material, and one per emitting triangle.
+        assert_eq!(scene.tri_surfaces.len(), emitting.len() + 6);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! position, the SDF grids, the BVH with every array laid out in its leaf order, and last the
 //! lights at infinity, which need the scene's bounds.
 
-use super::{permute, Prim, Scene, SceneError, Voxel, NO_LIGHT};
+use super::{permute, PackedPrim, Prim, Scene, SceneError, TriSurface, Voxel, NO_LIGHT};
 use crate::accel::{split_box, Bvh8, BvhParams, MAX_PRIMITIVES, TRIS_PER_BLOCK};
 use crate::bsdf::Material;
 use crate::camera::Camera;
@@ -56,6 +56,8 @@ impl Scene {
         let all_visible = prim_visibility.iter().all(|v| *v == Visibility::ALL);
         let only_triangles = spheres.spheres.is_empty() && grids.voxels.is_empty();
         let leaves = leaf_blocks(&mut bvh, &prims, &triangles.triangles, &prim_visibility);
+        let (tri_surface, tri_surfaces) =
+            surface_table(&triangles.material, &triangles.light, materials.len());
         let stats = BuildStats {
             bvh_seconds,
             bvh_nodes: bvh.node_count(),
@@ -66,8 +68,8 @@ impl Scene {
         Ok(Scene {
             tri_ng: triangles.triangles.iter().map(Triangle::normal).collect(),
             tri_slot: leaves.tri_slot,
-            tri_material: triangles.material,
-            tri_light: triangles.light,
+            tri_surface,
+            tri_surfaces,
             tri_uv: triangles.uv,
             tri_normals: triangles.normals,
             spheres: spheres.spheres,
@@ -79,7 +81,7 @@ impl Scene {
             voxels: grids.voxels,
             only_triangles,
             attributes: triangles.attributes,
-            prims,
+            prims: prims.into_iter().map(PackedPrim::new).collect(),
             all_visible,
             bvh,
             blocks: leaves.blocks,
@@ -195,6 +197,31 @@ impl Lights {
             _ => NO_LIGHT,
         }
     }
+}
+
+/// Each triangle's (material, light) as an index into a table of pairs: entry `m` of the
+/// table is material `m` (of `materials`) without a light, and each emitting triangle has an
+/// entry of its own. One index per triangle instead of two.
+fn surface_table(material: &[u32], light: &[u32], materials: usize) -> (Vec<u32>, Vec<TriSurface>) {
+    let mut table: Vec<TriSurface> = (0..materials as u32)
+        .map(|material| TriSurface {
+            material,
+            light: NO_LIGHT,
+        })
+        .collect();
+    let index = material
+        .iter()
+        .zip(light)
+        .map(|(&material, &light)| {
+            if light == NO_LIGHT && (material as usize) < materials {
+                material
+            } else {
+                table.push(TriSurface { material, light });
+                table.len() as u32 - 1
+            }
+        })
+        .collect();
+    (index, table)
 }
 
 /// Every mesh's triangles, with what each carries, in one array per property.

@@ -70,18 +70,29 @@ impl Hit {
     }
 }
 
-/// What a [`TriBlock`]'s lanes hold: their primitives' leaf slots and which lanes are
-/// other shapes than triangles (tested one by one) or seen by camera and other rays.
+/// What a [`TriBlock`]'s lanes hold: their primitives' leaf slots (consecutive: lane `i`
+/// holds slot `first_slot + i`), and which lanes are used, other shapes than triangles
+/// (tested one by one), or seen by camera and other rays.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BlockInfo {
-    /// Leaf slot of each lane's primitive (`u32::MAX` for an unused lane).
-    slots: [u32; TRIS_PER_BLOCK],
+    /// Leaf slot of lane 0's primitive.
+    first_slot: u32,
+    /// Lanes that hold a primitive (the first ones).
+    used: u8,
     /// Lanes that hold other shapes than triangles.
     shapes: u8,
     /// Lanes seen by camera rays.
     camera: u8,
     /// Lanes seen by other rays.
     indirect: u8,
+}
+
+impl BlockInfo {
+    /// Leaf slot of lane `lane`'s primitive.
+    #[inline(always)]
+    fn slot(&self, lane: usize) -> u32 {
+        self.first_slot + lane as u32
+    }
 }
 
 impl Scene {
@@ -105,7 +116,7 @@ impl Scene {
     /// Where `ray` meets the shape (not a triangle) in leaf slot `slot` within its extent.
     #[inline]
     fn shape_hit(&self, slot: u32, ray: &Ray) -> Option<f32> {
-        match self.prims[slot as usize] {
+        match self.prims[slot as usize].get() {
             Prim::Sphere(s) => self.spheres[s as usize].intersect(ray),
             Prim::Voxel(v) => {
                 let voxel = self.voxels[v as usize];
@@ -175,7 +186,7 @@ impl Scene {
                 let (triangles, shapes) = self.block_lanes(b, kind);
                 if let Some(h) = self.blocks[b].intersect(r, triangles) {
                     r.t_max = h.t;
-                    (slot, b1, b2) = (self.block_info[b].slots[h.lane], h.b1, h.b2);
+                    (slot, b1, b2) = (self.block_info[b].slot(h.lane), h.b1, h.b2);
                     any = true;
                 }
                 if shapes != 0 {
@@ -201,7 +212,7 @@ impl Scene {
         while shapes != 0 {
             let lane = shapes.trailing_zeros() as usize;
             shapes &= shapes - 1;
-            let slot = self.block_info[b].slots[lane];
+            let slot = self.block_info[b].slot(lane);
             if let Some(t) = self.shape_hit(slot, ray) {
                 ray.t_max = t;
                 nearest = Some(slot);
@@ -218,10 +229,7 @@ impl Scene {
         while shapes != 0 {
             let lane = shapes.trailing_zeros() as usize;
             shapes &= shapes - 1;
-            if self
-                .shape_hit(self.block_info[b].slots[lane], ray)
-                .is_some()
-            {
+            if self.shape_hit(self.block_info[b].slot(lane), ray).is_some() {
                 return true;
             }
         }
@@ -340,8 +348,8 @@ impl Scene {
             while shapes != 0 {
                 let lane = shapes.trailing_zeros() as usize;
                 shapes &= shapes - 1;
-                let slot = info.slots[lane];
-                let t: [f32; W] = match self.prims[slot as usize] {
+                let slot = info.slot(lane);
+                let t: [f32; W] = match self.prims[slot as usize].get() {
                     Prim::Sphere(k) => self.spheres[k as usize].intersect_lanes(
                         &rays.o,
                         &rays.d,
@@ -375,9 +383,9 @@ impl Scene {
     #[inline(always)]
     fn for_each_triangle<'a>(&'a self, mut f: impl FnMut(&'a TriBlock, usize, u32)) {
         for (block, info) in self.blocks.iter().zip(&self.block_info) {
-            for (lane, &slot) in info.slots.iter().enumerate() {
-                if slot != u32::MAX && info.shapes & (1 << lane) == 0 {
-                    f(block, lane, slot);
+            for lane in 0..TRIS_PER_BLOCK {
+                if (info.used & !info.shapes) & (1 << lane) != 0 {
+                    f(block, lane, info.slot(lane));
                 }
             }
         }
@@ -431,14 +439,15 @@ pub(super) fn leaf_blocks(
         for chunk_start in (start..start + count).step_by(TRIS_PER_BLOCK) {
             let chunk = chunk_start..(chunk_start + TRIS_PER_BLOCK as u32).min(start + count);
             let mut lanes = BlockInfo {
-                slots: [u32::MAX; TRIS_PER_BLOCK],
+                first_slot: chunk_start,
+                used: 0,
                 shapes: 0,
                 camera: 0,
                 indirect: 0,
             };
             let mut tris = [Triangle { p: [Vec3::ZERO; 3] }; TRIS_PER_BLOCK];
             for (lane, slot) in chunk.enumerate() {
-                lanes.slots[lane] = slot;
+                lanes.used |= 1 << lane;
                 match prims[slot as usize] {
                     Prim::Triangle(t) => {
                         tris[lane] = triangles[t as usize];

@@ -287,12 +287,12 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
             let Some((slot, t, b1, b2)) = lane else {
                 continue;
             };
-            spheres += usize::from(matches!(scene.prims[slot as usize], Prim::Sphere(_)));
+            spheres += usize::from(matches!(scene.prims[slot as usize].get(), Prim::Sphere(_)));
             if slot == bvh.slot() {
                 assert_eq!((b1, b2), bvh.barycentrics());
             } else {
                 // Another triangle at exactly the same distance (a shared edge).
-                let Prim::Triangle(i) = scene.prims[slot as usize] else {
+                let Prim::Triangle(i) = scene.prims[slot as usize].get() else {
                     panic!("a shape other than the BVH's at lane {i}")
                 };
                 let at = scene.tri_slot[i as usize] as usize;
