@@ -33,12 +33,30 @@ def embree(m):
         for t, v in rates.items()}
 
 
+def embree_bytes(m):
+    """Embree's bytes per triangle with its vertex and index buffers (embree_memory's output),
+    or None where it was not measured."""
+    try:
+        text = open(f"{work}/{m}.embree_memory.txt").read()
+    except OSError:
+        return None
+    found = re.search(r"with_buffers_bytes_per_triangle ([0-9.]+)", text)
+    return float(found.group(1)) if found else None
+
+
 ours_of = {m: median_json([json.load(open(f"{work}/{m}.pathlab.{k}.json"))
                            for k in range(1, reps + 1)]) for m in meshes}
+def bytes_cell(ours, theirs):
+    """pathlab's bytes per triangle, Embree's and their ratio (pathlab's alone without it)."""
+    if theirs is None:
+        return f"{ours:5.0f}/{'-':<5} {'':>6}"
+    return f"{ours:5.0f}/{theirs:<5.0f} {ours / theirs:6.2f}"
+
+
 rows = []
 print(f"{'mesh':<12} {'tris':>8} | {'build s':>16} {'ratio':>6} | "
       f"{'primary 1T Mrays/s':>19} {'ratio':>6} | {'bounce 1T Mrays/s':>18} {'ratio':>6} | "
-      f"{'bounce NT':>13} {'ratio':>6} | {'B/tri':>6} {'agree %':>8}")
+      f"{'bounce NT':>13} {'ratio':>6} | {'B/tri':>11} {'ratio':>6} | {'agree %':>8}")
 for m in meshes:
     build, per_thread = embree(m)
     e1, en = per_thread[1], per_thread[max(per_thread)]
@@ -51,9 +69,11 @@ for m in meshes:
     print(f"{m:<12} {ours['triangles']:>8} | {ours['bvh_build_seconds']:7.3f}/{build:<8.3f} "
           f"{ours['bvh_build_seconds'] / build:6.2f} | {p1:8.2f}/{e1[0]:<10.2f} {p1 / e1[0]:6.2f} | "
           f"{b1:7.2f}/{e1[1]:<10.2f} {b1 / e1[1]:6.2f} | {bn:5.2f}/{en[1]:<7.2f} {bn / en[1]:6.2f} | "
-          f"{ours['bytes_per_triangle']:6.0f} {agree:8.4f}")
+          f"{bytes_cell(ours['bytes_per_triangle'], embree_bytes(m))} | {agree:8.4f}")
 print("(each cell: pathlab/Embree, medians of", reps, "runs taken in turns; ratio = pathlab / Embree,"
-      " so > 1 is faster throughput, < 1 is faster build)")
+      " so > 1 is faster throughput, < 1 is faster build or less memory)")
+print("(B/tri: pathlab's geometry bytes per triangle, everything its surface interactions read"
+      " included; Embree's acceleration structure with its vertex and index buffers)")
 
 # The obvhs crate's compressed wide BVH on the same rays, where pathlab was built with it.
 rows = [(m, ours_of[m]) for m in meshes]

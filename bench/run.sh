@@ -34,6 +34,7 @@ apt_install() {
 if [ "$what" = all ] || [ "$what" = rays ]; then
     [ -e /usr/include/embree3/rtcore.h ] || apt_install libembree-dev
     cc -O3 -o "$work/embree_bench" "$shared/tools/embree-bench/embree_bench.c" -lembree3 -lpthread -lm
+    cc -O2 -o "$work/embree_memory" "$root/bench/embree_memory.c" -lembree3
     meshes=()
     for spec in "blob 200000" "blob 1000000" "soup 100000"; do
         set -- $spec
@@ -50,6 +51,9 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
     # takes each rate's median, so that one disturbed run moves no ratio.
     reps="${PATHLAB_BENCH_REPS:-3}"
     for m in "${meshes[@]}"; do
+        # Embree's bytes per triangle (its memory monitor), once: the build's memory does
+        # not vary by more than its allocator's blocks.
+        "$work/embree_memory" "$work/$m.obj" > "$work/$m.embree_memory.txt"
         for rep in $(seq "$reps"); do
             "$work/embree_bench" "$work/$m.obj" "$threads" "$work/$m.rays" > "$work/$m.embree.$rep.txt"
             "$bench" rays "$work/$m.obj" "$work/$m.rays" --repeat 5 --json > "$work/$m.pathlab.$rep.json"

@@ -54,6 +54,11 @@ struct RaysArgs {
     /// Print the results as JSON.
     #[arg(long)]
     json: bool,
+    /// Only the scene's hit distances on one thread (no parallel run, no surface
+    /// interactions, no baselines, no check against Embree's hits): for timing two builds
+    /// in turns.
+    #[arg(long)]
+    quick: bool,
 }
 
 /// One ray of the file: origin, unit direction, the start of its extent and Embree's hit
@@ -122,29 +127,49 @@ enum Query {
     Interaction,
 }
 
-/// Hit distances of every ray (infinite for a miss), measured from the file's origin.
+/// Hit distances of every ray (infinite for a miss), measured from the file's origin, written
+/// to `hits` (as long as `rays`; written before the clock starts, as the Embree benchmark's
+/// copy of its rays is, so that no run pays for first touching its pages).
 fn trace_all(
     scene: &Scene,
     rays: &[FileRay],
     pool: Option<&rayon::ThreadPool>,
     query: Query,
-) -> Vec<f32> {
-    let one = |r: &FileRay| {
+    hits: &mut [f32],
+) {
+    let one = |(r, hit): (&FileRay, &mut f32)| {
         let ray = to_ray(r);
-        match query {
+        *hit = match query {
             Query::Distance => scene.hit_distance(&ray),
             Query::Interaction => scene.intersect(&ray).0.map(|si| si.t),
         }
-        .unwrap_or(f32::INFINITY)
+        .unwrap_or(f32::INFINITY);
     };
     match pool {
-        None => rays.iter().map(one).collect(),
-        Some(pool) => pool.install(|| rays.par_iter().with_min_len(4096).map(one).collect()),
+        None => rays.iter().zip(hits.iter_mut()).for_each(one),
+        Some(pool) => pool.install(|| {
+            rays.par_iter()
+                .zip(hits.par_iter_mut())
+                .with_min_len(4096)
+                .for_each(one)
+        }),
     }
+}
+
+/// Best throughput in Mrays/s over `repeat` runs of `trace`, which traces all `count` rays.
+fn timed_into(count: usize, repeat: u32, mut trace: impl FnMut()) -> f64 {
+    let mut best = 0.0f64;
+    for _ in 0..repeat.max(1) {
+        let start = Instant::now();
+        trace();
+        best = best.max(count as f64 / start.elapsed().as_secs_f64() / 1e6);
+    }
+    best
 }
 
 /// Best throughput in Mrays/s over `repeat` runs of `trace` (which traces all `count` rays and
 /// returns their hit distances), and the hits of the last run.
+#[cfg(feature = "obvhs")]
 fn timed(count: usize, repeat: u32, mut trace: impl FnMut() -> Vec<f32>) -> (f64, Vec<f32>) {
     let mut best = 0.0f64;
     let mut hits = Vec::new();
@@ -256,11 +281,17 @@ fn rays(args: &RaysArgs) -> Result<()> {
     let mut sets = Vec::new();
     for (name, rays) in [("primary", &primary), ("bounce", &bounce)] {
         let run = |pool, query| {
-            timed(rays.len(), args.repeat, || {
-                trace_all(&scene, rays, pool, query)
-            })
+            let mut hits = vec![0.0f32; rays.len()];
+            let rate = timed_into(rays.len(), args.repeat, || {
+                trace_all(&scene, rays, pool, query, &mut hits)
+            });
+            (rate, hits)
         };
         let (one, hits) = run(None, Query::Distance);
+        if args.quick {
+            sets.push(json!({"rays": name, "count": rays.len(), "mrays_per_s_1_thread": one}));
+            continue;
+        }
         let (all, _) = run(Some(&pool), Query::Distance);
         let (with_interaction, full_hits) = run(None, Query::Interaction);
         let agree = agreement(rays, &hits).min(agreement(rays, &full_hits));
@@ -278,6 +309,10 @@ fn rays(args: &RaysArgs) -> Result<()> {
             "agreement": agree as f64 / rays.len().max(1) as f64,
             "nodes_per_ray": visited as f64 / rays.len().max(1) as f64,
         }));
+    }
+    if args.quick {
+        println!("{}", serde_json::to_string_pretty(&json!({"sets": sets}))?);
+        return Ok(());
     }
     let baseline = binary_baseline(&desc, &primary, &bounce, args.repeat);
     let bytes_per_triangle = scene.geometry_bytes() as f64 / stats.triangles as f64;
