@@ -26,16 +26,23 @@ fn gltf_json(bytes: &[u8]) -> Option<&[u8]> {
     (kind == 0x4E4F_534A).then(|| bytes.get(20..20 + length))?
 }
 
-/// That every mesh primitive's `POSITION` names an existing accessor: the `gltf` crate's
-/// validation reads that accessor before checking the index (and panics on a bad one).
-/// Anything else is left to the crate.
-fn check_position_accessors(bytes: &[u8]) -> Result<(), String> {
+/// What the `gltf` crate's import is not asked to judge, checked on the JSON first (anything
+/// else is left to the crate): that every mesh primitive's `POSITION` names an existing
+/// accessor, and that the files the buffers and images name can be read.
+fn check_before_import(path: &Path, bytes: &[u8]) -> Result<(), String> {
     let Some(json) = gltf_json(bytes) else {
         return Ok(());
     };
     let Ok(root) = serde_json::from_slice::<serde_json::Value>(json) else {
         return Ok(());
     };
+    check_position_accessors(&root)?;
+    check_referenced_files(path, &root)
+}
+
+/// That every mesh primitive's `POSITION` names an existing accessor: the `gltf` crate's
+/// validation reads that accessor before checking the index (and panics on a bad one).
+fn check_position_accessors(root: &serde_json::Value) -> Result<(), String> {
     let accessors = root["accessors"].as_array().map_or(0, Vec::len);
     for (m, mesh) in root["meshes"].as_array().into_iter().flatten().enumerate() {
         for (p, prim) in mesh["primitives"]
@@ -56,11 +63,66 @@ fn check_position_accessors(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
+/// That the files the buffers and images name (relative URIs, beside the glTF file; not
+/// `data:` URIs) can be read: the crate's import reports a missing one as an I/O error
+/// without its name.
+fn check_referenced_files(path: &Path, root: &serde_json::Value) -> Result<(), String> {
+    let dir = path.parent().unwrap_or(Path::new(""));
+    for kind in ["buffers", "images"] {
+        for (i, item) in root[kind].as_array().into_iter().flatten().enumerate() {
+            let Some(uri) = item["uri"].as_str() else {
+                continue;
+            };
+            if uri.starts_with("data:") {
+                continue;
+            }
+            let Some(name) = percent_decoded(uri) else {
+                return Err(format!(
+                    "{kind}[{i}] names '{uri}', whose escapes decode to no UTF-8 text"
+                ));
+            };
+            let file = dir.join(name);
+            if let Err(e) = std::fs::metadata(&file) {
+                return Err(format!(
+                    "{kind}[{i}] names '{uri}', which cannot be read ({}: {e})",
+                    file.display()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A URI's percent-escapes (`%20`) decoded, as glTF's relative URIs are written (a malformed
+/// escape is kept as it is); `None` where the result is not UTF-8.
+fn percent_decoded(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (bytes[i], hex) {
+            (b'%', Some(b)) => {
+                out.push(b);
+                i += 3;
+            }
+            (b, _) => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
 /// Loads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<SceneDesc, Error> {
     let err = |message: String| parse_error(path, message);
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    check_position_accessors(&bytes).map_err(err)?;
+    check_before_import(path, &bytes).map_err(err)?;
     let (doc, buffers, images) = gltf::import(path).map_err(|e| match e {
         gltf::Error::Io(io) => Error::io(path, io),
         other => err(format!("not a valid glTF file: {other}")),

@@ -29,6 +29,22 @@ fn read_obj(path: &Path) -> Result<(Vec<tobj::Model>, MtlResult), Error> {
     .map_err(|e| obj_error(path, e))
 }
 
+/// The MTL files an OBJ file's `mtllib` lines name that do not exist beside it (for the
+/// warning when its materials cannot be read: `tobj`'s error does not name the file).
+fn missing_mtl_files(path: &Path) -> Vec<String> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Vec::new();
+    };
+    text.lines()
+        .filter_map(|l| l.trim_start().strip_prefix("mtllib"))
+        .filter(|rest| rest.starts_with([' ', '\t']))
+        .flat_map(str::split_whitespace)
+        .filter(|name| !dir.join(name).exists())
+        .map(str::to_string)
+        .collect()
+}
+
 /// Loads a Wavefront OBJ file and the MTL files it names.
 pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
     let (models, materials) = read_obj(path)?;
@@ -36,8 +52,14 @@ pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
     let mtl = match materials {
         Ok(m) => m,
         Err(e) => {
+            let missing = missing_mtl_files(path);
+            let why = if missing.is_empty() {
+                e.to_string()
+            } else {
+                format!("{} not found beside the OBJ file ({e})", missing.join(", "))
+            };
             desc.warnings
-                .push(format!("materials: {e}; using grey diffuse"));
+                .push(format!("materials: {why}; using grey diffuse"));
             Vec::new()
         }
     };

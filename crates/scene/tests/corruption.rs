@@ -389,9 +389,8 @@ fn base64(bytes: &[u8]) -> String {
     out
 }
 
-/// A glTF 2.0 file of one triangle (positions and indices in an embedded buffer), a camera
-/// and an emissive material.
-fn gltf_triangle() -> String {
+/// The buffer of [`gltf_triangle`]: three positions and the indices (padded to 44 bytes).
+fn triangle_buffer() -> Vec<u8> {
     let mut buffer = Vec::new();
     for c in [0.0f32, 0., 0., 1., 0., 0., 0., 1., 0.] {
         buffer.extend(c.to_le_bytes());
@@ -399,6 +398,21 @@ fn gltf_triangle() -> String {
     for i in [0u16, 1, 2, 0] {
         buffer.extend(i.to_le_bytes());
     }
+    buffer
+}
+
+/// A glTF 2.0 file of one triangle (positions and indices in an embedded buffer), a camera
+/// and an emissive material.
+fn gltf_triangle() -> String {
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64(&triangle_buffer())
+    );
+    gltf_triangle_with_buffer(&uri)
+}
+
+/// [`gltf_triangle`] with its buffer at `uri`.
+fn gltf_triangle_with_buffer(uri: &str) -> String {
     format!(
         r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1]}}],
 "nodes":[{{"mesh":0}},{{"camera":0,"translation":[0.3,0.3,2]}}],
@@ -408,8 +422,7 @@ fn gltf_triangle() -> String {
 "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
 {{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}],
 "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],
-"buffers":[{{"byteLength":44,"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
-        base64(&buffer)
+"buffers":[{{"byteLength":44,"uri":"{uri}"}}]}}"#
     )
 }
 
@@ -422,6 +435,34 @@ fn the_gltf_triangle_loads() {
     let desc = pathlab_scene::load(path.to_str().unwrap()).unwrap();
     assert_eq!(desc.meshes.len(), 1);
     assert_eq!(desc.meshes[0].indices, vec![0, 1, 2]);
+}
+
+#[test]
+fn a_gltf_buffer_file_is_read_beside_it_and_named_when_missing() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corruption-gltf-external");
+    std::fs::create_dir_all(&dir).unwrap();
+    // The triangle's buffer in a file of its own, its name percent-escaped in the URI.
+    let external = gltf_triangle_with_buffer("tri%20data.bin");
+    let path = dir.join("tri.gltf");
+    std::fs::write(&path, &external).unwrap();
+    let _ = std::fs::remove_file(dir.join("tri data.bin"));
+    let err = pathlab_scene::load(path.to_str().unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("tri.gltf") && err.contains("buffers[0]") && err.contains("tri%20data.bin"),
+        "{err}"
+    );
+    std::fs::write(dir.join("tri data.bin"), triangle_buffer()).unwrap();
+    let desc = pathlab_scene::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(desc.meshes[0].indices, vec![0, 1, 2]);
+    // An escape that decodes to no UTF-8 (the gltf crate's own decoding panics on it) is an
+    // error naming the URI.
+    std::fs::write(&path, gltf_triangle_with_buffer("%FF%FE.bin")).unwrap();
+    let err = pathlab_scene::load(path.to_str().unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("%FF%FE.bin"), "{err}");
 }
 
 proptest! {

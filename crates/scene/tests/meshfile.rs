@@ -81,6 +81,17 @@ fn obj_with_mtl_round_trips_and_renders() {
     // An emissive material (Ke) makes the mesh a light; no default lights are added then.
     std::fs::write(scratch("box.mtl"), "newmtl red\nKd 0.8 0.1 0.1\nKe 2 2 2\n").unwrap();
     check_box(obj.to_str().unwrap(), true);
+    // Without its MTL file, the mesh is grey, with a warning naming the file.
+    let mtl = scratch("box.mtl"); // (`scratch` removes the file)
+    assert!(!mtl.exists());
+    let desc = load(obj.to_str().unwrap()).unwrap();
+    assert!(
+        desc.warnings
+            .iter()
+            .any(|w| w.contains("box.mtl not found") && w.contains("grey diffuse")),
+        "{:?}",
+        desc.warnings
+    );
 }
 
 fn ply_header(format: &str, vertices: usize, faces: usize) -> String {
