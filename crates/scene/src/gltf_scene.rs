@@ -76,12 +76,13 @@ fn check_referenced_files(path: &Path, root: &serde_json::Value) -> Result<(), S
             if uri.starts_with("data:") {
                 continue;
             }
-            let Some(name) = percent_decoded(uri) else {
+            // Decoded as the crate's import decodes it (which panics where this errs).
+            let Ok(name) = urlencoding::decode(uri) else {
                 return Err(format!(
                     "{kind}[{i}] names '{uri}', whose escapes decode to no UTF-8 text"
                 ));
             };
-            let file = dir.join(name);
+            let file = dir.join(&*name);
             if let Err(e) = std::fs::metadata(&file) {
                 return Err(format!(
                     "{kind}[{i}] names '{uri}', which cannot be read ({}: {e})",
@@ -91,31 +92,6 @@ fn check_referenced_files(path: &Path, root: &serde_json::Value) -> Result<(), S
         }
     }
     Ok(())
-}
-
-/// A URI's percent-escapes (`%20`) decoded, as glTF's relative URIs are written (a malformed
-/// escape is kept as it is); `None` where the result is not UTF-8.
-fn percent_decoded(uri: &str) -> Option<String> {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        let hex = bytes
-            .get(i + 1..i + 3)
-            .and_then(|h| std::str::from_utf8(h).ok())
-            .and_then(|h| u8::from_str_radix(h, 16).ok());
-        match (bytes[i], hex) {
-            (b'%', Some(b)) => {
-                out.push(b);
-                i += 3;
-            }
-            (b, _) => {
-                out.push(b);
-                i += 1;
-            }
-        }
-    }
-    String::from_utf8(out).ok()
 }
 
 /// Loads a glTF 2.0 file.
