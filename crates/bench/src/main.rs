@@ -167,21 +167,6 @@ fn timed_into(count: usize, repeat: u32, mut trace: impl FnMut()) -> f64 {
     best
 }
 
-/// Best throughput in Mrays/s over `repeat` runs of `trace` (which traces all `count` rays and
-/// returns their hit distances), and the hits of the last run.
-#[cfg(feature = "obvhs")]
-fn timed(count: usize, repeat: u32, mut trace: impl FnMut() -> Vec<f32>) -> (f64, Vec<f32>) {
-    let mut best = 0.0f64;
-    let mut hits = Vec::new();
-    for _ in 0..repeat.max(1) {
-        let start = Instant::now();
-        hits = trace();
-        let rate = count as f64 / start.elapsed().as_secs_f64() / 1e6;
-        best = best.max(rate);
-    }
-    (best, hits)
-}
-
 /// How many hits agree with Embree's: both miss, or distances within 1e-4 relative.
 fn agreement(rays: &[FileRay], hits: &[f32]) -> usize {
     rays.iter()
@@ -488,7 +473,12 @@ fn obvhs_baseline(
         }
     };
     let set = |rays: &[FileRay]| {
-        let (best, hits) = timed(rays.len(), repeat, || rays.iter().map(trace).collect());
+        let mut hits = vec![0.0f32; rays.len()];
+        let best = timed_into(rays.len(), repeat, || {
+            for (r, hit) in rays.iter().zip(hits.iter_mut()) {
+                *hit = trace(r);
+            }
+        });
         json!({
             "mrays_per_s": best,
             "agreement": agreement(rays, &hits) as f64 / rays.len().max(1) as f64,

@@ -418,12 +418,19 @@ impl Scene {
         }
     }
 
+    /// The leaf block and lane that hold triangle `i` (its first copy).
+    #[inline(always)]
+    fn triangle_block(&self, i: u32) -> (&TriBlock, usize) {
+        let slot = self.tri_slot[i as usize] as usize;
+        (&self.blocks[slot / TRIS_PER_BLOCK], slot % TRIS_PER_BLOCK)
+    }
+
     /// Triangle `i`'s first vertex and its edges to the second and third, from its leaf
     /// block.
     #[inline(always)]
     fn triangle_corner_and_edges(&self, i: u32) -> [Vec3; 3] {
-        let slot = self.tri_slot[i as usize] as usize;
-        self.blocks[slot / TRIS_PER_BLOCK].corner_and_edges(slot % TRIS_PER_BLOCK)
+        let (block, lane) = self.triangle_block(i);
+        block.corner_and_edges(lane)
     }
 
     /// The surface interaction at barycentrics (b1, b2) of triangle `i`, at distance `t`.

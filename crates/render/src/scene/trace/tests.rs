@@ -295,9 +295,8 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
                 let Prim::Triangle(i) = scene.prims[slot as usize].get() else {
                     panic!("a shape other than the BVH's at lane {i}")
                 };
-                let at = scene.tri_slot[i as usize] as usize;
-                let block = &scene.blocks[at / TRIS_PER_BLOCK];
-                let own = block.intersect(ray, 1 << (at % TRIS_PER_BLOCK));
+                let (block, lane) = scene.triangle_block(i);
+                let own = block.intersect(ray, 1 << lane);
                 assert_eq!(own.map(|h| h.t), Some(t));
                 ties += 1;
             }
