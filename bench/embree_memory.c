@@ -66,8 +66,8 @@ static ssize_t build(RTCDevice dev, int shared) {
   rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
   RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
   if (shared) {
-    /* Embree may read 16 bytes at the last vertex: V has room (its capacity is a power of two
-       at least 1024 vertices beyond what is used, or exactly nv; pad to be safe). */
+    /* Embree reads a vertex with a 16-byte load, so a shared vertex buffer needs 4 bytes after
+       its last vertex: one vertex more. */
     V = realloc(V, (nv + 1) * 12);
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, V, 0, 12, nv);
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, F, 0, 12, nf);
