@@ -4,8 +4,9 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use pathlab_render::desc::SceneDesc;
-use pathlab_render::limits::{self, Expected};
-use std::fmt::Display;
+use pathlab_render::limits;
+
+pub use pathlab_lab::render::within;
 
 /// The scene a command renders, as every such command names it.
 #[derive(Args, Debug)]
@@ -52,18 +53,6 @@ impl SceneArgs {
         pathlab_lab::render::apply_resolution(&mut desc, self.size())?;
         Ok(desc)
     }
-}
-
-/// A flag's value by its rule in [`limits`]: an error names the flag, the value and what was
-/// expected.
-pub fn within<T: Copy + Display>(
-    flag: &str,
-    value: Option<T>,
-    rule: fn(T) -> std::result::Result<T, Expected>,
-) -> Result<Option<T>> {
-    value
-        .map(|v| rule(v).map_err(|e| anyhow::anyhow!("{flag} {v}: {e}")))
-        .transpose()
 }
 
 /// A `--max-depth` value: a number of bounces or `inf` (also `-1`).

@@ -1,9 +1,9 @@
 //! `pathlab integrate`: the arguments and the report of [`pathlab_lab::integrate`] (a Monte
 //! Carlo estimate of an integral over a box, with its error and a convergence study).
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
-use pathlab_lab::expr::parse_constant;
+use pathlab_lab::expr::{parse_constant, parse_interval};
 use pathlab_lab::integrate::{convergence_plot, Integral, IntegrateReport};
 use pathlab_mc::sampler::SamplerKind;
 use std::path::PathBuf;
@@ -58,35 +58,9 @@ pub struct IntegrateArgs {
     pub json: bool,
 }
 
-fn parse_domain(text: &str) -> Result<(f64, f64)> {
-    let parts: Vec<&str> = text.split(',').collect();
-    if parts.len() != 2 {
-        bail!("--domain {text}: expected two bounds a,b such as -2,2");
-    }
-    let a = parse_constant(parts[0]).with_context(|| format!("--domain {text}"))?;
-    let b = parse_constant(parts[1]).with_context(|| format!("--domain {text}"))?;
-    if !(a.is_finite() && b.is_finite()) {
-        bail!("--domain {text}: bounds must be finite");
-    }
-    if a >= b {
-        bail!("--domain {text}: the interval is empty (need a < b)");
-    }
-    Ok((a, b))
-}
-
 /// Runs `pathlab integrate`.
 pub fn run(args: &IntegrateArgs) -> Result<()> {
     let n = crate::flags::sample_count(args.samples)?;
-    if args.reps == 0 {
-        bail!("--reps must be at least 1");
-    }
-    if args.sampler != SamplerKind::Independent && args.reps as u64 > args.samples {
-        bail!(
-            "--reps {} randomisations need at least as many samples, got -n {}",
-            args.reps,
-            args.samples
-        );
-    }
     let exact = args
         .exact
         .as_deref()
@@ -95,7 +69,7 @@ pub fn run(args: &IntegrateArgs) -> Result<()> {
     let domains = args
         .domain
         .iter()
-        .map(|d| parse_domain(d))
+        .map(|d| parse_interval("--domain", d))
         .collect::<Result<Vec<_>>>()?;
     let problem = Integral::new(
         &args.expression,

@@ -297,9 +297,43 @@ pub fn parse_constant(text: &str) -> Result<f64> {
         .with_context(|| format!("'{t}' is not a number"))
 }
 
+/// Reads an interval `a,b` whose bounds are numbers or constant expressions, finite, with
+/// a < b; an error names the setting (`--domain -2,2`).
+pub fn parse_interval(name: &str, text: &str) -> Result<(f64, f64)> {
+    let Some((a, b)) = text.split_once(',').filter(|(_, b)| !b.contains(',')) else {
+        bail!("{name} {text}: expected two bounds a,b such as -2,2");
+    };
+    let a = parse_constant(a).with_context(|| format!("{name} {text}"))?;
+    let b = parse_constant(b).with_context(|| format!("{name} {text}"))?;
+    if !(a.is_finite() && b.is_finite()) {
+        bail!("{name} {text}: bounds must be finite");
+    }
+    if a >= b {
+        bail!("{name} {text}: the interval is empty (need a < b)");
+    }
+    Ok((a, b))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn intervals_take_constant_bounds_in_order() {
+        let (a, b) = parse_interval("--domain", "-pi/2, 1").unwrap();
+        assert_eq!((a, b), (-std::f64::consts::FRAC_PI_2, 1.0));
+        for (text, expected) in [
+            ("0", "two bounds"),
+            ("0,1,2", "two bounds"),
+            ("1,1", "empty"),
+            ("0,q", "'q' is not a number"),
+            ("0,1/0", "finite"),
+        ] {
+            let e = format!("{:#}", parse_interval("--domain", text).unwrap_err());
+            assert!(e.starts_with(&format!("--domain {text}")), "{e}");
+            assert!(e.contains(expected), "{text}: {e}");
+        }
+    }
 
     #[test]
     fn binds_variables_to_dimensions() {

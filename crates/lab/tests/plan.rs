@@ -117,3 +117,114 @@ fn bdpt_says_when_it_traces_no_light_to_the_lens() {
         "{warnings:?}"
     );
 }
+
+#[test]
+fn contradictions_are_refused_before_the_scene_is_loaded() {
+    use pathlab_lab::render::Shard;
+    use pathlab_render::integrator::IntegratorChoice;
+    use pathlab_render::render::{Adaptive, AdaptiveRule};
+    // A scene that does not exist: each error must come before loading it.
+    let base = RenderRequest {
+        scene: "no-such-scene.xml".into(),
+        ..Default::default()
+    };
+    let error = |req: RenderRequest| {
+        let e = req.check().expect_err("a contradiction");
+        let by_plan = Plan::new(&req, &mut |_| {}, &AtomicBool::new(false));
+        assert_eq!(by_plan.err().map(|e| e.to_string()), Some(e.to_string()));
+        e.to_string()
+    };
+    let time = Some(ProgressiveStop {
+        time: Some(1.0),
+        ..Default::default()
+    });
+    let cases = [
+        (
+            RenderRequest {
+                integrator: IntegratorChoice {
+                    max_depth: Some(2),
+                    only_bounce: Some(3),
+                    ..Default::default()
+                },
+                ..base.clone()
+            },
+            "--only-bounce 3 is beyond --max-depth 2",
+        ),
+        (
+            RenderRequest {
+                crop: Some([4, 0, 4, 8]),
+                ..base.clone()
+            },
+            "--crop 4 0 4 8: need x0 < x1",
+        ),
+        (
+            RenderRequest {
+                adaptive: Some(Adaptive::DEFAULT),
+                progressive: time,
+                ..base.clone()
+            },
+            "choose one",
+        ),
+        (
+            RenderRequest {
+                shard: Some(Shard { index: 0, count: 2 }),
+                progressive: time,
+                ..base.clone()
+            },
+            "--shard splits a render of fixed samples",
+        ),
+        (
+            RenderRequest {
+                adaptive: Some(Adaptive {
+                    rule: AdaptiveRule::Course,
+                    ..Adaptive::DEFAULT
+                }),
+                checkpoints: true,
+                ..base.clone()
+            },
+            "use the default two-stage rule",
+        ),
+        (
+            RenderRequest {
+                edits: SceneEdits {
+                    fov: Some(200.0),
+                    ..Default::default()
+                },
+                ..base.clone()
+            },
+            "--fov 200: must be",
+        ),
+        (
+            RenderRequest {
+                progressive: Some(ProgressiveStop {
+                    target_error: Some(-1.0),
+                    ..Default::default()
+                }),
+                ..base.clone()
+            },
+            "--target-error -1: must be",
+        ),
+    ];
+    for (req, expected) in cases {
+        let e = error(req);
+        assert!(e.contains(expected), "{e}");
+    }
+    // The two-stage rule keeps its checkpoints; what is consistent passes.
+    let req = RenderRequest {
+        adaptive: Some(Adaptive::DEFAULT),
+        checkpoints: true,
+        ..base
+    };
+    assert!(req.check().is_ok());
+}
+
+#[test]
+fn shards_read_as_i_of_n() {
+    use pathlab_lab::render::Shard;
+    let s: Shard = " 2 / 5".parse().expect("a shard");
+    assert_eq!((s.index, s.count), (2, 5));
+    for bad in ["2", "a/5", "2/", "-1/4"] {
+        let e = bad.parse::<Shard>().expect_err(bad).to_string();
+        assert!(e.contains("expected I/N"), "{bad}: {e}");
+    }
+}

@@ -1,9 +1,9 @@
 //! `pathlab render`'s flags, and their checks before anything is loaded.
 
 use crate::flags::{self, within, SceneArgs};
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use pathlab_lab::render::{ProgressiveStop, RenderRequest, SceneEdits, Shard};
+use pathlab_lab::render::{ProgressiveStop, RenderRequest, SceneEdits};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::image_io::ToneMap;
 use pathlab_render::integrator::{DirectStrategy, IntegratorChoice, PathLighting};
@@ -242,14 +242,8 @@ fn parse_adaptive(values: &[String], rule: Option<RuleName>) -> Result<Adaptive>
     })
 }
 
-/// Flags that contradict each other: an error, before anything is loaded; flags that the
-/// chosen integrator does not read: a warning each (returned).
-fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>> {
-    if let (Some(k), Some(m)) = (args.only_bounce, cli_depth) {
-        if k > m {
-            bail!("--only-bounce {k} is beyond --max-depth {m}: the image would be black");
-        }
-    }
+/// Flags that the chosen integrator does not read: a warning each.
+fn unread_flags(args: &RenderArgs) -> Vec<String> {
     let mut warnings = Vec::new();
     let mut unused = |flag: &str, applies: &str| {
         warnings.push(format!("{flag} applies to {applies} only; ignored"))
@@ -275,7 +269,7 @@ fn check_flags(args: &RenderArgs, cli_depth: Option<u32>) -> Result<Vec<String>>
     if args.adaptive_rule.is_some() && args.adaptive.is_none() {
         unused("--adaptive-rule", "adaptive sampling (-a)");
     }
-    Ok(warnings)
+    warnings
 }
 
 /// The flags as a checked request, and warnings about flags the chosen integrator does not
@@ -288,48 +282,22 @@ pub(super) struct Checked {
 /// Checks every flag that needs no scene (an error names the flag and what was expected),
 /// and makes the request of them.
 pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
-    let cli_depth = args
-        .max_depth
-        .as_deref()
-        .map(flags::max_depth)
-        .transpose()?;
     within("--exposure", Some(args.exposure), limits::exposure)?;
-    let warnings = check_flags(args, cli_depth)?;
-    check_view(args)?;
     let every = Some(args.checkpoint_every);
     within("--checkpoint-every", every, limits::checkpoint_seconds)?;
-    let params = args.scene.params()?;
-    within("--target-error", args.target_error, limits::target_error)?;
-    within("--time", args.time, limits::render_seconds)?;
     let progressive =
         (args.target_error.is_some() || args.time.is_some()).then_some(ProgressiveStop {
             target_error: args.target_error,
             time: args.time,
         });
-    if progressive.is_some() && args.adaptive.is_some() {
-        bail!(
-            "--adaptive and --target-error/--time are different ways to place samples; choose one"
-        );
-    }
     let adaptive = args
         .adaptive
         .as_deref()
         .map(|a| parse_adaptive(a, args.adaptive_rule))
         .transpose()?;
-    if args.shard.is_some() && (progressive.is_some() || adaptive.is_some()) {
-        bail!("--shard splits a render of fixed samples per pixel; it cannot be combined with -a, --target-error or --time");
-    }
-    let stopping_rule = adaptive.is_some()
-        && matches!(
-            args.adaptive_rule,
-            Some(RuleName::Course | RuleName::Neyman)
-        );
-    if (args.checkpoint.is_some() || args.resume.is_some()) && stopping_rule {
-        bail!("--checkpoint and --resume: the course and neyman adaptive rules decide on every sample a pixel has drawn, which a film does not keep; use the default two-stage rule");
-    }
     let request = RenderRequest {
         scene: args.scene.name.clone(),
-        params,
+        params: args.scene.params()?,
         edits: SceneEdits {
             lens_radius: args.lens_radius,
             focal_distance: args.focal_distance,
@@ -344,7 +312,11 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
         sampler: args.sampler,
         integrator: IntegratorChoice {
             name: args.integrator,
-            max_depth: cli_depth,
+            max_depth: args
+                .max_depth
+                .as_deref()
+                .map(flags::max_depth)
+                .transpose()?,
             rr_depth: args.rr_depth,
             only_bounce: args.only_bounce,
             light_samples: args.light_samples,
@@ -355,46 +327,11 @@ pub(super) fn check(args: &RenderArgs) -> Result<Checked> {
         adaptive,
         progressive,
         crop: args.crop.as_deref().map(|c| [c[0], c[1], c[2], c[3]]),
-        shard: args.shard.as_deref().map(parse_shard).transpose()?,
+        shard: args.shard.as_deref().map(str::parse).transpose()?,
         film_files: false,
+        checkpoints: args.checkpoint.is_some() || args.resume.is_some(),
     };
+    request.check()?;
+    let warnings = unread_flags(args);
     Ok(Checked { request, warnings })
-}
-
-/// The camera's and the environment's flags: values no scene could take, each by its rule in
-/// [`limits`].
-fn check_view(args: &RenderArgs) -> Result<()> {
-    within("--lens-radius", args.lens_radius, limits::lens_radius)?;
-    within(
-        "--focal-distance",
-        args.focal_distance,
-        limits::focal_distance,
-    )?;
-    let envmap_scale = args.envmap.as_ref().map(|_| args.envmap_scale);
-    within("--envmap-scale", envmap_scale, limits::radiance_scale)?;
-    if let Some(c) = args
-        .crop
-        .as_deref()
-        .filter(|c| c[0] >= c[2] || c[1] >= c[3])
-    {
-        bail!(
-            "--crop {} {} {} {}: need x0 < x1 and y0 < y1",
-            c[0],
-            c[1],
-            c[2],
-            c[3]
-        );
-    }
-    within("--scale", args.scale, limits::image_scale)?;
-    within("--fov", args.fov, limits::fov_degrees)?;
-    Ok(())
-}
-
-/// `--shard I/N`.
-fn parse_shard(text: &str) -> Result<Shard> {
-    let (index, count) = text
-        .split_once('/')
-        .and_then(|(a, b)| Some((a.trim().parse::<u64>().ok()?, b.trim().parse::<u64>().ok()?)))
-        .with_context(|| format!("--shard {text}: expected I/N, such as 0/4"))?;
-    Ok(Shard { index, count })
 }

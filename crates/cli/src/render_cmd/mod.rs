@@ -110,15 +110,9 @@ pub fn run(args: &RenderArgs) -> Result<u8> {
 fn render(plan: &Plan, args: &RenderArgs, cancel: &AtomicBool) -> Result<JobOutcome> {
     let start_film = plan.start_film(args.resume.as_deref())?;
     if let (Some(path), false) = (&args.resume, args.quiet) {
-        let n = start_film
-            .pixels()
-            .iter()
-            .map(|p| p.count())
-            .min()
-            .unwrap_or(0);
-        let range = plan.header.range;
+        let (n, range) = (start_film.sample_count_range().min, plan.header.range);
         eprintln!(
-            "resuming {}: every pixel holds at least {n} of {} samples",
+            "resuming {}: every pixel holds at least {n:.0} of {} samples",
             path.display(),
             range[1] - range[0]
         );

@@ -259,6 +259,12 @@ impl Integral {
     /// (a warning in [`IntegralRun::warnings`], after the problem's own). An integrand that is
     /// not finite somewhere is an error naming a point where it is not.
     pub fn run(&self, kind: SamplerKind, n: u32, reps: u32, seed: u64) -> Result<IntegralRun> {
+        if reps == 0 {
+            bail!("--reps must be at least 1");
+        }
+        if kind != SamplerKind::Independent && reps > n {
+            bail!("--reps {reps} randomisations need at least as many samples, got -n {n}");
+        }
         let start = std::time::Instant::now();
         let estimate = self.estimate_with_error(kind, n, reps, seed);
         let seconds = start.elapsed().as_secs_f64();

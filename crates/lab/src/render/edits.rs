@@ -2,7 +2,7 @@
 //! view or another field of view, a thin lens, an environment map, Schlick's Fresnel on glass.
 //!
 //! Values that need no scene to be judged (a negative lens radius, a field of view of 200°)
-//! are the caller's to refuse before loading, by [`pathlab_render::limits`]; what depends on
+//! are refused before loading by [`super::RenderRequest::check`]; what depends on
 //! the scene (an orthographic camera has no field of view; a scale that makes the image too
 //! large) is refused here.
 

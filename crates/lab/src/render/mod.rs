@@ -1,5 +1,5 @@
-//! A render as its caller asks for it ([`RenderRequest`], every value already checked) and as
-//! the scene's hints complete it ([`Plan`]): the scene loaded, edited and built, the integrator
+//! A render as its caller asks for it ([`RenderRequest`], checked before anything is loaded
+//! by [`RenderRequest::check`]) and as the scene's hints complete it ([`Plan`]): the scene loaded, edited and built, the integrator
 //! chosen, the samples, sampler and adaptive rule settled, and its film files' header. The
 //! plan then runs as a [`RenderJob`], and [`summary`] says what was made.
 //!
@@ -8,74 +8,25 @@
 //! the request carries.
 
 pub mod edits;
+mod request;
 pub mod summary;
 
 pub use edits::{apply_resolution, apply_view, SceneEdits};
+pub use request::{within, ProgressiveStop, RenderRequest, Shard};
 
 use crate::job::{film_header, resumed_film, Checkpoint, RenderJob};
 use anyhow::{bail, Context, Result};
-use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::film::Film;
 use pathlab_render::film_file::FilmHeader;
-use pathlab_render::integrator::{IntegratorChoice, IntegratorKind, IntegratorName};
+use pathlab_render::integrator::{IntegratorKind, IntegratorName};
 use pathlab_render::progressive::StopRule;
-use pathlab_render::render::{Adaptive, AdaptiveRule, RenderSettings};
+use pathlab_render::render::{AdaptiveRule, RenderSettings};
 use pathlab_render::scene::Scene;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 /// Most samples a progressive render's pixel takes unless the caller caps it.
 pub const PROGRESSIVE_CAP: u32 = 65536;
-
-/// When a progressive render stops (at the first rule met, or at the cap of samples).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct ProgressiveStop {
-    /// The estimated relative RMSE to reach.
-    pub target_error: Option<f64>,
-    /// Seconds to render for.
-    pub time: Option<f64>,
-}
-
-/// Which part of a render's samples this run takes: shard `index` (from 0) of `count`.
-#[derive(Clone, Copy, Debug)]
-pub struct Shard {
-    /// This shard, from 0.
-    pub index: u64,
-    /// How many shards share the samples.
-    pub count: u64,
-}
-
-/// What the caller asks for; what it leaves open the scene's hints, then the defaults, fill.
-#[derive(Clone, Debug, Default)]
-pub struct RenderRequest {
-    /// The scene: a file, or the name of a built-in scene.
-    pub scene: String,
-    /// The scene's parameters (`$name` in Mitsuba files).
-    pub params: Vec<(String, String)>,
-    /// Changes to the scene before it is built.
-    pub edits: SceneEdits,
-    /// Samples per pixel (for a progressive render: its cap).
-    pub spp: Option<u32>,
-    /// Seed of the samplers.
-    pub seed: u64,
-    /// The sampler (default: the scene's, else Sobol; independent for progressive renders).
-    pub sampler: Option<SamplerKind>,
-    /// The integrator asked for.
-    pub integrator: IntegratorChoice,
-    /// Adaptive sampling; with `neyman`, its rule comes from a pilot render.
-    pub adaptive: Option<Adaptive>,
-    /// The Neyman allocation rule of adaptive sampling (needs `adaptive`).
-    pub neyman: bool,
-    /// A progressive render, and when it stops.
-    pub progressive: Option<ProgressiveStop>,
-    /// Only these pixels: x0, y0, x1, y1 (default: the scene file's crop window, if any).
-    pub crop: Option<[u32; 4]>,
-    /// Only this shard of the samples.
-    pub shard: Option<Shard>,
-    /// Film files are read or written (checkpoints, resumes, `.plf` outputs): the header
-    /// then carries the render's hashed identity.
-    pub film_files: bool,
-}
 
 /// A render ready to run, with everything the request left open decided.
 pub struct Plan {
@@ -110,6 +61,7 @@ impl Plan {
         warn: &mut dyn FnMut(&str),
         cancel: &AtomicBool,
     ) -> Result<Plan> {
+        req.check()?;
         let mut desc = pathlab_scene::load_with(&req.scene, &req.params)?;
         for w in &desc.warnings {
             warn(w);
