@@ -315,43 +315,7 @@ fn rays(args: &RaysArgs) -> Result<()> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        println!(
-            "{}: {} triangles, BVH build {:.3} s ({} nodes), {:.0} bytes/triangle",
-            args.mesh, stats.triangles, stats.bvh_seconds, stats.bvh_nodes, bytes_per_triangle
-        );
-        for s in &sets {
-            println!(
-                "  {:<8} {:>8} rays: {:>7.2} Mrays/s (1 thread), {:>7.2} Mrays/s ({threads} threads), {:.2} Mrays/s (1 thread, with surface interactions), {:.1} nodes/ray, hits agreeing with Embree {:.4}%",
-                s["rays"].as_str().unwrap_or(""),
-                s["count"],
-                s["mrays_per_s_1_thread"].as_f64().unwrap_or(0.0),
-                s["mrays_per_s_all_threads"].as_f64().unwrap_or(0.0),
-                s["mrays_per_s_1_thread_with_interaction"].as_f64().unwrap_or(0.0),
-                s["nodes_per_ray"].as_f64().unwrap_or(0.0),
-                100.0 * s["agreement"].as_f64().unwrap_or(0.0)
-            );
-        }
-    }
-    if !args.json {
-        println!(
-            "  baseline, 1 thread, triangles only: binary BVH build {:.3} s, primary {:.2} / bounce {:.2} Mrays/s; 4-wide build {:.3} s, {:.2} / {:.2} Mrays/s",
-            baseline["binary"]["build_seconds"].as_f64().unwrap_or(0.0),
-            baseline["binary"]["primary"].as_f64().unwrap_or(0.0),
-            baseline["binary"]["bounce"].as_f64().unwrap_or(0.0),
-            baseline["wide"]["build_seconds"].as_f64().unwrap_or(0.0),
-            baseline["wide"]["primary"].as_f64().unwrap_or(0.0),
-            baseline["wide"]["bounce"].as_f64().unwrap_or(0.0),
-        );
-        if let Some(o) = baseline.get("obvhs") {
-            println!(
-                "  obvhs (medium build), 1 thread: build {:.3} s, primary {:.2} / bounce {:.2} Mrays/s, hits agreeing {:.4}% / {:.4}%",
-                o["build_seconds"].as_f64().unwrap_or(0.0),
-                o["primary"]["mrays_per_s"].as_f64().unwrap_or(0.0),
-                o["bounce"]["mrays_per_s"].as_f64().unwrap_or(0.0),
-                100.0 * o["primary"]["agreement"].as_f64().unwrap_or(0.0),
-                100.0 * o["bounce"]["agreement"].as_f64().unwrap_or(0.0),
-            );
-        }
+        print_rays_text(&out);
     }
     let worst = sets
         .iter()
@@ -364,6 +328,52 @@ fn rays(args: &RaysArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The `rays` report as text: the scene, each ray set's rates, the baselines.
+fn print_rays_text(out: &serde_json::Value) {
+    let f = |v: &serde_json::Value| v.as_f64().unwrap_or(0.0);
+    let threads = &out["threads"];
+    println!(
+        "{}: {} triangles, BVH build {:.3} s ({} nodes), {:.0} bytes/triangle",
+        out["mesh"].as_str().unwrap_or(""),
+        out["triangles"],
+        f(&out["bvh_build_seconds"]),
+        out["bvh_nodes"],
+        f(&out["bytes_per_triangle"])
+    );
+    for s in out["sets"].as_array().into_iter().flatten() {
+        println!(
+            "  {:<8} {:>8} rays: {:>7.2} Mrays/s (1 thread), {:>7.2} Mrays/s ({threads} threads), {:.2} Mrays/s (1 thread, with surface interactions), {:.1} nodes/ray, hits agreeing with Embree {:.4}%",
+            s["rays"].as_str().unwrap_or(""),
+            s["count"],
+            f(&s["mrays_per_s_1_thread"]),
+            f(&s["mrays_per_s_all_threads"]),
+            f(&s["mrays_per_s_1_thread_with_interaction"]),
+            f(&s["nodes_per_ray"]),
+            100.0 * f(&s["agreement"])
+        );
+    }
+    let baseline = &out["binary_bvh_baseline"];
+    println!(
+        "  baseline, 1 thread, triangles only: binary BVH build {:.3} s, primary {:.2} / bounce {:.2} Mrays/s; 4-wide build {:.3} s, {:.2} / {:.2} Mrays/s",
+        f(&baseline["binary"]["build_seconds"]),
+        f(&baseline["binary"]["primary"]),
+        f(&baseline["binary"]["bounce"]),
+        f(&baseline["wide"]["build_seconds"]),
+        f(&baseline["wide"]["primary"]),
+        f(&baseline["wide"]["bounce"]),
+    );
+    if let Some(o) = baseline.get("obvhs") {
+        println!(
+            "  obvhs (medium build), 1 thread: build {:.3} s, primary {:.2} / bounce {:.2} Mrays/s, hits agreeing {:.4}% / {:.4}%",
+            f(&o["build_seconds"]),
+            f(&o["primary"]["mrays_per_s"]),
+            f(&o["bounce"]["mrays_per_s"]),
+            100.0 * f(&o["primary"]["agreement"]),
+            100.0 * f(&o["bounce"]["agreement"]),
+        );
+    }
 }
 
 /// The binary BVH against the 4-wide one on the same triangles and rays, one thread, without

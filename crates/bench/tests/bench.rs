@@ -68,6 +68,20 @@ fn bench_rays_checks_hits_against_the_ray_file() {
     for set in v["sets"].as_array().unwrap() {
         assert_eq!(set["agreement"].as_f64().unwrap(), 1.0, "{set}");
     }
+    // The text report: the scene, both ray sets, the baselines.
+    let out = bench(&[
+        "rays",
+        obj.to_str().unwrap(),
+        good.to_str().unwrap(),
+        "--repeat",
+        "1",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains(": 2 triangles, BVH build"), "{text}");
+    for line in ["  primary ", "  bounce ", "  baseline, 1 thread"] {
+        assert!(text.contains(line), "{line}: {text}");
+    }
     // A disagreeing hit distance fails the run.
     let bad = write_rays("bad.rays", true);
     let out = bench(&[
