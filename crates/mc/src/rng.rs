@@ -75,6 +75,7 @@ impl Pcg32 {
 
     /// Jumps `delta` steps ahead in O(log delta) time (Brown, "Random number generation with
     /// arbitrary strides", 1994): the result equals calling [`Pcg32::next_u32`] `delta` times.
+    #[inline]
     pub fn advance(&mut self, delta: u64) {
         let (mult, plus) = jump_coefficients(delta);
         self.state = mult
@@ -83,18 +84,15 @@ impl Pcg32 {
     }
 
     /// Moves to the same dimension `samples` pixel samples on: [`Pcg32::advance`] by
-    /// `samples` times [`DIMENSIONS_PER_SAMPLE`], squaring the one-sample jump (a step per bit
-    /// of `samples`, not per bit of the whole distance).
+    /// `samples` times [`DIMENSIONS_PER_SAMPLE`] (a jump per bit set in `samples`).
     #[inline]
     pub fn skip_pixel_samples(&mut self, samples: u32) {
-        let (mult, plus) = jump_power(SAMPLE_JUMP, u64::from(samples));
-        self.state = mult
-            .wrapping_mul(self.state)
-            .wrapping_add(plus.wrapping_mul(self.inc));
+        self.advance(u64::from(samples) * DIMENSIONS_PER_SAMPLE);
     }
 
     /// The generator for one pixel sample: stream chosen by `(seed, pixel)`, positioned at
     /// `sample_index * 2^16 + dimension`. A pure function of its arguments.
+    #[inline]
     pub fn for_pixel_sample(seed: u64, pixel: [u32; 2], sample_index: u32, dimension: u32) -> Self {
         let mut rng = Pcg32::new(hash_pixel(pixel, seed), mix_bits(seed));
         rng.advance(sample_index as u64 * DIMENSIONS_PER_SAMPLE + dimension as u64);
@@ -103,31 +101,34 @@ impl Pcg32 {
 }
 
 /// `(m, p)` such that `delta` steps of the generator take `state` to `m · state + p · inc`
-/// (Brown, "Random Number Generation with Arbitrary Strides", 1994): the multiplier and
-/// increment of `delta` steps, built by squaring; the increment's part is linear in `inc`.
-const fn jump_coefficients(delta: u64) -> (u64, u64) {
-    jump_power((PCG32_MULT, 1), delta)
-}
-
-/// The coefficients of applying the jump `(mult, plus)` (see [`jump_coefficients`]) `delta`
-/// times, by squaring.
-const fn jump_power((mult, plus): (u64, u64), mut delta: u64) -> (u64, u64) {
-    let (mut cur_mult, mut cur_plus) = (mult, plus);
+/// (Brown, "Random Number Generation with Arbitrary Strides", 1994): the jumps of 2^k steps
+/// ([`POWER_OF_TWO_JUMPS`]) of the bits set in `delta`, composed. Every jump is a power of
+/// the one-step map, so they commute and the result is the one map of `delta` steps.
+#[inline]
+fn jump_coefficients(mut delta: u64) -> (u64, u64) {
     let (mut acc_mult, mut acc_plus) = (1u64, 0u64);
-    while delta > 0 {
-        if delta & 1 == 1 {
-            acc_mult = acc_mult.wrapping_mul(cur_mult);
-            acc_plus = acc_plus.wrapping_mul(cur_mult).wrapping_add(cur_plus);
-        }
-        cur_plus = cur_mult.wrapping_add(1).wrapping_mul(cur_plus);
-        cur_mult = cur_mult.wrapping_mul(cur_mult);
-        delta >>= 1;
+    while delta != 0 {
+        let (mult, plus) = POWER_OF_TWO_JUMPS[delta.trailing_zeros() as usize];
+        acc_mult = acc_mult.wrapping_mul(mult);
+        acc_plus = acc_plus.wrapping_mul(mult).wrapping_add(plus);
+        delta &= delta - 1;
     }
     (acc_mult, acc_plus)
 }
 
-/// [`jump_coefficients`] for one pixel sample.
-const SAMPLE_JUMP: (u64, u64) = jump_coefficients(DIMENSIONS_PER_SAMPLE);
+/// Entry k: the coefficients `(m, p)` of 2^k steps, by squaring the one-step map k times.
+const POWER_OF_TWO_JUMPS: [(u64, u64); 64] = {
+    let mut table = [(0u64, 0u64); 64];
+    let (mut mult, mut plus) = (PCG32_MULT, 1u64);
+    let mut k = 0;
+    while k < 64 {
+        table[k] = (mult, plus);
+        plus = mult.wrapping_add(1).wrapping_mul(plus);
+        mult = mult.wrapping_mul(mult);
+        k += 1;
+    }
+    table
+};
 
 /// A 64-bit finaliser with good avalanche (every input bit flips each output bit with
 /// probability close to 1/2); the constants are those of Stafford's "Mix13" variant.
@@ -174,12 +175,35 @@ mod tests {
     }
 
     #[test]
-    fn skipping_samples_is_advancing_by_their_dimensions() {
-        let start = Pcg32::for_pixel_sample(5, [1, 2], 3, 0);
-        for k in [0, 1, 2, 7, 8, 9, 63, 1000, u32::MAX] {
-            let (mut a, mut b) = (start.clone(), start.clone());
+    fn jumps_of_any_distance_are_the_squared_one_step_map() {
+        // The reference: Brown's algorithm, squaring the one-step map for every bit.
+        let squared = |mut delta: u64| {
+            let (mut mult, mut plus) = (PCG32_MULT, 1u64);
+            let (mut acc_mult, mut acc_plus) = (1u64, 0u64);
+            while delta > 0 {
+                if delta & 1 == 1 {
+                    acc_mult = acc_mult.wrapping_mul(mult);
+                    acc_plus = acc_plus.wrapping_mul(mult).wrapping_add(plus);
+                }
+                plus = mult.wrapping_add(1).wrapping_mul(plus);
+                mult = mult.wrapping_mul(mult);
+                delta >>= 1;
+            }
+            (acc_mult, acc_plus)
+        };
+        let mut rng = Pcg32::new(5, 6);
+        let edges = [0, 1, 2, 1 << 16, (1 << 16) + 3, 1 << 63, u64::MAX];
+        let random = (0..1000).map(|_| u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32()));
+        for delta in edges.into_iter().chain(random) {
+            assert_eq!(jump_coefficients(delta), squared(delta), "{delta}");
+        }
+        // Skipping k samples is advancing by their dimensions, and jumps add.
+        for k in [0u32, 1, 7, 64, 1 << 20] {
+            let mut a = Pcg32::new(3, 4);
+            let mut b = a.clone();
             a.skip_pixel_samples(k);
-            b.advance(u64::from(k) * DIMENSIONS_PER_SAMPLE);
+            b.advance(u64::from(k) * DIMENSIONS_PER_SAMPLE / 2);
+            b.advance(u64::from(k) * DIMENSIONS_PER_SAMPLE / 2);
             assert_eq!(a, b, "{k}");
         }
     }
