@@ -155,6 +155,17 @@ fn samplers(c: &mut Criterion) {
             })
         });
     }
+    // A new pixel's first sample: the stream's hash and its jump to the sample.
+    c.bench_function("pixel sample generator, 64 pixels", |b| {
+        b.iter(|| {
+            let mut acc = 0u32;
+            for i in 0..64u32 {
+                let mut rng = Pcg32::for_pixel_sample(1, [i, 7], black_box(37), 0);
+                acc = acc.wrapping_add(rng.next_u32());
+            }
+            acc
+        })
+    });
 }
 
 criterion_group!(benches, traversal, bsdfs, samplers);
