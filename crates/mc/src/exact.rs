@@ -36,6 +36,26 @@ pub fn to_fixed(x: f64) -> i128 {
     }
 }
 
+/// `sum.saturating_add(to_fixed(x))`, the same to the bit, with the common case (|x| < 16, a
+/// sum far from the bounds) in a handful of instructions: the conversion without the checks
+/// that an arbitrary `f64` needs, and the 128-bit addition without saturating.
+#[inline]
+pub fn add_fixed(sum: i128, x: f64) -> i128 {
+    let v = x * ONE;
+    if v.abs() < (1u64 << 52) as f64 {
+        let w = v + 0.5f64.copysign(v);
+        // SAFETY: |v| < 2^52, so w is finite with |w| <= 2^52 + 1/2, and its truncation fits
+        // in an i64: the conditions of `to_int_unchecked`. (NaN fails the test above.)
+        let r = i128::from(unsafe { w.to_int_unchecked::<i64>() });
+        match sum.checked_add(r) {
+            Some(s) => s,
+            None => sum.saturating_add(r),
+        }
+    } else {
+        sum.saturating_add(v as i128)
+    }
+}
+
 /// A fixed-point value as `f64` (rounded to nearest).
 #[inline]
 pub fn from_fixed(v: i128) -> f64 {
@@ -62,8 +82,8 @@ impl ExactStats {
     #[inline]
     pub fn push(&mut self, x: f64) {
         self.n += 1;
-        self.sum = self.sum.saturating_add(to_fixed(x));
-        self.sum_sq = self.sum_sq.saturating_add(to_fixed(x * x));
+        self.sum = add_fixed(self.sum, x);
+        self.sum_sq = add_fixed(self.sum_sq, x * x);
     }
 
     /// Adds the values of another set: exactly the same as pushing them here.
@@ -147,6 +167,53 @@ mod tests {
         xs.iter().for_each(|&x| w.push(x));
         assert!((forward.mean() - w.mean()).abs() < 1e-12 * w.mean());
         assert!((forward.variance() - w.variance()).abs() < 1e-9 * w.variance());
+    }
+
+    #[test]
+    fn adding_in_fixed_point_is_saturating_add_of_to_fixed() {
+        // Values on both sides of the fast path's bound (|x| < 16, v = x 2^48 < 2^52), halves
+        // of the fixed point's unit, non-finite values; sums at zero and by both bounds.
+        let unit = 1.0 / ONE;
+        let bound = 16.0f64;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            unit / 2.0,
+            -unit / 2.0,
+            1.5 * unit,
+            -2.5 * unit,
+            bound,
+            -bound,
+            bound.next_down(),
+            (-bound).next_up(),
+            1e30,
+            -1e30,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let mut rng = crate::rng::Pcg32::new(3, 9);
+        values.extend((0..200).map(|_| (rng.uniform_f64() - 0.5) * 40.0));
+        let sums = [
+            0,
+            1,
+            -1,
+            i128::MAX,
+            i128::MIN,
+            i128::MAX - (1 << 40),
+            i128::MIN + (1 << 40),
+        ];
+        for &x in &values {
+            for &sum in &sums {
+                assert_eq!(
+                    add_fixed(sum, x),
+                    sum.saturating_add(to_fixed(x)),
+                    "{sum} + {x}"
+                );
+            }
+        }
     }
 
     #[test]

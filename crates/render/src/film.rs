@@ -2,7 +2,7 @@
 
 use crate::desc::Rgb;
 use glam::{DVec3, Vec3};
-use pathlab_mc::exact::{from_fixed, to_fixed, ExactStats};
+use pathlab_mc::exact::{add_fixed, from_fixed, ExactStats};
 
 /// Statistics of one pixel's samples: their count, and exact sums of each channel and of
 /// luminance and of their squares ([`pathlab_mc::exact`]): the same for any order in which
@@ -28,8 +28,8 @@ impl PixelStats {
         let lum = crate::color::luminance(l);
         for (c, v) in [l.x, l.y, l.z, lum].into_iter().enumerate() {
             let v = v as f64;
-            self.sums[c] = self.sums[c].saturating_add(to_fixed(v));
-            self.squares[c] = self.squares[c].saturating_add(to_fixed(v * v));
+            self.sums[c] = add_fixed(self.sums[c], v);
+            self.squares[c] = add_fixed(self.squares[c], v * v);
         }
     }
 
@@ -176,7 +176,7 @@ impl Film {
         }
         let s = &mut self.splats[(y * self.width + x) as usize];
         for (c, v) in [v.x, v.y, v.z].into_iter().enumerate() {
-            s[c] = s[c].saturating_add(to_fixed(v as f64));
+            s[c] = add_fixed(s[c], f64::from(v));
         }
     }
 
