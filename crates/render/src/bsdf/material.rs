@@ -262,6 +262,22 @@ fn tangent_frame(n: Vec3, dpdu: Vec3) -> Frame {
     }
 }
 
+/// The lobes a material tree gathers at a point, in order: those of positive weight, the
+/// first [`MAX_LOBES`] of them (a BSDF holds no more), on the stack.
+#[derive(Default)]
+struct LobeList([Option<Lobe>; MAX_LOBES]);
+
+impl LobeList {
+    fn push(&mut self, lobe: Lobe) {
+        // `weight > 0` also leaves out NaN weights.
+        if lobe.weight > 0.0 {
+            if let Some(slot) = self.0.iter_mut().find(|l| l.is_none()) {
+                *slot = Some(lobe);
+            }
+        }
+    }
+}
+
 impl Material {
     /// A material of one model without textures.
     pub fn new(bxdf: Bxdf, two_sided: bool) -> Self {
@@ -315,7 +331,7 @@ impl Material {
 
     #[inline(never)]
     fn bsdf_general(&self, p: &ShadingPoint, wo: Vec3) -> Bsdf {
-        let mut lobes: Vec<Lobe> = Vec::with_capacity(2);
+        let mut lobes = LobeList::default();
         let mut null = 0.0;
         let local = Local {
             n: p.n,
@@ -324,20 +340,17 @@ impl Material {
             guard: None,
         };
         self.collect(p, &local, wo, 1.0, &mut lobes, &mut null);
-        lobes.retain(|l| l.weight > 0.0);
-        lobes.truncate(MAX_LOBES);
-        if lobes.is_empty() {
-            // Nothing but passing through (or nothing at all): a black lobe holds the frame.
-            lobes.push(Lobe {
-                weight: 0.0,
-                frame: Frame::from_normal(p.n),
-                bxdf: Bxdf::Diffuse(Diffuse {
-                    reflectance: Rgb::ZERO,
-                }),
-                guard: None,
-            });
-        }
-        Bsdf::mixture(&lobes, null)
+        let [first, rest @ ..] = lobes.0;
+        // Nothing but passing through (or nothing at all): a black lobe holds the frame.
+        let first = first.unwrap_or_else(|| Lobe {
+            weight: 0.0,
+            frame: Frame::from_normal(p.n),
+            bxdf: Bxdf::Diffuse(Diffuse {
+                reflectance: Rgb::ZERO,
+            }),
+            guard: None,
+        });
+        Bsdf::mixture(first, rest, null)
     }
 
     fn collect(
@@ -346,7 +359,7 @@ impl Material {
         at: &Local,
         wo: Vec3,
         weight: f32,
-        lobes: &mut Vec<Lobe>,
+        lobes: &mut LobeList,
         null: &mut f32,
     ) {
         if weight <= 0.0 {
@@ -541,5 +554,61 @@ impl From<&MaterialDesc> for Material {
     /// The material for a description (mesh attributes read as zero).
     fn from(d: &MaterialDesc) -> Self {
         Material::from_desc(d, &mut |_| u32::MAX)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn diffuse(r: f32) -> Material {
+        Material::new(
+            Bxdf::Diffuse(Diffuse {
+                reflectance: Rgb::splat(r),
+            }),
+            false,
+        )
+    }
+
+    fn blend(w: f32, a: Material, b: Material) -> Material {
+        Material::Blend(Tex::Constant(Rgb::splat(w)), Box::new((a, b)))
+    }
+
+    #[test]
+    fn a_tree_gives_its_first_lobes_in_order_up_to_the_most_a_bsdf_holds() {
+        // Five leaves, the last two at an eighth each: the BSDF keeps the first four.
+        let tree = blend(
+            0.5,
+            blend(0.5, diffuse(0.1), diffuse(0.2)),
+            blend(0.5, diffuse(0.3), blend(0.5, diffuse(0.4), diffuse(0.5))),
+        );
+        let bsdf = tree.bsdf(&ShadingPoint::at(Vec3::Z), Vec3::Z);
+        let lobes: Vec<(f32, Bxdf)> = bsdf.lobes().map(|l| (l.weight, l.bxdf)).collect();
+        assert_eq!(lobes.len(), MAX_LOBES);
+        for (k, (weight, r)) in [(0.25, 0.1), (0.25, 0.2), (0.25, 0.3), (0.125, 0.4)]
+            .into_iter()
+            .enumerate()
+        {
+            let Bxdf::Diffuse(d) = lobes[k].1 else {
+                panic!("lobe {k}: {:?}", lobes[k].1);
+            };
+            assert_eq!(
+                (lobes[k].0, d.reflectance),
+                (weight, Rgb::splat(r)),
+                "lobe {k}"
+            );
+        }
+        assert_eq!(bsdf.pass_through(), 0.0);
+    }
+
+    #[test]
+    fn a_fully_transparent_material_is_a_black_lobe_and_passing_through() {
+        let mask = Material::Mask(Tex::Constant(Rgb::ZERO), Box::new(diffuse(0.5)));
+        let bsdf = mask.bsdf(&ShadingPoint::at(Vec3::Z), Vec3::Z);
+        let lobes: Vec<&Lobe> = bsdf.lobes().collect();
+        assert_eq!(lobes.len(), 1);
+        assert_eq!(lobes[0].weight, 0.0);
+        assert!(matches!(lobes[0].bxdf, Bxdf::Diffuse(d) if d.reflectance == Rgb::ZERO));
+        assert_eq!(bsdf.pass_through(), 1.0);
     }
 }

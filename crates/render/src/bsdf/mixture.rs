@@ -130,18 +130,9 @@ impl Bsdf {
         }
     }
 
-    /// A mixture of `lobes` (at least one; at most [`MAX_LOBES`]) and pass-through weight
-    /// `null`.
-    pub(crate) fn mixture(lobes: &[Lobe], null: f32) -> Self {
-        let mut rest = [None; MAX_LOBES - 1];
-        for (slot, lobe) in rest.iter_mut().zip(lobes.iter().skip(1)) {
-            *slot = Some(*lobe);
-        }
-        Bsdf {
-            first: lobes[0],
-            rest,
-            null,
-        }
+    /// A mixture of lobe `first`, the lobes `rest` holds, and pass-through weight `null`.
+    pub(crate) fn mixture(first: Lobe, rest: [Option<Lobe>; MAX_LOBES - 1], null: f32) -> Self {
+        Bsdf { first, rest, null }
     }
 
     /// Every lobe.
