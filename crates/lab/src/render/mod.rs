@@ -1,7 +1,8 @@
 //! A render as its caller asks for it ([`RenderRequest`], checked before anything is loaded
-//! by [`RenderRequest::check`]) and as the scene's hints complete it ([`Plan`]): the scene loaded, edited and built, the integrator
-//! chosen, the samples, sampler and adaptive rule settled, and its film files' header. The
-//! plan then runs as a [`RenderJob`], and [`summary`] says what was made.
+//! by [`RenderRequest::check`]) and as the scene's hints complete it ([`Plan`]): the scene
+//! loaded, edited and built, the integrator chosen, the samples, sampler and adaptive rule
+//! settled, and its film files' header. The plan then runs as a [`RenderJob`], and
+//! [`summary`] says what was made.
 //!
 //! Errors about what depends on the scene (a crop window past its image, a bounce beyond its
 //! largest, a shard of more parts than samples) name the command line's flags, whose values
