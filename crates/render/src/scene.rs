@@ -363,6 +363,7 @@ impl Scene {
     /// The distance to the nearest surface along a non-camera ray, without making its surface
     /// interaction: the query a ray-tracing kernel answers (`rtcIntersect1`), for measuring
     /// traversal alone.
+    #[inline]
     pub fn hit_distance(&self, ray: &Ray) -> Option<f32> {
         let mut r = *ray;
         self.closest_hit(&mut r, RayKind::Indirect)
