@@ -154,8 +154,12 @@ pub struct Scene {
     tri_slot: Vec<u32>,
     /// Unit geometric normal of each triangle (its winding's side), computed once.
     tri_ng: Vec<Vec3>,
-    /// Each triangle's material and light, as an index into `tri_surfaces`.
+    /// Each triangle's material and light, as an index into `tri_surfaces`; empty where
+    /// every triangle has the same, `same_surface`.
     tri_surface: Vec<u32>,
+    /// The index into `tri_surfaces` of every triangle's material and light, where
+    /// `tri_surface` is empty.
+    same_surface: u32,
     /// The (material, light) pairs of the triangles: entry `m` is material `m` without a
     /// light, then one entry per emitting triangle.
     tri_surfaces: Vec<TriSurface>,
@@ -440,8 +444,11 @@ impl Scene {
         let [p0, e1, e2] = self.triangle_corner_and_edges(i);
         let p = p0 + b1 * e1 + b2 * e2;
         let ng = self.tri_ng[i as usize];
-        let TriSurface { material, light } =
-            self.tri_surfaces[self.tri_surface[i as usize] as usize];
+        let surface = match self.tri_surface.get(i as usize) {
+            Some(&s) => s,
+            None => self.same_surface,
+        };
+        let TriSurface { material, light } = self.tri_surfaces[surface as usize];
         let uv = match self.tri_uv.get(i as usize) {
             Some(uv) => (1.0 - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2],
             None => Vec2::new(b1, b2),
@@ -565,6 +572,11 @@ mod tests {
 
     /// Quads side by side along x, each its own mesh with its own material; some emit.
     fn quads(emitting: &[bool]) -> Scene {
+        Scene::build(&quads_desc(emitting)).unwrap()
+    }
+
+    /// The scene description of [`quads`].
+    fn quads_desc(emitting: &[bool]) -> SceneDesc {
         let meshes = emitting
             .iter()
             .enumerate()
@@ -588,15 +600,14 @@ mod tests {
                 }
             })
             .collect();
-        let desc = SceneDesc {
+        SceneDesc {
             meshes,
             materials: (0..emitting.len())
                 .map(|k| diffuse(Vec3::splat(0.1 * k as f32), false))
                 .collect(),
             resolution: [4, 4],
             ..Default::default()
-        };
-        Scene::build(&desc).unwrap()
+        }
     }
 
     #[test]
@@ -624,6 +635,32 @@ mod tests {
         assert_eq!((n, lights_seen.len()), (6, 6));
         // One table entry per material, and one per emitting triangle.
         assert_eq!(scene.tri_surfaces.len(), emitting.len() + 6);
+    }
+
+    #[test]
+    fn triangles_of_one_surface_keep_no_index_each() {
+        // Every quad of the last material, none emitting: no per-triangle index, and every
+        // hit still reports that material.
+        let mut desc = quads_desc(&[false; 4]);
+        for m in &mut desc.meshes {
+            m.material = 3;
+        }
+        let scene = Scene::build(&desc).unwrap();
+        assert!(scene.tri_surface.is_empty());
+        // The same quads, each of its own material.
+        let with_index = quads(&[false; 4]);
+        assert_eq!(with_index.tri_surface.len(), 8);
+        assert_eq!(
+            scene.geometry_bytes() + 8 * std::mem::size_of::<u32>(),
+            with_index.geometry_bytes()
+        );
+        for k in 0..4 {
+            for (dx, dy) in [(0.7, 0.2), (0.2, 0.7)] {
+                let o = Vec3::new(2.0 * k as f32 + dx, dy, 1.0);
+                let si = scene.intersect(&Ray::new(o, -Vec3::Z)).0.unwrap();
+                assert_eq!((si.material, si.light), (3, None), "quad {k}");
+            }
+        }
     }
 
     #[test]

@@ -56,7 +56,7 @@ impl Scene {
         let all_visible = prim_visibility.iter().all(|v| *v == Visibility::ALL);
         let only_triangles = spheres.spheres.is_empty() && grids.voxels.is_empty();
         let leaves = leaf_blocks(&mut bvh, &prims, &triangles.triangles, &prim_visibility);
-        let (tri_surface, tri_surfaces) =
+        let (tri_surface, tri_surfaces, same_surface) =
             surface_table(&triangles.material, &triangles.light, materials.len());
         let stats = BuildStats {
             bvh_seconds,
@@ -70,6 +70,7 @@ impl Scene {
             tri_slot: leaves.tri_slot,
             tri_surface,
             tri_surfaces,
+            same_surface,
             tri_uv: triangles.uv,
             tri_normals: triangles.normals,
             spheres: spheres.spheres,
@@ -201,15 +202,21 @@ impl Lights {
 
 /// Each triangle's (material, light) as an index into a table of pairs: entry `m` of the
 /// table is material `m` (of `materials`) without a light, and each emitting triangle has an
-/// entry of its own. One index per triangle instead of two.
-fn surface_table(material: &[u32], light: &[u32], materials: usize) -> (Vec<u32>, Vec<TriSurface>) {
+/// entry of its own. One index per triangle instead of two, and none where every triangle
+/// has the same pair (a mesh of one material, not emitting: the index list is then empty
+/// and the third value is that one index).
+fn surface_table(
+    material: &[u32],
+    light: &[u32],
+    materials: usize,
+) -> (Vec<u32>, Vec<TriSurface>, u32) {
     let mut table: Vec<TriSurface> = (0..materials as u32)
         .map(|material| TriSurface {
             material,
             light: NO_LIGHT,
         })
         .collect();
-    let index = material
+    let index: Vec<u32> = material
         .iter()
         .zip(light)
         .map(|(&material, &light)| {
@@ -221,7 +228,10 @@ fn surface_table(material: &[u32], light: &[u32], materials: usize) -> (Vec<u32>
             }
         })
         .collect();
-    (index, table)
+    match index.first() {
+        Some(&first) if index.iter().all(|&s| s == first) => (Vec::new(), table, first),
+        _ => (index, table, 0),
+    }
 }
 
 /// Every mesh's triangles, with what each carries, in one array per property.
