@@ -1,6 +1,7 @@
 //! Micro-benchmarks of the renderer's hot paths, so that regressions show: the ray–triangle
 //! test, closest-hit and any-hit traversal of the 4-wide BVH (and the binary one it replaced),
-//! BSDF sampling, and the samplers. `cargo bench -p pathlab-render`. Not tests.
+//! BSDF sampling, the samplers, and an environment map's light samples and lookups.
+//! `cargo bench -p pathlab-render`. Not tests.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use glam::{Vec2, Vec3};
@@ -168,5 +169,43 @@ fn samplers(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, traversal, bsdfs, samplers);
+/// A 512 × 256 sky: a gradient from the horizon up and a small sun of radiance 5,000.
+fn sky() -> pathlab_render::envmap::EnvironmentMap {
+    let (w, h) = (512, 256);
+    let sun = Vec3::new(0.3, 0.8, -0.5).normalize();
+    let texels = (0..w * h)
+        .map(|k| {
+            let d = pathlab_render::envmap::EnvironmentMap::grid_direction(k % w, k / w, w, h);
+            let up = d.y.max(0.0);
+            let near_sun = if d.dot(sun) > 0.9995 { 5000.0 } else { 0.0 };
+            Vec3::new(0.3 + up, 0.5 + up, 1.0) + Vec3::splat(near_sun)
+        })
+        .collect();
+    pathlab_render::envmap::EnvironmentMap::new(texels, w, h, glam::Mat3::IDENTITY, 1.0)
+        .expect("a valid map")
+}
+
+fn environment_map(c: &mut Criterion) {
+    let map = sky();
+    let mut rng = Pcg32::new(5, 1);
+    let us: Vec<Vec2> = (0..1024)
+        .map(|_| Vec2::new(rng.uniform_f32(), rng.uniform_f32()))
+        .collect();
+    c.bench_function("environment map sample, 1024 draws", |b| {
+        b.iter(|| us.iter().filter_map(|&u| map.sample(black_box(u))).count())
+    });
+    let ws: Vec<Vec3> = us
+        .iter()
+        .map(|u| pathlab_mc::warp::sample_uniform_sphere(*u))
+        .collect();
+    c.bench_function("environment map radiance and pdf, 1024 directions", |b| {
+        b.iter(|| {
+            ws.iter()
+                .map(|&w| map.eval_and_pdf(black_box(w)).1)
+                .sum::<f32>()
+        })
+    });
+}
+
+criterion_group!(benches, traversal, bsdfs, samplers, environment_map);
 criterion_main!(benches);
