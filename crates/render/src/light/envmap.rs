@@ -147,7 +147,7 @@ impl EnvironmentMap {
     /// (u, v) of a local direction.
     fn direction_to_uv(d: Vec3) -> Vec2 {
         let u = d.x.atan2(-d.z) / TAU;
-        Vec2::new(u - u.floor(), d.y.clamp(-1.0, 1.0).acos() / PI)
+        Vec2::new(wrap_u(u), d.y.clamp(-1.0, 1.0).acos() / PI)
     }
 
     /// The local direction of (u, v), and sin θ.
@@ -162,9 +162,8 @@ impl EnvironmentMap {
 
     /// Grid coordinates (x in [0, W), y in [0, H - 1]) of (u, v).
     fn grid(&self, uv: Vec2) -> Vec2 {
-        let a = uv.x - self.half_texel();
         Vec2::new(
-            (a - a.floor()) * self.width as f32,
+            wrap_u(uv.x - self.half_texel()) * self.width as f32,
             uv.y * (self.height - 1) as f32,
         )
     }
@@ -175,7 +174,8 @@ impl EnvironmentMap {
         let x0 = (g.x as usize).min(self.width - 1);
         let y0 = (g.y as usize).min(self.height - 2);
         let (fx, fy) = (g.x - x0 as f32, (g.y - y0 as f32).clamp(0.0, 1.0));
-        let x1 = (x0 + 1) % self.width;
+        // The next column, wrapping around in u (a comparison, not an integer division).
+        let x1 = if x0 + 1 == self.width { 0 } else { x0 + 1 };
         let at = |x: usize, y: usize| self.texels[y * self.width + x];
         let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
         let bottom = at(x0, y0 + 1) * (1.0 - fx) + at(x1, y0 + 1) * fx;
@@ -208,8 +208,7 @@ impl EnvironmentMap {
             return None;
         }
         // Cells start at grid column 0, half a texel into u.
-        let mut uv = Vec2::new(cell_uv.x + self.half_texel(), cell_uv.y);
-        uv.x -= uv.x.floor();
+        let uv = Vec2::new(wrap_u(cell_uv.x + self.half_texel()), cell_uv.y);
         let (d, sin_t) = Self::uv_to_direction(uv);
         if sin_t <= 0.0 {
             return None;
@@ -231,9 +230,24 @@ impl EnvironmentMap {
         if sin2 <= 0.0 {
             return 0.0;
         }
-        let a = uv.x - self.half_texel();
-        let cell_uv = Vec2::new(a - a.floor(), uv.y);
+        let cell_uv = Vec2::new(wrap_u(uv.x - self.half_texel()), uv.y);
         self.distribution.pdf(cell_uv) / (2.0 * PI * PI * sin2.sqrt())
+    }
+}
+
+/// `u - floor(u)` for `u` in [-1, 2), the range of every u coordinate this module wraps
+/// (shifted by half a texel at most, or from `atan2`'s [-½, ½]): the same subtraction of the
+/// same whole number, chosen by comparisons rather than computed by `floor` (a library call
+/// on CPUs without SSE4.1). A -0 stays -0 (`floor` would give +0), which no caller tells
+/// apart: every one scales it or subtracts from it.
+#[inline]
+fn wrap_u(u: f32) -> f32 {
+    if u < 0.0 {
+        u + 1.0
+    } else if u >= 1.0 {
+        u - 1.0
+    } else {
+        u
     }
 }
 
@@ -263,6 +277,33 @@ mod tests {
         let phi = TAU * 6.0 / 16.0;
         let d = Vec3::new(phi.sin(), 0.0, -phi.cos());
         assert!((m.eval(d) - Vec3::splat(0.5)).abs().max_element() < 1e-5);
+    }
+
+    #[test]
+    fn wrapping_u_subtracts_its_floor() {
+        let mut us = vec![
+            -1.0f32,
+            -0.5,
+            -1e-30,
+            0.0,
+            1e-30,
+            0.25,
+            0.5,
+            1.0,
+            1.5,
+            2.0f32.next_down(),
+        ];
+        us.extend(us.clone().iter().flat_map(|u| [u.next_up(), u.next_down()]));
+        us.extend((0..1000).map(|i| -1.0 + 3.0 * i as f32 / 1000.0));
+        for u in us.into_iter().filter(|u| (-1.0..2.0).contains(u)) {
+            let floored = u - u.floor();
+            // The same number; -0 only where floor gives +0.
+            assert_eq!(wrap_u(u), floored, "u = {u}");
+            assert!(
+                wrap_u(u).to_bits() == floored.to_bits() || u == 0.0,
+                "u = {u}"
+            );
+        }
     }
 
     #[test]
