@@ -52,19 +52,7 @@ impl Texture {
         if !uv.is_finite() {
             return self.texels[0];
         }
-        let (w, h) = (self.width as i64, self.height as i64);
-        let fix = |i: i64, n: i64| -> Option<usize> {
-            match wrap {
-                WrapMode::Repeat => Some(i.rem_euclid(n) as usize),
-                WrapMode::Clamp => Some(i.clamp(0, n - 1) as usize),
-                WrapMode::Mirror => {
-                    let m = i.rem_euclid(2 * n);
-                    Some((if m < n { m } else { 2 * n - 1 - m }) as usize)
-                }
-                WrapMode::Black => (0..n).contains(&i).then_some(i as usize),
-            }
-        };
-        let at = |x: i64, y: i64| match (fix(x, w), fix(y, h)) {
+        let at = |x: Option<usize>, y: Option<usize>| match (x, y) {
             (Some(x), Some(y)) => self.texels[y * self.width + x],
             _ => Rgb::ZERO,
         };
@@ -72,14 +60,19 @@ impl Texture {
         let x = uv.x * self.width as f32;
         let y = (1.0 - uv.y) * self.height as f32;
         match filter {
-            TextureFilter::Nearest => at(x.floor() as i64, y.floor() as i64),
+            TextureFilter::Nearest => {
+                let column = wrap.texel(floor(x) as i64, self.width);
+                at(column, wrap.texel(floor(y) as i64, self.height))
+            }
             TextureFilter::Bilinear => {
                 let (x, y) = (x - 0.5, y - 0.5);
-                let (x0, y0) = (x.floor(), y.floor());
+                let (x0, y0) = (floor(x), floor(y));
                 let (fx, fy) = (x - x0, y - y0);
-                let (xi, yi) = (x0 as i64, y0 as i64);
-                let top = at(xi, yi) * (1.0 - fx) + at(xi + 1, yi) * fx;
-                let bottom = at(xi, yi + 1) * (1.0 - fx) + at(xi + 1, yi + 1) * fx;
+                // Each axis's two texels wrapped once, not once per corner.
+                let [xa, xb] = wrap.texel_pair(x0 as i64, self.width);
+                let [ya, yb] = wrap.texel_pair(y0 as i64, self.height);
+                let top = at(xa, ya) * (1.0 - fx) + at(xb, ya) * fx;
+                let bottom = at(xa, yb) * (1.0 - fx) + at(xb, yb) * fx;
                 top * (1.0 - fy) + bottom * fy
             }
         }
@@ -92,15 +85,64 @@ impl Texture {
         }
         let x = uv.x * self.width as f32 - 0.5;
         let y = (1.0 - uv.y) * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (floor(x), floor(y));
         let (fx, fy) = (x - x0, y - y0);
-        let wrap = |i: f32, n: usize| (i as i64).rem_euclid(n as i64) as usize;
+        let wrap = |i: f32, n: usize| WrapMode::Repeat.texel(i as i64, n).unwrap_or(0);
         let (xa, xb) = (wrap(x0, self.width), wrap(x0 + 1.0, self.width));
         let (ya, yb) = (wrap(y0, self.height), wrap(y0 + 1.0, self.height));
         let at = |x: usize, y: usize| self.texels[y * self.width + x];
         let top = at(xa, ya) * (1.0 - fx) + at(xb, ya) * fx;
         let bottom = at(xa, yb) * (1.0 - fx) + at(xb, yb) * fx;
         top * (1.0 - fy) + bottom * fy
+    }
+}
+
+impl WrapMode {
+    /// The texel of an axis `n` texels long that coordinate `i` (in texels) reads; none where
+    /// the image is black there.
+    #[inline]
+    fn texel(self, i: i64, n: usize) -> Option<usize> {
+        let n = n as i64;
+        let inside = (0..n).contains(&i);
+        match self {
+            // Inside the image, as nearly every lookup is, without the integer division.
+            WrapMode::Repeat => Some(if inside { i } else { i.rem_euclid(n) } as usize),
+            WrapMode::Clamp => Some(i.clamp(0, n - 1) as usize),
+            WrapMode::Mirror => {
+                let m = if inside { i } else { i.rem_euclid(2 * n) };
+                Some((if m < n { m } else { 2 * n - 1 - m }) as usize)
+            }
+            WrapMode::Black => inside.then_some(i as usize),
+        }
+    }
+
+    /// The texels that coordinates `i` and `i + 1` read ([`WrapMode::texel`]).
+    #[inline]
+    fn texel_pair(self, i: i64, n: usize) -> [Option<usize>; 2] {
+        let first = self.texel(i, n);
+        let second = match (self, first) {
+            // The next texel of a repeating image, without wrapping again.
+            (WrapMode::Repeat, Some(a)) => Some(if a + 1 == n { 0 } else { a + 1 }),
+            _ => self.texel(i.saturating_add(1), n),
+        };
+        [first, second]
+    }
+}
+
+/// `x.floor()`, to the bit (a -0 stays -0), computed inline: on x86-64 CPUs without SSE4.1,
+/// the target the renderer is compiled for, `floor` is a library call.
+#[inline]
+pub(crate) fn floor(x: f32) -> f32 {
+    // From 2^23 on every float is a whole number (and NaN is its own floor).
+    if !(x.abs() < 8_388_608.0) {
+        return x;
+    }
+    // Truncation, exact in this range, with the sign kept (-0.3 truncates to -0).
+    let t = (x as i32 as f32).copysign(x);
+    if t > x {
+        t - 1.0
+    } else {
+        t
     }
 }
 
@@ -250,7 +292,7 @@ impl Tex {
                 to_uv,
             } => {
                 let q = to_uv.transform_point2(p.uv);
-                let (x, y) = (q.x - q.x.floor() > 0.5, q.y - q.y.floor() > 0.5);
+                let (x, y) = (q.x - floor(q.x) > 0.5, q.y - floor(q.y) > 0.5);
                 if x == y {
                     *color0
                 } else {
@@ -299,7 +341,7 @@ impl Tex {
         let lum = crate::color::mitsuba_luminance;
         let x = q.x * w - 0.5;
         let y = (1.0 - q.y) * h - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (floor(x), floor(y));
         let (fx, fy) = (x - x0, y - y0);
         let at = |dx: f32, dy: f32| {
             // Texel centres: back to image coordinates for the wrapped lookup.
@@ -343,6 +385,77 @@ impl Tex {
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn floor_is_the_standard_floor_to_the_bit() {
+        let mut xs = vec![
+            0.0f32,
+            -0.0,
+            0.3,
+            -0.3,
+            1.0,
+            -1.0,
+            2.5,
+            -2.5,
+            1e-30,
+            -1e-30,
+            8_388_607.5,
+            -8_388_607.5,
+            8_388_608.0,
+            -8_388_609.0,
+            3e9,
+            -3e9,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        let mut rng = pathlab_mc::rng::Pcg32::new(9, 2);
+        xs.extend((0..20_000).map(|_| (rng.uniform_f32() - 0.5) * 4096.0));
+        xs.extend(
+            xs.clone()
+                .into_iter()
+                .flat_map(|x| [x.next_up(), x.next_down()]),
+        );
+        for x in xs {
+            assert_eq!(floor(x).to_bits(), x.floor().to_bits(), "x = {x}");
+        }
+        assert!(floor(f32::NAN).is_nan());
+    }
+
+    #[test]
+    fn each_wrap_mode_reads_the_texel_the_formula_gives() {
+        let expected = |wrap: WrapMode, i: i64, n: i64| -> Option<usize> {
+            match wrap {
+                WrapMode::Repeat => Some(i.rem_euclid(n) as usize),
+                WrapMode::Clamp => Some(i.clamp(0, n - 1) as usize),
+                WrapMode::Mirror => {
+                    let m = i.rem_euclid(2 * n);
+                    Some((if m < n { m } else { 2 * n - 1 - m }) as usize)
+                }
+                WrapMode::Black => (0..n).contains(&i).then_some(i as usize),
+            }
+        };
+        for wrap in [
+            WrapMode::Repeat,
+            WrapMode::Mirror,
+            WrapMode::Clamp,
+            WrapMode::Black,
+        ] {
+            for n in [1usize, 2, 3, 7, 64] {
+                let far = [i64::MIN, i64::MIN + 1, -(1 << 40), 1 << 40, i64::MAX - 1];
+                for i in (-4 * n as i64..4 * n as i64).chain(far) {
+                    let n64 = n as i64;
+                    assert_eq!(wrap.texel(i, n), expected(wrap, i, n64), "{wrap:?} {i} {n}");
+                    assert_eq!(
+                        wrap.texel_pair(i, n),
+                        [expected(wrap, i, n64), expected(wrap, i + 1, n64)],
+                        "{wrap:?} {i} {n}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn texel_centres_are_exact_and_between_is_interpolated() {
