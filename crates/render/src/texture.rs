@@ -134,7 +134,7 @@ impl WrapMode {
 #[inline]
 pub(crate) fn floor(x: f32) -> f32 {
     // From 2^23 on every float is a whole number (and NaN is its own floor).
-    if !(x.abs() < 8_388_608.0) {
+    if x.abs() >= 8_388_608.0 || x.is_nan() {
         return x;
     }
     // Truncation, exact in this range, with the sign kept (-0.3 truncates to -0).
