@@ -48,78 +48,68 @@ struct Entry {
 #[inline]
 fn count_at_most(values: &[f32], u: f32) -> usize {
     #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        let mut chunks = values.chunks_exact(4);
-        // SAFETY: SSE2, all these intrinsics require, is part of every x86-64 CPU; each load
+    return count_by_fours(
+        values,
+        u,
+        |&c| c,
+        // SAFETY: SSE2, all `_mm_loadu_ps` requires, is part of every x86-64 CPU; the load
         // reads the four floats of a chunk of exactly four.
-        let counted = unsafe {
-            let u4 = _mm_set1_ps(u);
-            let mut lanes = _mm_setzero_si128();
-            for chunk in &mut chunks {
-                let le = _mm_cmple_ps(_mm_loadu_ps(chunk.as_ptr()), u4);
-                lanes = count_lanes(lanes, le);
-            }
-            sum_lanes(lanes)
-        };
-        counted + chunks.remainder().iter().filter(|&&c| c <= u).count()
-    }
+        |four| unsafe { std::arch::x86_64::_mm_loadu_ps(four.as_ptr()) },
+    );
     #[cfg(not(target_arch = "x86_64"))]
     values.iter().filter(|&&c| c <= u).count()
 }
 
-/// How many of `entries` have a CDF value at most `u`, as [`count_at_most`] counts, the
-/// values picked from the entries' pairs of floats.
+/// How many of `entries` have a CDF value at most `u`, as [`count_at_most`] counts.
 #[inline]
 fn count_cdf_at_most(entries: &[Entry], u: f32) -> usize {
     #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        let mut chunks = entries.chunks_exact(4);
-        // SAFETY: as in `count_at_most`; an `Entry` is two `f32` (`repr(C)`), so a chunk of
-        // four entries is eight floats, read by two loads of four.
-        let counted = unsafe {
-            let u4 = _mm_set1_ps(u);
-            let mut lanes = _mm_setzero_si128();
-            for chunk in &mut chunks {
-                let p = chunk.as_ptr().cast::<f32>();
-                let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(4)));
-                // The CDF values are the even floats: lanes 0 and 2 of each load.
-                let cdf = _mm_shuffle_ps::<0b10_00_10_00>(a, b);
-                lanes = count_lanes(lanes, _mm_cmple_ps(cdf, u4));
+    return count_by_fours(
+        entries,
+        u,
+        |e| e.cdf,
+        |four| {
+            use std::arch::x86_64::*;
+            // SAFETY: as in `count_at_most`; an `Entry` is two `f32` (`repr(C)`), so four
+            // entries are eight floats, read by two loads of four, whose even lanes are the
+            // CDF values.
+            unsafe {
+                let p = four.as_ptr().cast::<f32>();
+                _mm_shuffle_ps::<0b10_00_10_00>(_mm_loadu_ps(p), _mm_loadu_ps(p.add(4)))
             }
-            sum_lanes(lanes)
-        };
-        counted + chunks.remainder().iter().filter(|e| e.cdf <= u).count()
-    }
+        },
+    );
     #[cfg(not(target_arch = "x86_64"))]
     entries.iter().filter(|e| e.cdf <= u).count()
 }
 
-/// Adds one to each lane of `counts` whose lane of the comparison `mask` is true (all ones:
-/// -1 as an integer, so subtracting it counts).
+/// How many of `items` have a `key` at most `u`: the keys of each chunk of four, as `keys`
+/// loads them into one register, compared with one SSE2 instruction, the last few one at a
+/// time.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn count_lanes(
-    counts: std::arch::x86_64::__m128i,
-    mask: std::arch::x86_64::__m128,
-) -> std::arch::x86_64::__m128i {
+fn count_by_fours<T>(
+    items: &[T],
+    u: f32,
+    key: impl Fn(&T) -> f32,
+    keys: impl Fn(&[T]) -> std::arch::x86_64::__m128,
+) -> usize {
     use std::arch::x86_64::*;
-    // SAFETY: SSE2 is part of every x86-64 CPU.
-    unsafe { _mm_sub_epi32(counts, _mm_castps_si128(mask)) }
-}
-
-/// The sum of the four lanes of `counts`.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn sum_lanes(counts: std::arch::x86_64::__m128i) -> usize {
-    use std::arch::x86_64::*;
-    // SAFETY: SSE2 is part of every x86-64 CPU.
-    unsafe {
+    let mut chunks = items.chunks_exact(4);
+    // SAFETY: SSE2, all these intrinsics require, is part of every x86-64 CPU.
+    let counted = unsafe {
+        let u4 = _mm_set1_ps(u);
+        // A true comparison is all ones, -1 as an integer: subtracting it counts.
+        let mut counts = _mm_setzero_si128();
+        for four in &mut chunks {
+            let le = _mm_cmple_ps(keys(four), u4);
+            counts = _mm_sub_epi32(counts, _mm_castps_si128(le));
+        }
         let pairs = _mm_add_epi32(counts, _mm_shuffle_epi32::<0b01_00_11_10>(counts));
         let all = _mm_add_epi32(pairs, _mm_shuffle_epi32::<0b10_11_00_01>(pairs));
         _mm_cvtsi128_si32(all) as usize
-    }
+    };
+    counted + chunks.remainder().iter().filter(|x| key(x) <= u).count()
 }
 
 /// The tables of one 1D distribution, borrowed: what sampling and evaluation read. A
