@@ -80,20 +80,7 @@ impl Texture {
 
     /// The bilinearly interpolated value at `uv` (repeating outside [0, 1]²).
     pub fn eval(&self, uv: Vec2) -> Rgb {
-        if !uv.is_finite() {
-            return self.texels[0];
-        }
-        let x = uv.x * self.width as f32 - 0.5;
-        let y = (1.0 - uv.y) * self.height as f32 - 0.5;
-        let (x0, y0) = (floor(x), floor(y));
-        let (fx, fy) = (x - x0, y - y0);
-        let wrap = |i: f32, n: usize| WrapMode::Repeat.texel(i as i64, n).unwrap_or(0);
-        let (xa, xb) = (wrap(x0, self.width), wrap(x0 + 1.0, self.width));
-        let (ya, yb) = (wrap(y0, self.height), wrap(y0 + 1.0, self.height));
-        let at = |x: usize, y: usize| self.texels[y * self.width + x];
-        let top = at(xa, ya) * (1.0 - fx) + at(xb, ya) * fx;
-        let bottom = at(xa, yb) * (1.0 - fx) + at(xb, yb) * fx;
-        top * (1.0 - fy) + bottom * fy
+        self.lookup(uv, TextureFilter::Bilinear, WrapMode::Repeat)
     }
 }
 
