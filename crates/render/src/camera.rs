@@ -4,6 +4,7 @@
 
 use crate::desc::{CameraDesc, FovAxis, PixelFilter, Projection};
 use crate::geometry::Ray;
+use crate::simd::lanes::{Real, Vector3, F8, W};
 use glam::{Vec2, Vec3};
 use pathlab_mc::warp::sample_uniform_disk_concentric;
 use std::sync::Arc;
@@ -131,21 +132,10 @@ impl Camera {
     /// `u_lens` when the camera has an aperture. The direction has unit length.
     #[inline]
     pub fn generate_ray(&self, film: Vec2, u_lens: Vec2) -> Ray {
-        let mut ndc = Vec2::new(
-            2.0 * film.x / self.resolution[0] as f32 - 1.0,
-            1.0 - 2.0 * film.y / self.resolution[1] as f32,
-        );
-        if self.shift != Vec2::ZERO {
-            ndc += self.shift;
-        }
-        if self.orthographic {
-            let o = self.origin + ndc.x * self.half.x * self.right + ndc.y * self.half.y * self.up;
-            return self.clip(Ray::new(o, self.forward), 1.0);
-        }
-        let d = (ndc.x * self.half.x * self.right + ndc.y * self.half.y * self.up + self.forward)
-            .normalize();
-        if self.lens_radius <= 0.0 {
-            return self.clip(Ray::new(self.origin, d), d.dot(self.forward));
+        let (o, d, cos) = self.pinhole_ray(film.x, film.y);
+        if self.orthographic || self.lens_radius <= 0.0 {
+            let (t_min, t_max) = self.clip(cos);
+            return Ray { o, d, t_min, t_max };
         }
         // Thin lens: every ray through the lens point meets the pinhole ray at the plane of
         // focus.
@@ -153,7 +143,69 @@ impl Camera {
         let o = self.origin + lens.x * self.right + lens.y * self.up;
         let focus = self.origin + d * (self.focal_distance / d.dot(self.forward));
         let d = (focus - o).normalize();
-        self.clip(Ray::new(o, d), d.dot(self.forward))
+        let (t_min, t_max) = self.clip(d.dot(self.forward));
+        Ray { o, d, t_min, t_max }
+    }
+
+    /// [`Camera::generate_ray`] for eight film positions at once, the same rays to the bit,
+    /// where the camera has no lens (pinhole or orthographic; `None` for a thin lens, whose
+    /// disk warp is one lane at a time).
+    pub fn generate_rays(&self, film: [Vec2; W]) -> Option<[Ray; W]> {
+        if !self.orthographic && self.lens_radius > 0.0 {
+            return None;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx2) = crate::simd::Avx2::detect() {
+            // SAFETY: `rays_avx2` requires AVX2 and FMA, which `avx2` proves this CPU has. Its
+            // body is safe code.
+            return Some(unsafe { self.rays_avx2(avx2, &film) });
+        }
+        Some(self.rays_lanes(&film))
+    }
+
+    /// [`Camera::rays_lanes`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn rays_avx2(&self, _: crate::simd::Avx2, film: &[Vec2; W]) -> [Ray; W] {
+        self.rays_lanes(film)
+    }
+
+    /// The rays of a camera without a lens through eight film positions, on lanes.
+    #[inline(always)]
+    fn rays_lanes(&self, film: &[Vec2; W]) -> [Ray; W] {
+        let (o, d, cos) = self.pinhole_ray(F8(film.map(|f| f.x)), F8(film.map(|f| f.y)));
+        let (t_min, t_max) = self.clip(cos);
+        std::array::from_fn(|i| Ray {
+            o: o.get(i),
+            d: d.get(i),
+            t_min: t_min.0[i],
+            t_max: t_max.0[i],
+        })
+    }
+
+    /// The ray through film position (`fx`, `fy`) of the camera without its lens, for one
+    /// position or for lanes: origin, unit direction, and the cosine to the viewing direction
+    /// that turns the clipping distances into distances along the ray (one for an
+    /// orthographic camera).
+    #[inline(always)]
+    fn pinhole_ray<T: Real>(&self, fx: T, fy: T) -> (T::V3, T::V3, T) {
+        let [w, h] = self.resolution.map(|r| T::splat(r as f32));
+        let (one, two) = (T::splat(1.0), T::splat(2.0));
+        let (mut x, mut y) = (two * fx / w - one, one - two * fy / h);
+        if self.shift != Vec2::ZERO {
+            x = x + T::splat(self.shift.x);
+            y = y + T::splat(self.shift.y);
+        }
+        let right = T::V3::splat(self.right).scale(x * T::splat(self.half.x));
+        let up = T::V3::splat(self.up).scale(y * T::splat(self.half.y));
+        let forward = T::V3::splat(self.forward);
+        if self.orthographic {
+            return (T::V3::splat(self.origin) + right + up, forward, one);
+        }
+        // glam's `normalize`: times the reciprocal of the length.
+        let v = right + up + forward;
+        let d = v.scale(one / v.dot(v).sqrt());
+        (T::V3::splat(self.origin), d, d.dot(forward))
     }
 
     /// The film position (pixel units, as [`Camera::film_position`] gives them) where world
@@ -175,16 +227,16 @@ impl Camera {
         film.is_finite().then_some(film)
     }
 
-    /// `ray` limited to the depths between the near and far clipping planes (`cos`: the cosine
-    /// between the ray and the viewing direction).
-    #[inline]
-    fn clip(&self, mut ray: Ray, cos: f32) -> Ray {
+    /// The extent of a ray between the near and far clipping planes, `(t_min, t_max)` (`cos`:
+    /// the cosine between the ray and the viewing direction); unbounded without clipping.
+    #[inline(always)]
+    fn clip<T: Real>(&self, cos: T) -> (T, T) {
         if self.near > 0.0 || self.far.is_finite() {
-            let inv = 1.0 / cos.max(1e-6);
-            ray.t_min = self.near * inv;
-            ray.t_max = self.far * inv;
+            let inv = T::splat(1.0) / cos.max(T::splat(1e-6));
+            (T::splat(self.near) * inv, T::splat(self.far) * inv)
+        } else {
+            (T::splat(0.0), T::splat(f32::INFINITY))
         }
-        ray
     }
 }
 
@@ -615,5 +667,70 @@ mod tests {
             let t = (focus - r.o).dot(r.d);
             assert!((r.at(t) - focus).length() < 1e-4);
         }
+    }
+
+    #[test]
+    fn eight_rays_at_once_are_the_one_ray_code_to_the_bit() {
+        use pathlab_mc::rng::Pcg32;
+        let base = CameraDesc {
+            origin: Vec3::new(0.3, 0.5, 3.9),
+            target: Vec3::new(0.0, 0.2, 0.0),
+            up: Vec3::Y,
+            fov_degrees: 39.3,
+            ..Default::default()
+        };
+        let cameras = [
+            base,
+            CameraDesc {
+                principal_point_offset: Vec2::new(0.1, -0.05),
+                near_clip: 0.01,
+                far_clip: 100.0,
+                ..base
+            },
+            CameraDesc {
+                projection: Projection::Orthographic {
+                    half_extent: Vec2::new(2.0, 1.2),
+                },
+                far_clip: 50.0,
+                ..base
+            },
+        ];
+        let mut rng = Pcg32::new(3, 5);
+        for desc in cameras {
+            let cam = Camera::new(&desc, [160, 90]);
+            for _ in 0..64 {
+                // Film positions inside the image and a little outside it.
+                let film: [Vec2; W] = std::array::from_fn(|_| {
+                    Vec2::new(
+                        rng.uniform_f32() * 200.0 - 20.0,
+                        rng.uniform_f32() * 130.0 - 20.0,
+                    )
+                });
+                let one = film.map(|f| cam.generate_ray(f, Vec2::ZERO));
+                let bits = |r: &Ray| {
+                    [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.t_min, r.t_max].map(f32::to_bits)
+                };
+                let dispatched = cam.generate_rays(film).unwrap();
+                let portable = cam.rays_lanes(&film);
+                for i in 0..W {
+                    assert_eq!(
+                        bits(&dispatched[i]),
+                        bits(&one[i]),
+                        "{desc:?} at {}",
+                        film[i]
+                    );
+                    assert_eq!(bits(&portable[i]), bits(&one[i]), "{desc:?} at {}", film[i]);
+                }
+            }
+        }
+        let lens = Camera::new(
+            &CameraDesc {
+                lens_radius: 0.1,
+                focal_distance: 3.0,
+                ..base
+            },
+            [160, 90],
+        );
+        assert!(lens.generate_rays([Vec2::ZERO; W]).is_none());
     }
 }

@@ -129,10 +129,31 @@ pub fn li_one_at_a_time<I: Integrator + ?Sized>(
 /// sample's radiance takes (one, except under a pixel filter with negative lobes).
 #[inline]
 pub fn camera_ray(scene: &Scene, sampler: &mut AnySampler, s: SampleRef) -> (Ray, f32) {
+    let c = camera_sample(scene, sampler, s);
+    (scene.camera().generate_ray(c.film, c.u_lens), c.weight)
+}
+
+/// What a camera ray is made from: the film position, the weight of the sample's radiance
+/// and the lens sample.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct CameraSample {
+    pub film: glam::Vec2,
+    pub weight: f32,
+    pub u_lens: glam::Vec2,
+}
+
+/// [`camera_ray`]'s use of the sampler: positions it at pixel sample `s` and draws the
+/// position in the pixel, then the point on the lens.
+#[inline]
+pub(crate) fn camera_sample(scene: &Scene, sampler: &mut AnySampler, s: SampleRef) -> CameraSample {
     sampler.start_pixel_sample(s.pixel, s.index, 0);
     let (film, weight) = scene.camera().film_sample(s.pixel, sampler.next_pixel_2d());
     let u_lens = sampler.next_2d();
-    (scene.camera().generate_ray(film, u_lens), weight)
+    CameraSample {
+        film,
+        weight,
+        u_lens,
+    }
 }
 
 /// Which integrator, with its settings.

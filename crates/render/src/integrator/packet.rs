@@ -17,7 +17,9 @@
 //! tested, which of several triangles at exactly the same distance a ray is taken to hit.
 
 use super::path::{PathIntegrator, PathState};
-use super::{camera_ray, power_heuristic_weight, sample_light, PathStats, SampleRef};
+use super::{
+    camera_sample, power_heuristic_weight, sample_light, CameraSample, PathStats, SampleRef,
+};
 use crate::accel::RayLanes;
 use crate::bsdf::Diffuse;
 use crate::desc::{RayKind, Rgb};
@@ -294,27 +296,52 @@ impl PathIntegrator {
     }
 }
 
-/// Idle lanes take the next samples' camera rays; returns whether samples remain.
+/// Idle lanes take the next samples' camera rays, made together where several lanes start and
+/// the camera allows ([`crate::camera::Camera::generate_rays`]); returns whether samples
+/// remain.
 fn start_paths(
     scene: &Scene,
     lanes: &mut [Option<Lane>; W],
     samplers: &mut [AnySampler; W],
     samples: &mut dyn Iterator<Item = SampleRef>,
 ) -> bool {
-    for (lane, smp) in lanes.iter_mut().zip(samplers.iter_mut()) {
+    let mut cam = [CameraSample::default(); W];
+    let mut started = 0u32;
+    let mut more = true;
+    for (i, (lane, smp)) in lanes.iter_mut().zip(samplers.iter_mut()).enumerate() {
         if lane.is_none() {
             let Some(s) = samples.next() else {
-                return false;
+                more = false;
+                break;
             };
-            let (ray, weight) = camera_ray(scene, smp, s);
+            cam[i] = camera_sample(scene, smp, s);
             *lane = Some(Lane {
                 tag: s.tag,
-                st: PathState::new(ray),
-                weight,
+                st: PathState::new(Ray::new(glam::Vec3::ZERO, glam::Vec3::ZERO)),
+                weight: cam[i].weight,
             });
+            started |= 1 << i;
         }
     }
-    true
+    if started == 0 {
+        return more;
+    }
+    // Together where several lanes start (one lane alone is made faster by itself).
+    let camera = scene.camera();
+    let rays = if started.count_ones() > 1 {
+        camera.generate_rays(cam.map(|c| c.film))
+    } else {
+        None
+    };
+    for (i, lane) in lanes.iter_mut().enumerate() {
+        if let (true, Some(lane)) = (started & (1 << i) != 0, lane) {
+            lane.st.ray = match &rays {
+                Some(rays) => rays[i],
+                None => camera.generate_ray(cam[i].film, cam[i].u_lens),
+            };
+        }
+    }
+    more
 }
 
 /// Every busy lane's ray against every primitive at once (the small scenes' trace); idle lanes
