@@ -100,6 +100,102 @@ impl Pcg32 {
     }
 }
 
+/// Eight generators side by side, a lane each, for drawing from all of them at once.
+pub(crate) const LANES: usize = 8;
+
+impl Pcg32 {
+    /// [`Pcg32::uniform_f32`] `out.len()` times from each generator of `rngs` whose bit is set
+    /// in `lanes`: draw k into `out[k][lane]`. The same numbers as those calls, and each of
+    /// those generators is left where the calls leave it; the other lanes of `out` and their
+    /// generators are untouched. All lanes step together: with AVX-512 in one register of
+    /// eight 64-bit states, with AVX2 in two.
+    #[inline]
+    pub(crate) fn uniform_f32_lanes(
+        rngs: [&mut Pcg32; LANES],
+        lanes: u32,
+        out: &mut [[f32; LANES]],
+    ) {
+        let mut state: [u64; LANES] = std::array::from_fn(|i| rngs[i].state);
+        let inc: [u64; LANES] = std::array::from_fn(|i| rngs[i].inc);
+        let mut drawn = [[0.0f32; LANES]; 8];
+        for chunk in out.chunks_mut(drawn.len()) {
+            let drawn = &mut drawn[..chunk.len()];
+            draw_lanes(&mut state, &inc, drawn);
+            for (o, d) in chunk.iter_mut().zip(drawn.iter()) {
+                for (i, (o, d)) in o.iter_mut().zip(d).enumerate() {
+                    if lanes & (1 << i) != 0 {
+                        *o = *d;
+                    }
+                }
+            }
+        }
+        for (i, rng) in rngs.into_iter().enumerate() {
+            if lanes & (1 << i) != 0 {
+                rng.state = state[i];
+            }
+        }
+    }
+}
+
+/// `out.len()` draws of [`Pcg32::uniform_f32`] from every lane's generator (`state`, `inc`),
+/// on the best vector unit this CPU has.
+#[inline]
+fn draw_lanes(state: &mut [u64; LANES], inc: &[u64; LANES], out: &mut [[f32; LANES]]) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx512) = crate::simd::Avx512::detect() {
+        // SAFETY: `draw_lanes_avx512` requires the AVX-512 subsets, AVX2 and FMA that
+        // `avx512` proves this CPU has. Its body is safe code.
+        return unsafe { draw_lanes_avx512(avx512, state, inc, out) };
+    }
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx2) = crate::simd::Avx2::detect() {
+        // SAFETY: `draw_lanes_avx2` requires AVX2 and FMA, which `avx2` proves this CPU has.
+        // Its body is safe code.
+        return unsafe { draw_lanes_avx2(avx2, state, inc, out) };
+    }
+    draw_lanes_portable(state, inc, out)
+}
+
+/// [`draw_lanes_portable`] compiled for AVX-512 (a 64-bit multiply per lane in one
+/// instruction, and a rotate by a variable amount).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+fn draw_lanes_avx512(
+    _: crate::simd::Avx512,
+    state: &mut [u64; LANES],
+    inc: &[u64; LANES],
+    out: &mut [[f32; LANES]],
+) {
+    draw_lanes_portable(state, inc, out)
+}
+
+/// [`draw_lanes_portable`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn draw_lanes_avx2(
+    _: crate::simd::Avx2,
+    state: &mut [u64; LANES],
+    inc: &[u64; LANES],
+    out: &mut [[f32; LANES]],
+) {
+    draw_lanes_portable(state, inc, out)
+}
+
+/// [`Pcg32::next_u32`] and [`Pcg32::uniform_f32`]'s arithmetic on every lane: loops over the
+/// lanes that the compiler turns into vector instructions.
+#[inline(always)]
+fn draw_lanes_portable(state: &mut [u64; LANES], inc: &[u64; LANES], out: &mut [[f32; LANES]]) {
+    for row in out.iter_mut() {
+        for i in 0..LANES {
+            let old = state[i];
+            state[i] = old.wrapping_mul(PCG32_MULT).wrapping_add(inc[i]);
+            let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+            let bits = xorshifted.rotate_right((old >> 59) as u32);
+            row[i] = (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
+        }
+    }
+}
+
 /// `(m, p)` such that `delta` steps of the generator take `state` to `m · state + p · inc`
 /// (Brown, "Random Number Generation with Arbitrary Strides", 1994): the jumps of 2^k steps
 /// ([`POWER_OF_TWO_JUMPS`]) of the bits set in `delta`, composed. Every jump is a power of
@@ -239,6 +335,59 @@ mod tests {
             assert!((0.0..1.0).contains(&f));
             let d = rng.uniform_f64();
             assert!((0.0..1.0).contains(&d));
+        }
+    }
+
+    #[test]
+    fn lanes_draw_what_each_generator_draws_on_every_vector_unit() {
+        let gens: [Pcg32; LANES] =
+            std::array::from_fn(|i| Pcg32::new(7 * i as u64 + 1, 3 * i as u64));
+        for mask in [0xff, 0b1010_0110, 0b1, 0] {
+            for n in [1, 7, 8, 9, 17] {
+                let mut expect = gens.clone();
+                let mut want = vec![[-1.0f32; LANES]; n];
+                for (i, rng) in expect.iter_mut().enumerate() {
+                    if mask & (1 << i) != 0 {
+                        for row in want.iter_mut() {
+                            row[i] = rng.uniform_f32();
+                        }
+                    }
+                }
+                let mut got_gens = gens.clone();
+                let mut got = vec![[-1.0f32; LANES]; n];
+                Pcg32::uniform_f32_lanes(got_gens.each_mut(), mask, &mut got);
+                assert_eq!(got, want, "mask {mask:#b}, {n} draws");
+                assert_eq!(got_gens, expect, "mask {mask:#b}, {n} draws");
+            }
+        }
+        // Each vector unit's compilation of the step, against the portable one.
+        let state0: [u64; LANES] = std::array::from_fn(|i| gens[i].state);
+        let inc: [u64; LANES] = std::array::from_fn(|i| gens[i].inc);
+        type Draw<'a> = &'a dyn Fn(&mut [u64; LANES], &mut [[f32; LANES]]);
+        let run = |f: Draw| {
+            let mut state = state0;
+            let mut out = vec![[0.0f32; LANES]; 33];
+            f(&mut state, &mut out);
+            (state, out)
+        };
+        let portable = run(&|s, o| draw_lanes_portable(s, &inc, o));
+        assert_eq!(run(&|s, o| draw_lanes(s, &inc, o)), portable);
+        #[cfg(target_arch = "x86_64")]
+        {
+            if let Some(avx2) = crate::simd::Avx2::detect() {
+                // SAFETY: `avx2` proves the CPU has what the function is compiled for.
+                assert_eq!(
+                    run(&|s, o| unsafe { draw_lanes_avx2(avx2, s, &inc, o) }),
+                    portable
+                );
+            }
+            if let Some(avx512) = crate::simd::Avx512::detect() {
+                // SAFETY: `avx512` proves the CPU has what the function is compiled for.
+                assert_eq!(
+                    run(&|s, o| unsafe { draw_lanes_avx512(avx512, s, &inc, o) }),
+                    portable
+                );
+            }
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The independent sampler ([`IndependentSampler`]): uniform numbers from a PCG32 stream per
 //! pixel, each sample and dimension at its own position in it, independent of one another.
 
-use super::Sampler;
+use super::{Sampler, PATH_LANES};
 use crate::rng::Pcg32;
 use glam::Vec2;
 
@@ -31,6 +31,21 @@ impl IndependentSampler {
             rng: rng.clone(),
             start: ([0, 0], 0, rng),
         }
+    }
+}
+
+impl IndependentSampler {
+    /// [`super::AnySampler::next_lanes`] for eight independent samplers: every request is one
+    /// draw per dimension, in order, so the requests `dims` are their total of draws from
+    /// each lane's generator, all lanes at once ([`Pcg32::uniform_f32_lanes`]).
+    pub(crate) fn next_lanes(
+        samplers: [&mut IndependentSampler; PATH_LANES],
+        lanes: u32,
+        dims: &[u32],
+        out: &mut [[f32; PATH_LANES]],
+    ) {
+        let draws = dims.iter().sum::<u32>() as usize;
+        Pcg32::uniform_f32_lanes(samplers.map(|s| &mut s.rng), lanes, &mut out[..draws]);
     }
 }
 

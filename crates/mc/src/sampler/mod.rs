@@ -164,7 +164,8 @@ impl AnySampler {
     /// [`Sampler::next_1d`], 2 for [`Sampler::next_2d`]) made in order: a value per dimension,
     /// lane by lane (`out[k][lane]`), for the lanes whose bit is set in `lanes`. The same
     /// numbers as those calls; Sobol samplers compute their scrambles for all lanes together
-    /// ([`SobolSampler::next_lanes`]), the others draw one lane after another.
+    /// ([`SobolSampler::next_lanes`]), independent ones step their generators together
+    /// ([`IndependentSampler::next_lanes`]), the others draw one lane after another.
     pub fn next_lanes(
         samplers: &mut [AnySampler; PATH_LANES],
         lanes: u32,
@@ -175,6 +176,11 @@ impl AnySampler {
             samplers
         {
             return SobolSampler::next_lanes(&mut [a, b, c, d, e, f, g, h], lanes, dims, out);
+        }
+        if let [AnySampler::Independent(a), AnySampler::Independent(b), AnySampler::Independent(c), AnySampler::Independent(d), AnySampler::Independent(e), AnySampler::Independent(f), AnySampler::Independent(g), AnySampler::Independent(h)] =
+            samplers
+        {
+            return IndependentSampler::next_lanes([a, b, c, d, e, f, g, h], lanes, dims, out);
         }
         for (lane, s) in samplers.iter_mut().enumerate() {
             if lanes & (1 << lane) != 0 {
