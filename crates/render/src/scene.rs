@@ -188,6 +188,9 @@ pub struct Scene {
     /// The primitives of the BVH's leaves, four to a block, in leaf order.
     blocks: Vec<TriBlock>,
     block_info: Vec<BlockInfo>,
+    /// The box of each block's triangles, in scenes small enough for
+    /// [`Scene::nearest_of_rays`] (empty in others).
+    block_bounds: Vec<Aabb>,
     materials: Vec<Material>,
     /// Whether each material needs the surface's tangents.
     needs_tangents: Vec<bool>,

@@ -15,8 +15,8 @@ pub(crate) use tri_block::{
 };
 pub use tri_block::{BlockHit, Nearest, RayLanes, TriBlock, TRIS_PER_BLOCK};
 pub use wide::{
-    split_box, BoxTest, Bvh4, Bvh8, Node, Portable, SplitPrim, WideBvh, BVH_WIDTH, MAX_PRIMITIVES,
-    SPLIT_BUDGET,
+    split_box, BoxTest, Bvh4, Bvh8, Node, Portable, SplitPrim, WideBvh, BVH_WIDTH, FAR_SCALE,
+    MAX_PRIMITIVES, SPLIT_BUDGET,
 };
 
 /// Test helpers shared by the BVHs' tests: random boxes as primitives.

@@ -345,15 +345,20 @@ fn start_paths(
 }
 
 /// Every busy lane's ray against every primitive at once (the small scenes' trace); idle lanes
-/// get an empty interval.
+/// get an empty interval. Blocks of triangles that no ray meets are skipped where every ray
+/// is a camera ray or a first bounce (the lanes take consecutive samples of a pixel, so
+/// those rays go the same way; deeper ones leave scattered points and meet nearly every
+/// block).
 fn nearest_of_lanes(
     scene: &Scene,
     lanes: &[Option<Lane>; W],
     rays: &mut RayLanes,
 ) -> crate::accel::Nearest {
     let mut t_max = F8::splat(f32::NEG_INFINITY);
+    let mut coherent = true;
     for (i, lane) in lanes.iter().enumerate() {
         if let Some(lane) = lane {
+            coherent &= lane.st.depth <= 1;
             let ray = &lane.st.ray;
             rays.o.set(i, ray.o);
             rays.d.set(i, ray.d);
@@ -361,7 +366,7 @@ fn nearest_of_lanes(
             t_max.0[i] = ray.t_max;
         }
     }
-    scene.nearest_of_rays(rays, t_max)
+    scene.nearest_of_rays(rays, t_max, coherent)
 }
 
 /// Lane `i`'s light choice from `u_select`: an emitting triangle's data go to the lane of `a`

@@ -87,6 +87,7 @@ impl Scene {
             bvh,
             blocks: leaves.blocks,
             block_info: leaves.info,
+            block_bounds: leaves.bounds,
             needs_tangents: materials.iter().map(Material::needs_tangents).collect(),
             materials,
             lights: lights.lights,

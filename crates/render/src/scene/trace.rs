@@ -7,12 +7,12 @@
 
 use super::{Prim, Scene};
 use crate::accel::{
-    BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, BVH_WIDTH, TRIS_PER_BLOCK,
+    BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, BVH_WIDTH, FAR_SCALE, TRIS_PER_BLOCK,
 };
 use crate::desc::{RayKind, Visibility};
-use crate::geometry::Ray;
+use crate::geometry::{Aabb, Ray};
 use crate::shape::Triangle;
-use crate::simd::lanes::{F8, W};
+use crate::simd::lanes::{F8, M8, W};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx512};
 use glam::Vec3;
@@ -253,32 +253,41 @@ impl Scene {
     /// sphere tests, to the bit); of several primitives at exactly that distance (a ray
     /// through a shared edge) it may report another than the BVH would. Only for scenes
     /// where [`Scene::tests_every_primitive`].
-    pub(crate) fn nearest_of_rays(&self, rays: &RayLanes, t_max: F8) -> Nearest {
+    ///
+    /// With `cull`, a block of triangles that no ray meets the box of is skipped (same
+    /// result): worth its box tests where the rays go the same way, as camera rays of one
+    /// pixel and the first bounce from it do; rays from scattered points meet nearly every
+    /// box.
+    pub(crate) fn nearest_of_rays(&self, rays: &RayLanes, t_max: F8, cull: bool) -> Nearest {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx512) = Avx512::detect() {
             // SAFETY: `nearest_of_rays_avx512` requires AVX-512 F, VL and DQ, AVX2 and FMA,
             // which `avx512` proves this CPU has. Its body is safe code.
-            return unsafe { self.nearest_of_rays_avx512(avx512, rays, t_max) };
+            return unsafe { self.nearest_of_rays_avx512(avx512, rays, t_max, cull) };
         }
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = Avx2::detect() {
             // SAFETY: `nearest_of_rays_avx2` requires AVX2 and FMA, which `avx2` proves this
             // CPU has. Its body is safe code.
-            return unsafe { self.nearest_of_rays_avx2(avx2, rays, t_max) };
+            return unsafe { self.nearest_of_rays_avx2(avx2, rays, t_max, cull) };
         }
-        self.nearest_of_rays_lanes(rays, t_max)
+        self.nearest_of_rays_lanes(rays, t_max, cull)
     }
 
     /// [`Scene::nearest_of_rays`] compiled for AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    fn nearest_of_rays_avx2(&self, _: Avx2, rays_in: &RayLanes, t_max: F8) -> Nearest {
+    fn nearest_of_rays_avx2(&self, _: Avx2, rays_in: &RayLanes, t_max: F8, cull: bool) -> Nearest {
         use crate::accel::{AvxNearest, AvxRays};
         let rays = AvxRays::new(rays_in);
         let mut nearest = AvxNearest::new(t_max);
-        self.for_each_triangle(|block, lane, slot| {
-            block.nearest_for_rays_avx(lane, slot, &rays, &mut nearest)
-        });
+        self.for_each_triangle_seen(
+            rays_in,
+            cull,
+            &mut nearest,
+            |n| n.t(),
+            |n, block, lane, slot| block.nearest_for_rays_avx(lane, slot, &rays, n),
+        );
         self.with_nearest_shapes(rays_in, nearest.lanes())
     }
 
@@ -287,15 +296,27 @@ impl Scene {
     /// (an odd last triangle is paired with itself).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
-    fn nearest_of_rays_avx512(&self, _: Avx512, rays_in: &RayLanes, t_max: F8) -> Nearest {
+    fn nearest_of_rays_avx512(
+        &self,
+        _: Avx512,
+        rays_in: &RayLanes,
+        t_max: F8,
+        cull: bool,
+    ) -> Nearest {
         use crate::accel::{nearest_for_rays_pair_avx512, Avx512Nearest, Avx512Rays, AvxRays};
         let rays = Avx512Rays::new(&AvxRays::new(rays_in));
         let mut nearest = Avx512Nearest::new(t_max);
         let mut first = None;
-        self.for_each_triangle(|block, lane, slot| match first.take() {
-            None => first = Some((block, lane, slot)),
-            Some(a) => nearest_for_rays_pair_avx512(a, (block, lane, slot), &rays, &mut nearest),
-        });
+        self.for_each_triangle_seen(
+            rays_in,
+            cull,
+            &mut nearest,
+            |n| n.t(),
+            |n, block, lane, slot| match first.take() {
+                None => first = Some((block, lane, slot)),
+                Some(a) => nearest_for_rays_pair_avx512(a, (block, lane, slot), &rays, n),
+            },
+        );
         if let Some(a) = first {
             nearest_for_rays_pair_avx512(a, a, &rays, &mut nearest);
         }
@@ -305,20 +326,25 @@ impl Scene {
     /// [`Scene::nearest_of_rays`] at every SIMD level this CPU has (AVX-512, AVX2, then the
     /// portable lane loops), named, for the tests that compare them.
     #[cfg(test)]
-    fn nearest_of_rays_each_level(&self, rays: &RayLanes, t_max: F8) -> Vec<(&str, Nearest)> {
-        let mut all = vec![("portable", self.nearest_of_rays_lanes(rays, t_max))];
+    fn nearest_of_rays_each_level(
+        &self,
+        rays: &RayLanes,
+        t_max: F8,
+        cull: bool,
+    ) -> Vec<(&str, Nearest)> {
+        let mut all = vec![("portable", self.nearest_of_rays_lanes(rays, t_max, cull))];
         #[cfg(target_arch = "x86_64")]
         {
             if let Some(avx2) = Avx2::detect() {
                 // SAFETY: `avx2` proves the features `nearest_of_rays_avx2` requires.
                 all.push(("AVX2", unsafe {
-                    self.nearest_of_rays_avx2(avx2, rays, t_max)
+                    self.nearest_of_rays_avx2(avx2, rays, t_max, cull)
                 }));
             }
             if let Some(avx512) = Avx512::detect() {
                 // SAFETY: `avx512` proves the features `nearest_of_rays_avx512` requires.
                 all.push(("AVX-512", unsafe {
-                    self.nearest_of_rays_avx512(avx512, rays, t_max)
+                    self.nearest_of_rays_avx512(avx512, rays, t_max, cull)
                 }));
             }
         }
@@ -326,11 +352,15 @@ impl Scene {
     }
 
     #[inline(always)]
-    fn nearest_of_rays_lanes(&self, rays: &RayLanes, t_max: F8) -> Nearest {
+    fn nearest_of_rays_lanes(&self, rays: &RayLanes, t_max: F8, cull: bool) -> Nearest {
         let mut nearest = Nearest::new(t_max);
-        self.for_each_triangle(|block, lane, slot| {
-            block.nearest_for_rays(lane, slot, rays, &mut nearest)
-        });
+        self.for_each_triangle_seen(
+            rays,
+            cull,
+            &mut nearest,
+            |n| n.t,
+            |n, block, lane, slot| block.nearest_for_rays(lane, slot, rays, n),
+        );
         self.with_nearest_shapes(rays, nearest)
     }
 
@@ -379,13 +409,30 @@ impl Scene {
         nearest
     }
 
-    /// `f(block, lane, leaf slot)` for every lane of every leaf block that holds a triangle.
+    /// `f(nearest, block, lane, leaf slot)` for every lane of every leaf block that holds a
+    /// triangle, except, with `cull`, in the blocks whose box none of the rays meets before
+    /// its nearest hit so far (`t_now(nearest)`). The box test is the BVH's (its far
+    /// distances widened against rounding), so a block is skipped only where the BVH would
+    /// not look either, and the nearest hits are those of testing every triangle.
     #[inline(always)]
-    fn for_each_triangle<'a>(&'a self, mut f: impl FnMut(&'a TriBlock, usize, u32)) {
-        for (block, info) in self.blocks.iter().zip(&self.block_info) {
+    fn for_each_triangle_seen<'a, N>(
+        &'a self,
+        rays: &RayLanes,
+        cull: bool,
+        nearest: &mut N,
+        t_now: impl Fn(&N) -> F8,
+        mut f: impl FnMut(&mut N, &'a TriBlock, usize, u32),
+    ) {
+        let boxes = (cull && !self.block_bounds.is_empty()).then(|| RayBoxLanes::new(rays));
+        for (b, (block, info)) in self.blocks.iter().zip(&self.block_info).enumerate() {
+            if let Some(boxes) = &boxes {
+                if !boxes.meets(&self.block_bounds[b], t_now(nearest)) {
+                    continue;
+                }
+            }
             for lane in 0..TRIS_PER_BLOCK {
                 if (info.used & !info.shapes) & (1 << lane) != 0 {
-                    f(block, lane, info.slot(lane));
+                    f(nearest, block, lane, info.slot(lane));
                 }
             }
         }
@@ -402,6 +449,53 @@ impl Scene {
                     || (shapes != 0 && self.hits_shape(b, shapes, r))
             })
         })
+    }
+}
+
+/// Eight rays set up for testing boxes, a lane each: the BVH's slab test ([`BoxTest`]'s
+/// portable one), with the lanes being rays instead of boxes.
+struct RayBoxLanes {
+    o: [F8; 3],
+    inv_d: [F8; 3],
+    /// `inv_d` widened by [`FAR_SCALE`], for far planes.
+    inv_far: [F8; 3],
+    /// Lanes whose direction is negative on the axis (they enter by the upper plane).
+    negative: [M8; 3],
+    /// Where entry distances start: `t_min`, or +0 where it is not positive.
+    t_min: F8,
+}
+
+impl RayBoxLanes {
+    #[inline(always)]
+    fn new(rays: &RayLanes) -> RayBoxLanes {
+        let d = [rays.d.x, rays.d.y, rays.d.z];
+        let inv_d = d.map(|d| F8::splat(1.0) / d);
+        let zero = F8::splat(0.0);
+        RayBoxLanes {
+            o: [rays.o.x, rays.o.y, rays.o.z],
+            inv_d,
+            inv_far: inv_d.map(|i| i * F8::splat(FAR_SCALE)),
+            negative: d.map(|d| M8(d.0.map(|x| if x.is_sign_negative() { !0 } else { 0 }))),
+            t_min: rays.t_min.gt(zero).select(rays.t_min, zero),
+        }
+    }
+
+    /// Whether some lane's ray meets `bounds` between its `t_min` and `t_max`.
+    #[inline(always)]
+    fn meets(&self, bounds: &Aabb, t_max: F8) -> bool {
+        let (mut t_near, mut t_far) = (self.t_min, t_max);
+        for axis in 0..3 {
+            let (lo, hi) = (F8::splat(bounds.min[axis]), F8::splat(bounds.max[axis]));
+            let near = self.negative[axis].select(hi, lo);
+            let far = self.negative[axis].select(lo, hi);
+            let tn = (near - self.o[axis]) * self.inv_d[axis];
+            let tf = (far - self.o[axis]) * self.inv_far[axis];
+            // As the BVH's test: a NaN (0 · ∞ for a ray in a box's plane) leaves the running
+            // value unchanged.
+            t_near = tn.gt(t_near).select(tn, t_near);
+            t_far = tf.lt(t_far).select(tf, t_far);
+        }
+        t_near.le(t_far).0.iter().fold(0, |any, &m| any | m) != 0
     }
 }
 
@@ -422,6 +516,9 @@ pub(super) struct LeafBlocks {
     pub blocks: Vec<TriBlock>,
     pub info: Vec<BlockInfo>,
     pub tri_slot: Vec<u32>,
+    /// The box of each block's triangles, where there are at most [`SMALL_SCENE_BLOCKS`]
+    /// blocks (for [`Scene::nearest_of_rays`]); empty otherwise.
+    pub bounds: Vec<Aabb>,
 }
 
 /// Packs the primitives of each of `bvh`'s leaves into blocks (see [`LeafBlocks`]).
@@ -434,6 +531,7 @@ pub(super) fn leaf_blocks(
     let mut blocks = Vec::with_capacity(prims.len() / 2 + 1);
     let mut info = Vec::with_capacity(prims.len() / 2 + 1);
     let mut tri_slot = vec![u32::MAX; triangles.len()];
+    let mut bounds = Vec::new();
     bvh.remap_leaves(|start, count| {
         let first = blocks.len() as u32;
         for chunk_start in (start..start + count).step_by(TRIS_PER_BLOCK) {
@@ -446,11 +544,13 @@ pub(super) fn leaf_blocks(
                 indirect: 0,
             };
             let mut tris = [Triangle { p: [Vec3::ZERO; 3] }; TRIS_PER_BLOCK];
+            let mut block_box = Aabb::EMPTY;
             for (lane, slot) in chunk.enumerate() {
                 lanes.used |= 1 << lane;
                 match prims[slot as usize] {
                     Prim::Triangle(t) => {
                         tris[lane] = triangles[t as usize];
+                        block_box = tris[lane].p.iter().fold(block_box, |b, &p| b.grow(p));
                         if tri_slot[t as usize] == u32::MAX {
                             tri_slot[t as usize] = (blocks.len() * TRIS_PER_BLOCK + lane) as u32;
                         }
@@ -463,13 +563,20 @@ pub(super) fn leaf_blocks(
             }
             blocks.push(TriBlock::new(&tris));
             info.push(lanes);
+            if blocks.len() <= SMALL_SCENE_BLOCKS {
+                bounds.push(block_box);
+            }
         }
         (first, blocks.len() as u32 - first)
     });
+    if blocks.len() > SMALL_SCENE_BLOCKS {
+        bounds = Vec::new();
+    }
     LeafBlocks {
         blocks,
         info,
         tri_slot,
+        bounds,
     }
 }
 

@@ -474,6 +474,17 @@ impl Avx512Nearest {
         }
     }
 
+    /// Each ray's nearest distance so far (the nearer of its two halves').
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+    #[inline]
+    pub(crate) fn t(&self) -> F8 {
+        use std::arch::x86_64::*;
+        from_avx(_mm256_min_ps(
+            _mm512_castps512_ps256(self.t),
+            _mm512_extractf32x8_ps::<1>(self.t),
+        ))
+    }
+
     /// Each ray's hit as testing the triangles one by one, in order, would find it: the
     /// nearer of its two halves' hits, and of two at the same distance the earlier one (the
     /// lower pair, or the first triangle of the same pair).
@@ -574,6 +585,13 @@ impl AvxNearest {
             b2: _mm256_setzero_ps(),
             slot: _mm256_set1_ps(f32::from_bits(u32::MAX)),
         }
+    }
+
+    /// Each ray's nearest distance so far.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    pub(crate) fn t(&self) -> F8 {
+        from_avx(self.t)
     }
 
     /// Back to lanes.

@@ -6,7 +6,7 @@ use crate::geometry::Ray;
 
 /// Relative widening of the far distance of a box test, so that rounding never culls a box
 /// the ray touches (pbrt-v4's 1 + 2γ₃).
-const FAR_SCALE: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON * 0.5 / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub const FAR_SCALE: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON * 0.5 / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// The ray quantities every box test uses.
 #[doc(hidden)]

@@ -26,7 +26,7 @@ mod spatial;
 mod stack;
 mod traverse;
 
-pub use box_test::{BoxTest, Portable};
+pub use box_test::{BoxTest, Portable, FAR_SCALE};
 use node::{leaf_range, leaf_word, LEAF, MAX_LEAF};
 pub use node::{Node, MAX_PRIMITIVES};
 pub use spatial::{split_box, SplitPrim, SPLIT_BUDGET};

@@ -251,15 +251,24 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
     let mut rng = pathlab_mc::rng::Pcg32::new(seed, 1);
     let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
     let (mut hits, mut ties, mut spheres) = (0, 0, 0);
+    let mut culled = 0;
     for k in 0..2000 {
         let mut rays = RayLanes::default();
         let mut t_max = F8::splat(f32::INFINITY);
         let mut each = [Ray::new(Vec3::ZERO, Vec3::X); 8];
+        // Every other packet goes one way: eight rays from one point towards points close
+        // together, as a pixel's camera rays (the packets whose boxes culling skips).
+        let (shared_o, shared_target) = (point() * 3.0 - 1.5, point() * 2.0 - 1.0);
         for (i, ray) in each.iter_mut().enumerate() {
             // Origins inside and outside the boxes, some rays aimed at corners and edges
             // (where triangles meet), some with a finite extent.
-            let o = point() * 3.0 - 1.5;
+            let o = if k % 2 == 0 {
+                shared_o
+            } else {
+                point() * 3.0 - 1.5
+            };
             let target = match (k + i) % 3 {
+                _ if k % 2 == 0 => shared_target + (point() - 0.5) * 0.05,
                 0 => point() * 2.0 - 1.0,
                 1 => point().round() * 2.0 - 1.0,
                 _ => Vec3::new(point().x * 2.0 - 1.0, 1.0, -1.0),
@@ -273,8 +282,14 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
             rays.t_min.0[i] = ray.t_min;
             t_max.0[i] = ray.t_max;
         }
-        let levels = scene.nearest_of_rays_each_level(&rays, t_max);
-        let dispatched = scene.nearest_of_rays(&rays, t_max);
+        // Every SIMD level, with and without culling blocks, finds the same.
+        let mut levels = scene.nearest_of_rays_each_level(&rays, t_max, false);
+        levels.extend(scene.nearest_of_rays_each_level(&rays, t_max, true));
+        let dispatched = scene.nearest_of_rays(&rays, t_max, true);
+        let boxes = RayBoxLanes::new(&rays);
+        culled += (scene.block_bounds.iter())
+            .filter(|b| !boxes.meets(b, t_max))
+            .count();
         for (i, ray) in each.iter().enumerate() {
             let mut r = *ray;
             let bvh = scene.closest_hit(&mut r, RayKind::Indirect);
@@ -302,6 +317,10 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
             }
         }
     }
+    assert!(
+        culled > 1000,
+        "{culled} blocks missed by all rays of a packet"
+    );
     (hits, ties, spheres)
 }
 
@@ -384,7 +403,8 @@ fn every_simd_level_finds_the_same_triangles_to_the_bit() {
                 t_max.0[i] = 0.7;
             }
         }
-        let all = scene.nearest_of_rays_each_level(&rays, t_max);
+        let mut all = scene.nearest_of_rays_each_level(&rays, t_max, false);
+        all.extend(scene.nearest_of_rays_each_level(&rays, t_max, true));
         let (_, portable) = &all[0];
         for (name, n) in &all[1..] {
             assert_eq!(bits(n), bits(portable), "{name} against the portable lanes");
