@@ -683,5 +683,13 @@ mod tests {
         // Without normals, shading is flat.
         let scene = triangle_with_normals(Vec::new());
         assert_eq!(scene.intersect(&ray).0.unwrap().ns, Vec3::Z);
+        // Normals that are the face's but for rounding are not kept: shading is flat.
+        let nearly = Vec3::new(3e-7, -2e-7, 1.0);
+        let scene = triangle_with_normals(vec![nearly, Vec3::Z, -nearly]);
+        assert!(scene.tri_normals.is_empty());
+        assert_eq!(scene.intersect(&ray).0.unwrap().ns, Vec3::Z);
+        // Another beyond that: all are kept.
+        let scene = triangle_with_normals(vec![nearly, Vec3::new(1e-4, 0.0, 1.0), Vec3::Z]);
+        assert_eq!(scene.tri_normals.len(), 1);
     }
 }

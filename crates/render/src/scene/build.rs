@@ -342,6 +342,16 @@ impl Triangles {
                 ));
             }
         }
+        if out
+            .normals
+            .iter()
+            .zip(&out.triangles)
+            .all(|(n, t)| is_flat(n, t.normal()))
+        {
+            // Flat meshes (such as Mitsuba's rectangles and cubes) shade with their faces'
+            // normals: keeping theirs would renormalise the same normal at every hit.
+            out.normals = Vec::new();
+        }
         Ok(out)
     }
 
@@ -387,6 +397,15 @@ fn corner_normals(mesh: &MeshDesc, tri: &[u32], face: Vec3) -> [Vec3; 3] {
             None => face,
         }
     })
+}
+
+/// Whether a triangle's corner normals (as [`corner_normals`] gives them) are its face normal
+/// `face` but for rounding: every component within 10⁻⁶, an angle of at most about 10⁻⁶
+/// radians, far below what shading can show.
+fn is_flat(corners: &[Vec3; 3], face: Vec3) -> bool {
+    corners
+        .iter()
+        .all(|&n| (n - face).abs().max_element() <= 1e-6)
 }
 
 /// An attribute's values at a triangle's corners (per face or per vertex; zero where the
