@@ -194,15 +194,15 @@ impl Sphere {
     /// compiled for wide registers computes the eight lanes together.
     #[inline(always)]
     pub fn intersect_lanes(&self, o: &V8, d: &V8, t_min: &F8, t_max: &F8) -> [f32; W] {
-        std::array::from_fn(|i| {
+        // A loop over the lanes rather than `array::from_fn`, whose closure the compiler
+        // keeps out of line, one lane at a time.
+        let mut t = [0.0; W];
+        for (i, t) in t.iter_mut().enumerate() {
             let q = self.quadratic(o.get(i), d.get(i));
-            let t = q.nearest_root(t_min.0[i], t_max.0[i]);
-            if q.has_roots() {
-                t
-            } else {
-                f32::NAN
-            }
-        })
+            let root = q.nearest_root(t_min.0[i], t_max.0[i]);
+            *t = if q.has_roots() { root } else { f32::NAN };
+        }
+        t
     }
 
     /// The quadratic of a ray from `o` along `d`, relative to the centre in `f64`.
