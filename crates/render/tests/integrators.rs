@@ -390,3 +390,63 @@ fn the_course_strategies_samples_estimate_the_same_direct_light() {
         assert!(se > light_se, "{strategy:?} noisier than light sampling");
     }
 }
+
+#[test]
+fn direct_lighting_by_the_path_tracers_lanes_is_its_own_estimate() {
+    // MIS of one light sample and one BSDF sample renders as the path tracer at depth one
+    // (eight paths at a time). The integrator's own one-sample code draws the same random
+    // numbers in the same order, so every sample's estimate is the same but for rounding
+    // (the sums are formed in another order) in a scene of diffuse and mirror surfaces,
+    // area, sphere and point lights.
+    let direct = DirectIntegrator::default();
+    assert!(direct.as_path().is_some());
+    let scene = pathlab_render::scene::Scene::build(&mixed_scene()).unwrap();
+    let [w, h] = scene.camera().resolution();
+    let samples: Vec<SampleRef> = (0..w * h)
+        .flat_map(|p| {
+            (0..16).map(move |index| SampleRef {
+                pixel: [p % w, p / w],
+                index,
+                tag: p * 16 + index,
+            })
+        })
+        .collect();
+    let mut sampler = pathlab_mc::sampler::SamplerKind::Independent.build(16, 3);
+    let mut lanes = vec![None; samples.len()];
+    direct.li_samples(
+        &scene,
+        &mut sampler,
+        &mut samples.iter().copied(),
+        &mut |tag, l| lanes[tag as usize] = Some(l),
+        &mut PathStats::default(),
+    );
+    let mut lit = 0;
+    for s in &samples {
+        let (ray, weight) = camera_ray(&scene, &mut sampler, *s);
+        let own = direct.li(&scene, ray, &mut sampler, &mut PathStats::default()) * weight;
+        let l = lanes[s.tag as usize].expect("every sample is estimated");
+        assert!(
+            (l - own).abs().max_element() <= 1e-5 * (1.0 + own.abs().max_element()),
+            "{s:?}: {l} by the lanes, {own} by the direct integrator"
+        );
+        lit += usize::from(own.max_element() > 0.0);
+    }
+    assert!(lit * 10 > samples.len(), "{lit} of {} lit", samples.len());
+    // Other settings keep the direct integrator's own code.
+    for other in [
+        DirectIntegrator {
+            samples: 2,
+            ..direct
+        },
+        DirectIntegrator {
+            bsdf_samples: Some(0),
+            ..direct
+        },
+        DirectIntegrator {
+            strategy: DirectStrategy::Light,
+            ..direct
+        },
+    ] {
+        assert!(other.as_path().is_none(), "{other:?}");
+    }
+}

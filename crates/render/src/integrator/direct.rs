@@ -2,7 +2,9 @@
 //! hemisphere, cosine, BSDF or light sampling, or both combined by MIS ([`DirectStrategy`]),
 //! the course's first estimators.
 
-use super::{emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathStats};
+use super::{
+    emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathIntegrator, PathStats,
+};
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::Frame;
 use crate::geometry::{spawn_ray, Ray};
@@ -144,6 +146,22 @@ struct Gathered {
 }
 
 impl Integrator for DirectIntegrator {
+    /// The samples' estimates; by the path tracer's eight-lane scheduling where it computes
+    /// the same estimator ([`DirectIntegrator::as_path`]).
+    fn li_samples(
+        &self,
+        scene: &Scene,
+        sampler: &mut AnySampler,
+        samples: &mut dyn Iterator<Item = super::SampleRef>,
+        out: &mut dyn FnMut(u32, Rgb),
+        stats: &mut PathStats,
+    ) {
+        match self.as_path() {
+            Some(path) => path.li_samples(scene, sampler, samples, out, stats),
+            None => super::li_one_at_a_time(self, scene, sampler, samples, out, stats),
+        }
+    }
+
     fn li(&self, scene: &Scene, ray: Ray, sampler: &mut AnySampler, stats: &mut PathStats) -> Rgb {
         let seen = |found: Option<(Rgb, f32)>| match found {
             Some((le, _)) if !self.hide_emitters => le,
@@ -183,6 +201,20 @@ impl Integrator for DirectIntegrator {
 }
 
 impl DirectIntegrator {
+    /// The path tracer whose estimate this integrator's is, where there is one: MIS of one
+    /// light sample and one BSDF sample is the path tracer's estimate at depth one (the
+    /// emission the camera sees, the light sample at the first surface and the emission the
+    /// BSDF sample finds, weighted by the same power heuristic, from the same random numbers
+    /// in the same order); Russian roulette starts later.
+    pub fn as_path(&self) -> Option<PathIntegrator> {
+        let one_each = self.samples == 1 && self.bsdf_samples.unwrap_or(self.samples) == 1;
+        (self.strategy == DirectStrategy::Mis && one_each).then(|| PathIntegrator {
+            max_depth: 1,
+            hide_emitters: self.hide_emitters,
+            ..PathIntegrator::default()
+        })
+    }
+
     /// Light and BSDF samples combined by the power heuristic with their counts. With equal
     /// counts the samples come in pairs (light, then BSDF), as the course's comparison draws
     /// them.
