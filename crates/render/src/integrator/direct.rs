@@ -1,6 +1,8 @@
 //! Direct lighting only ([`DirectIntegrator`]): one bounce, its directions drawn by uniform
 //! hemisphere, cosine, BSDF or light sampling, or both combined by MIS ([`DirectStrategy`]),
-//! the course's first estimators.
+//! the course's first estimators. With MIS of one light and one BSDF sample (Mitsuba's
+//! `direct` as its scenes use it) the estimator is the path tracer's at depth one, and renders
+//! run through the path tracer's eight lanes ([`DirectIntegrator::as_path`]).
 
 use super::{
     emitted, escaped, power_heuristic, sample_light, trace, Integrator, PathIntegrator, PathStats,

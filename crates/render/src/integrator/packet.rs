@@ -1,7 +1,11 @@
 //! Path tracing eight paths at a time: each lane follows one pixel sample, and a lane whose
 //! path ends takes the next sample at once, so the lanes stay busy. Rays are traced one lane
 //! after another through the BVH (its own SIMD traversal), or, in scenes of a few dozen
-//! triangles and a few spheres, all eight against every primitive at once.
+//! triangles and a few spheres, all eight against every primitive at once (skipping the
+//! blocks of triangles none of them meets where the rays go one way: camera rays and first
+//! bounces, since the lanes take consecutive samples of a pixel). The lanes that start
+//! together make their camera rays together, and the sampler draws each bounce's random
+//! numbers for all lanes at once.
 //!
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
 //! for every lane and bounce, except where a lane's surface is Lambertian and its light an
