@@ -401,16 +401,7 @@ fn direct_lighting_by_the_path_tracers_lanes_is_its_own_estimate() {
     let direct = DirectIntegrator::default();
     assert!(direct.as_path().is_some());
     let scene = pathlab_render::scene::Scene::build(&mixed_scene()).unwrap();
-    let [w, h] = scene.camera().resolution();
-    let samples: Vec<SampleRef> = (0..w * h)
-        .flat_map(|p| {
-            (0..16).map(move |index| SampleRef {
-                pixel: [p % w, p / w],
-                index,
-                tag: p * 16 + index,
-            })
-        })
-        .collect();
+    let samples = every_sample(&scene, 16);
     let mut sampler = pathlab_mc::sampler::SamplerKind::Independent.build(16, 3);
     let mut lanes = vec![None; samples.len()];
     direct.li_samples(

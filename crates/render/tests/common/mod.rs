@@ -177,17 +177,22 @@ pub fn mixed_scene() -> SceneDesc {
     desc
 }
 
-pub fn packets_match_one_path_at_a_time(scene: &Scene, bvh: bool) {
+/// Every pixel's samples 0..spp, in order, each tagged with its position in the list.
+pub fn every_sample(scene: &Scene, spp: u32) -> Vec<SampleRef> {
     let [w, h] = scene.camera().resolution();
-    let samples: Vec<SampleRef> = (0..w * h)
+    (0..w * h)
         .flat_map(|p| {
-            (0..6).map(move |index| SampleRef {
+            (0..spp).map(move |index| SampleRef {
                 pixel: [p % w, p / w],
                 index,
-                tag: p * 6 + index,
+                tag: p * spp + index,
             })
         })
-        .collect();
+        .collect()
+}
+
+pub fn packets_match_one_path_at_a_time(scene: &Scene, bvh: bool) {
+    let samples = every_sample(scene, 6);
     let mut lit = 0;
     for kind in SamplerKind::ALL {
         for (max_depth, rr_depth) in [(u32::MAX, 5), (u32::MAX, 1), (3, 5), (0, 5)] {
