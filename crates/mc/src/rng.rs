@@ -53,16 +53,14 @@ impl Pcg32 {
     #[inline]
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
-        self.state = old.wrapping_mul(PCG32_MULT).wrapping_add(self.inc);
-        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-        let rot = (old >> 59) as u32;
-        xorshifted.rotate_right(rot)
+        self.state = step(old, self.inc);
+        output(old)
     }
 
     /// A uniform `f32` in [0, 1), with 24 random bits (every value is exactly representable).
     #[inline]
     pub fn uniform_f32(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+        to_unit_f32(self.next_u32())
     }
 
     /// A uniform `f64` in [0, 1), with 53 random bits.
@@ -98,6 +96,25 @@ impl Pcg32 {
         rng.advance(sample_index as u64 * DIMENSIONS_PER_SAMPLE + dimension as u64);
         rng
     }
+}
+
+/// The LCG step from state `old` on the stream of increment `inc`.
+#[inline(always)]
+fn step(old: u64, inc: u64) -> u64 {
+    old.wrapping_mul(PCG32_MULT).wrapping_add(inc)
+}
+
+/// The XSH-RR output of state `old`: 32 bits.
+#[inline(always)]
+fn output(old: u64) -> u32 {
+    let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+    xorshifted.rotate_right((old >> 59) as u32)
+}
+
+/// 32 random bits as a uniform `f32` in [0, 1): the top 24, each value exactly representable.
+#[inline(always)]
+fn to_unit_f32(bits: u32) -> f32 {
+    (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// Eight generators side by side, a lane each, for drawing from all of them at once.
@@ -181,17 +198,15 @@ fn draw_lanes_avx2(
     draw_lanes_portable(state, inc, out)
 }
 
-/// [`Pcg32::next_u32`] and [`Pcg32::uniform_f32`]'s arithmetic on every lane: loops over the
-/// lanes that the compiler turns into vector instructions.
+/// [`Pcg32::uniform_f32`]'s step, output and conversion on every lane: loops over the lanes
+/// that the compiler turns into vector instructions.
 #[inline(always)]
 fn draw_lanes_portable(state: &mut [u64; LANES], inc: &[u64; LANES], out: &mut [[f32; LANES]]) {
     for row in out.iter_mut() {
         for i in 0..LANES {
             let old = state[i];
-            state[i] = old.wrapping_mul(PCG32_MULT).wrapping_add(inc[i]);
-            let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-            let bits = xorshifted.rotate_right((old >> 59) as u32);
-            row[i] = (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
+            state[i] = step(old, inc[i]);
+            row[i] = to_unit_f32(output(old));
         }
     }
 }

@@ -281,6 +281,8 @@ impl Triangles {
             attributes: vec![Vec::new(); attribute_names.len()],
         };
         let any_uvs = desc.meshes.iter().any(|m| !m.uvs.is_empty());
+        // Whether every triangle's corner normals are its face normal (see below).
+        let mut all_flat = true;
         for (mesh_index, mesh) in desc.meshes.iter().enumerate() {
             let material = check.index(&mesh.name, mesh.material)?;
             let mesh_attributes: Vec<Option<&MeshAttribute>> = attribute_names
@@ -319,7 +321,10 @@ impl Triangles {
                     out.uv.push([0, 1, 2].map(|k| corner_uv(mesh, tri, k)));
                 }
                 if any_normals {
-                    out.normals.push(corner_normals(mesh, tri, t.normal()));
+                    let face = t.normal();
+                    let corners = corner_normals(mesh, tri, face);
+                    all_flat &= is_flat(&corners, face);
+                    out.normals.push(corners);
                 }
                 out.material.push(material);
                 out.visibility.push(mesh.visibility);
@@ -342,12 +347,7 @@ impl Triangles {
                 ));
             }
         }
-        if out
-            .normals
-            .iter()
-            .zip(&out.triangles)
-            .all(|(n, t)| is_flat(n, t.normal()))
-        {
+        if all_flat {
             // Flat meshes (such as Mitsuba's rectangles and cubes) shade with their faces'
             // normals: keeping theirs would renormalise the same normal at every hit.
             out.normals = Vec::new();

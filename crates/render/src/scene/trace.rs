@@ -550,7 +550,7 @@ pub(super) fn leaf_blocks(
                 match prims[slot as usize] {
                     Prim::Triangle(t) => {
                         tris[lane] = triangles[t as usize];
-                        block_box = tris[lane].p.iter().fold(block_box, |b, &p| b.grow(p));
+                        block_box = block_box.union(tris[lane].bounds());
                         if tri_slot[t as usize] == u32::MAX {
                             tri_slot[t as usize] = (blocks.len() * TRIS_PER_BLOCK + lane) as u32;
                         }
