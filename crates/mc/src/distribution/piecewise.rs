@@ -30,8 +30,9 @@ pub struct DiscreteSample {
     pub u_remapped: f32,
 }
 
-/// CDF entries per block of the coarse search level.
-const CDF_BLOCK: usize = 16;
+/// Pieces per bucket of the guide table, on average: the table has a quarter as many
+/// buckets as there are pieces (rounded to a power of two).
+const PIECES_PER_BUCKET: usize = 4;
 
 /// Entry `i` of a tabulated distribution: the CDF at the start of piece `i` and the piece's
 /// value (0 for the entry after the last piece). Kept side by side so that the search's block
@@ -43,24 +44,8 @@ struct Entry {
     func: f32,
 }
 
-/// How many of `values` are at most `u` (a NaN is not): four comparisons per SSE2
-/// instruction on x86-64 (whose every CPU has SSE2), one at a time elsewhere.
-#[inline]
-fn count_at_most(values: &[f32], u: f32) -> usize {
-    #[cfg(target_arch = "x86_64")]
-    return count_by_fours(
-        values,
-        u,
-        |&c| c,
-        // SAFETY: SSE2, all `_mm_loadu_ps` requires, is part of every x86-64 CPU; the load
-        // reads the four floats of a chunk of exactly four.
-        |four| unsafe { std::arch::x86_64::_mm_loadu_ps(four.as_ptr()) },
-    );
-    #[cfg(not(target_arch = "x86_64"))]
-    values.iter().filter(|&&c| c <= u).count()
-}
-
-/// How many of `entries` have a CDF value at most `u`, as [`count_at_most`] counts.
+/// How many of `entries` have a CDF value at most `u` (a NaN is not): four comparisons per
+/// SSE2 instruction on x86-64 (whose every CPU has SSE2), one at a time elsewhere.
 #[inline]
 fn count_cdf_at_most(entries: &[Entry], u: f32) -> usize {
     #[cfg(target_arch = "x86_64")]
@@ -70,9 +55,9 @@ fn count_cdf_at_most(entries: &[Entry], u: f32) -> usize {
         |e| e.cdf,
         |four| {
             use std::arch::x86_64::*;
-            // SAFETY: as in `count_at_most`; an `Entry` is two `f32` (`repr(C)`), so four
-            // entries are eight floats, read by two loads of four, whose even lanes are the
-            // CDF values.
+            // SAFETY: SSE2, all these intrinsics require, is part of every x86-64 CPU. An
+            // `Entry` is two `f32` (`repr(C)`), so a chunk of exactly four entries is eight
+            // floats, read by two loads of four, whose even lanes are the CDF values.
             unsafe {
                 let p = four.as_ptr().cast::<f32>();
                 _mm_shuffle_ps::<0b10_00_10_00>(_mm_loadu_ps(p), _mm_loadu_ps(p.add(4)))
@@ -119,8 +104,8 @@ fn count_by_fours<T>(
 struct Pieces<'a> {
     /// `n + 1` entries.
     entries: &'a [Entry],
-    /// Every [`CDF_BLOCK`]th CDF entry (`cdf[0]`, `cdf[16]`, ...).
-    coarse: &'a [f32],
+    /// The guide table ([`guide_table`]): `K + 2` counts for `K` buckets.
+    guide: &'a [u32],
     min: f32,
     max: f32,
     func_int: f32,
@@ -143,21 +128,23 @@ impl Pieces<'_> {
     }
 
     /// The number of CDF entries `<= u` (the CDF does not decrease, so they are its first
-    /// ones): the blocks whose first entry is `<= u` from the coarse level, then the entries
-    /// of the last of them. The same count as a binary search over the whole CDF.
+    /// ones): the guide table gives the counts at the two multiples of 1/K around `u`, and
+    /// the entries between them are counted. The same count as a binary search over the
+    /// whole CDF.
     #[inline]
     fn cdf_entries_at_most(&self, u: f32) -> usize {
-        // Counted rather than bisected: every comparison is independent of the others, so a
-        // row of a large table costs one wait for memory, not one per halving.
-        let blocks = count_at_most(self.coarse, u);
-        if blocks == 0 {
+        let buckets = self.guide.len() - 2;
+        // K is a power of two, so t is exactly u·K and k/K ≤ u < (k + 1)/K.
+        let t = u * buckets as f32;
+        if t.is_nan() || t < 0.0 {
+            // Every CDF entry is ≥ 0, and none compares ≤ NaN.
             return 0;
         }
-        // Entry `CDF_BLOCK * (blocks - 1)` is <= u and entry `CDF_BLOCK * blocks` (if any)
-        // is not: count the ones between.
-        let first = CDF_BLOCK * (blocks - 1) + 1;
-        let end = (CDF_BLOCK * blocks).min(self.entries.len());
-        first + count_cdf_at_most(&self.entries[first..end], u)
+        let k = (t as usize).min(buckets);
+        // Entries before `lo` are ≤ k/K ≤ u; entries from `hi` on exceed (k + 1)/K > u
+        // (bucket K, u ≥ 1, runs to the end).
+        let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+        lo + count_cdf_at_most(&self.entries[lo..hi], u)
     }
 
     /// Density of piece `o` with respect to x.
@@ -214,11 +201,26 @@ impl Pieces<'_> {
     }
 }
 
+/// The guide table of a CDF (Chen and Asau's cutpoints): for `K` buckets (a power of two, a
+/// quarter of the pieces), entry `k` of `0..=K` is the number of CDF entries at most `k/K`,
+/// and a last entry counts them all. A `u` in bucket `k` has between entries `k` and
+/// `k + 1` CDF entries at most it, so a search reads two counts and the few entries between.
+fn guide_table(cdf: &[f32]) -> Vec<u32> {
+    let buckets = (cdf.len().saturating_sub(1).next_power_of_two() / PIECES_PER_BUCKET).max(1);
+    // Counts fit in u32: a distribution of 2^32 pieces would need 32 GiB of entries.
+    let count = |x: f32| cdf.partition_point(|&c| c <= x) as u32;
+    (0..=buckets)
+        .map(|k| count(k as f32 / buckets as f32))
+        .chain([cdf.len() as u32])
+        .collect()
+}
+
 /// A piecewise-constant density on `[min, max]`: `n` equal pieces with values `f[i]`,
 /// normalised so that it integrates to one.
 ///
 /// Construction builds the CDF (running sums in `f64`, stored in `f32`); sampling inverts it by
-/// search for the piece (a coarse level of every 16th CDF entry, then one block of 16) and
+/// search for the piece (a guide table of where each quarter-of-four-pieces' worth of u starts,
+/// then the few entries of one bucket) and
 /// linear interpolation inside the piece. A function that is
 /// zero everywhere is treated as uniform, so that sampling is always defined.
 ///
@@ -233,10 +235,9 @@ impl Pieces<'_> {
 pub struct PiecewiseConstant1D {
     /// `n + 1` entries: the CDF at the piece boundaries and the pieces' values.
     entries: Vec<Entry>,
-    /// Every [`CDF_BLOCK`]th CDF entry: the search finds the block here, then the entry
-    /// within one block, so that it touches two or three cache lines of a long CDF rather
-    /// than one per halving.
-    coarse: Vec<f32>,
+    /// The guide table ([`guide_table`]): the search reads two of its counts, then the few
+    /// entries between them, a cache line or two of a long CDF rather than one per halving.
+    guide: Vec<u32>,
     min: f32,
     max: f32,
     func_int: f32,
@@ -276,7 +277,7 @@ impl PiecewiseConstant1D {
             .collect();
         Ok(PiecewiseConstant1D {
             entries,
-            coarse: cdf.iter().step_by(CDF_BLOCK).copied().collect(),
+            guide: guide_table(&cdf),
             min,
             max,
             func_int: func_int as f32,
@@ -287,7 +288,7 @@ impl PiecewiseConstant1D {
     fn pieces(&self) -> Pieces<'_> {
         Pieces {
             entries: &self.entries,
-            coarse: &self.coarse,
+            guide: &self.guide,
             min: self.min,
             max: self.max,
             func_int: self.func_int,
@@ -383,18 +384,18 @@ impl PiecewiseConstant1D {
 /// the values are luminance × sin θ so that the density is uniform in solid angle where the map
 /// is constant.
 ///
-/// The rows' tables are held in two flat arrays, every row's coarse search level in one
-/// (a few tens of kilobytes for an environment map, which stay in cache) and every row's CDF
-/// and values in the other, so that sampling a row of a large table waits on memory once.
+/// The rows' tables are held in two flat arrays, every row's guide table in one and every
+/// row's CDF and values in the other, so that sampling a row of a large table reads a cache
+/// line of each.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PiecewiseConstant2D {
     /// Pieces per row.
     nu: usize,
     /// `nu + 1` entries per row.
     entries: Vec<Entry>,
-    /// Coarse levels, `coarse_len` per row.
-    coarse: Vec<f32>,
-    coarse_len: usize,
+    /// Guide tables, `guide_len` per row.
+    guide: Vec<u32>,
+    guide_len: usize,
     /// ∫ f(u, v) du of each row.
     row_integrals: Vec<f32>,
     marginal: PiecewiseConstant1D,
@@ -418,22 +419,23 @@ impl PiecewiseConstant2D {
             });
         }
         check_weights(WHAT, func)?;
-        let coarse_len = (nu + 1).div_ceil(CDF_BLOCK);
         let mut entries = Vec::with_capacity((nu + 1) * nv);
-        let mut coarse = Vec::with_capacity(coarse_len * nv);
+        let mut guide = Vec::new();
+        let mut guide_len = 0;
         let mut row_integrals = Vec::with_capacity(nv);
         for row in func.chunks_exact(nu) {
             let d = PiecewiseConstant1D::new(row, min.x, max.x)?;
             entries.extend_from_slice(&d.entries);
-            coarse.extend_from_slice(&d.coarse);
+            guide_len = d.guide.len();
+            guide.extend_from_slice(&d.guide);
             row_integrals.push(d.func_int);
         }
         let marginal = PiecewiseConstant1D::new(&row_integrals, min.y, max.y)?;
         Ok(PiecewiseConstant2D {
             nu,
             entries,
-            coarse,
-            coarse_len,
+            guide,
+            guide_len,
             row_integrals,
             marginal,
             min,
@@ -447,7 +449,7 @@ impl PiecewiseConstant2D {
         let n = self.nu + 1;
         Pieces {
             entries: &self.entries[v * n..(v + 1) * n],
-            coarse: &self.coarse[v * self.coarse_len..(v + 1) * self.coarse_len],
+            guide: &self.guide[v * self.guide_len..(v + 1) * self.guide_len],
             min: self.min.x,
             max: self.max.x,
             func_int: self.row_integrals[v],
@@ -501,7 +503,7 @@ mod tests {
     use crate::rng::Pcg32;
 
     #[test]
-    fn the_two_level_search_counts_what_a_binary_search_counts() {
+    fn the_guided_search_counts_what_a_binary_search_counts() {
         let mut rng = Pcg32::new(3, 7);
         for n in [1, 2, 15, 16, 17, 31, 32, 33, 255, 256, 512, 1000] {
             // Runs of zero pieces (flat CDF stretches), a few large pieces and small ones.
