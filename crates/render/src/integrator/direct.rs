@@ -108,7 +108,7 @@ impl DirectIntegrator {
         let hit = trace(scene, &ray, RayKind::Indirect, stats);
         let found = match &hit {
             Some(hit) => emitted(scene, si.p, &ray, hit),
-            None => escaped(scene, &ray),
+            None => escaped(scene, &ray, true),
         };
         let end = hit.map(|h| h.p);
         match found {
@@ -170,7 +170,7 @@ impl Integrator for DirectIntegrator {
             _ => Rgb::ZERO,
         };
         let Some(si) = trace(scene, &ray, RayKind::Camera, stats) else {
-            return seen(escaped(scene, &ray));
+            return seen(escaped(scene, &ray, false));
         };
         let wo = -ray.d;
         let mut l = seen(emitted(scene, ray.o, &ray, &si));

@@ -388,11 +388,15 @@ pub(crate) fn emitted(
 }
 
 /// Environment radiance along a ray that left the scene, and the density with which light
-/// sampling would have chosen its direction.
+/// sampling would have chosen its direction: computed where `pdf_needed` (for an MIS weight),
+/// 0 otherwise (a camera ray, a delta lobe's ray).
 #[inline]
-pub(crate) fn escaped(scene: &Scene, ray: &Ray) -> Option<(Rgb, f32)> {
+pub(crate) fn escaped(scene: &Scene, ray: &Ray, pdf_needed: bool) -> Option<(Rgb, f32)> {
     let index = scene.environment()?;
     let light = &scene.lights()[index as usize];
+    if !pdf_needed {
+        return Some((light.le_environment(ray.d), 0.0));
+    }
     let (le, pdf) = light.le_and_pdf_towards(ray.d);
     Some((le, scene.light_sampler().pmf(index as usize) * pdf))
 }

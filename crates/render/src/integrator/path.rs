@@ -168,7 +168,10 @@ impl PathIntegrator {
         hit: Option<&SurfaceInteraction>,
     ) -> bool {
         let Some(si) = hit else {
-            if let Some(found) = escaped(scene, &st.ray) {
+            // The density of the direction only matters to `bsdf_weight`'s power heuristic.
+            let pdf_needed =
+                self.lighting == PathLighting::Mis && st.prev.is_some_and(|v| !v.delta);
+            if let Some(found) = escaped(scene, &st.ray, pdf_needed) {
                 self.add_found_light(st, found);
             }
             return false;
