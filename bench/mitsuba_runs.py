@@ -86,14 +86,16 @@ def unwrapped(integrator):
     return mi.load_dict(settings), f"{name}{ {k: v for k, v in settings.items() if k != 'type'} }"
 
 
-def compare(reps, spp, pixels, ref, mitsuba, pathlab, probe_spp):
+def compare(reps, spp, pixels, ref, mitsuba, pathlab):
     """One scene measured both ways, as bench/scenes.py and bench/suite.py report it.
 
     Speed: `reps` renders at `spp` by each renderer, taking turns (`mitsuba(rep)` gives
     (seconds, image); `pathlab(flags, kind)` gives (its JSON statistics, image), pathlab with
     the independent sampler as the scenes ask); each rate the median. Equal time: Mitsuba's
     median time is the budget; pathlab, with its default settings, renders at the spp its own
-    rate at those settings (probed at `probe_spp`) allows, `reps` times with seeds 1, 2, ...
+    rate at those settings allows, `reps` times with seeds 1, 2, ... That rate is probed by a
+    render as long as the speed runs (`spp`): a short probe counts the start of a render
+    (threads, film) against too few samples and would leave part of the budget unused.
     Errors are RMSE against `ref`, medians over the repetitions on each side: a scene's error
     is heavy-tailed (a few bright pixels), so one image's RMSE says little."""
     rates_m, rates_p, times_m, errs_m = [], [], [], []
@@ -106,7 +108,7 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, probe_spp):
         rates_p.append(stats["samples_per_second"])
     rate_m, rate_p = float(np.median(rates_m)), float(np.median(rates_p))
     t_m, e_m = float(np.median(times_m)), float(np.median(errs_m))
-    probe, _ = pathlab(["-s", str(probe_spp)], "probe")
+    probe, _ = pathlab(["-s", str(spp)], "probe")
     spp_p = max(1, int(t_m * probe["samples_per_second"] / pixels))
     errs_p, secs_p = [], []
     for rep in range(reps):

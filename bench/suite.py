@@ -71,8 +71,7 @@ for path in files:
         c = mitsuba_runs.compare(
             args.reps, args.spp, pixels, ref, mitsuba,
             lambda flags, kind: pathlab_render(path, integrator, flags,
-                                               f"{args.work}/{kind}-{tag}.exr"),
-            probe_spp=64)
+                                               f"{args.work}/{kind}-{tag}.exr"))
     except subprocess.CalledProcessError as e:
         if rendered:  # Mitsuba rendered it: the failure is pathlab's
             raise
