@@ -55,7 +55,8 @@ def bytes_cell(ours, theirs):
 
 rows = []
 print(f"{'mesh':<12} {'tris':>8} | {'build s':>16} {'ratio':>6} | "
-      f"{'primary 1T Mrays/s':>19} {'ratio':>6} | {'bounce 1T Mrays/s':>18} {'ratio':>6} | "
+      f"{'primary 1T Mrays/s':>19} {'ratio':>6} | {'packets of 8':>19} {'ratio':>6} | "
+      f"{'bounce 1T Mrays/s':>18} {'ratio':>6} | "
       f"{'bounce NT':>13} {'ratio':>6} | {'B/tri':>11} {'ratio':>6} | {'agree %':>8}")
 for m in meshes:
     build, per_thread = embree(m)
@@ -63,15 +64,19 @@ for m in meshes:
     ours = ours_of[m]
     sets = {s["rays"]: s for s in ours["sets"]}
     p1 = sets["primary"]["mrays_per_s_1_thread"]
+    p8 = sets["primary"]["mrays_per_s_1_thread_packets"]
     b1 = sets["bounce"]["mrays_per_s_1_thread"]
     bn = sets["bounce"]["mrays_per_s_all_threads"]
     agree = min(s["agreement"] for s in ours["sets"]) * 100
     print(f"{m:<12} {ours['triangles']:>8} | {ours['bvh_build_seconds']:7.3f}/{build:<8.3f} "
           f"{ours['bvh_build_seconds'] / build:6.2f} | {p1:8.2f}/{e1[0]:<10.2f} {p1 / e1[0]:6.2f} | "
+          f"{p8:8.2f}/{e1[0]:<10.2f} {p8 / e1[0]:6.2f} | "
           f"{b1:7.2f}/{e1[1]:<10.2f} {b1 / e1[1]:6.2f} | {bn:5.2f}/{en[1]:<7.2f} {bn / en[1]:6.2f} | "
           f"{bytes_cell(ours['bytes_per_triangle'], embree_bytes(m))} | {agree:8.4f}")
 print("(each cell: pathlab/Embree, medians of", reps, "runs taken in turns; ratio = pathlab / Embree,"
       " so > 1 is faster throughput, < 1 is faster build or less memory)")
+print("(packets of 8: pathlab with eight consecutive rays walking its BVH together, against"
+      " Embree's one ray at a time, rtcIntersect1, which is what embree_bench calls)")
 print("(B/tri: pathlab's geometry bytes per triangle, everything its surface interactions read"
       " included; Embree's acceleration structure with its vertex and index buffers)")
 
@@ -86,6 +91,7 @@ if rows:
         o = d["binary_bvh_baseline"]["obvhs"]
         sets = {s["rays"]: s for s in d["sets"]}
         p1 = sets["primary"]["mrays_per_s_1_thread"]
+    p8 = sets["primary"]["mrays_per_s_1_thread_packets"]
         b1 = sets["bounce"]["mrays_per_s_1_thread"]
         print(f"{m:<12} | {o['build_seconds']:13.3f} | {o['primary']['mrays_per_s']:17.2f} "
               f"{p1 / o['primary']['mrays_per_s']:14.2f} | {o['bounce']['mrays_per_s']:16.2f} "

@@ -18,6 +18,7 @@ pub use wide::{
     split_box, BoxTest, Bvh4, Bvh8, Node, Portable, SplitPrim, WideBvh, BVH_WIDTH, FAR_SCALE,
     MAX_PRIMITIVES, SPLIT_BUDGET,
 };
+pub(crate) use wide::{PacketBounds, RayBoxLanes};
 
 /// Test helpers shared by the BVHs' tests: random boxes as primitives.
 #[cfg(test)]

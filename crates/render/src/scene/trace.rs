@@ -3,16 +3,19 @@
 //! their lanes), and the traversal is
 //! compiled twice, for AVX2 and for the target's baseline, the CPU choosing at run time.
 //! Small scenes skip the BVH for camera and bounce rays: eight rays against every primitive
-//! at once ([`Scene::nearest_of_rays`]), at the best SIMD level the CPU has.
+//! at once ([`Scene::nearest_of_rays`]), at the best SIMD level the CPU has. In scenes of
+//! triangles only, eight rays that go the same way can walk the BVH together
+//! ([`Scene::nearest_of_packet`]), each tested exactly at the leaves.
 
 use super::{Prim, Scene};
 use crate::accel::{
-    BoxTest, Bvh8, Nearest, Portable, RayLanes, TriBlock, BVH_WIDTH, FAR_SCALE, TRIS_PER_BLOCK,
+    BoxTest, Bvh8, Nearest, PacketBounds, Portable, RayBoxLanes, RayLanes, TriBlock, BVH_WIDTH,
+    TRIS_PER_BLOCK,
 };
 use crate::desc::{RayKind, Visibility};
 use crate::geometry::{Aabb, Ray};
 use crate::shape::Triangle;
-use crate::simd::lanes::{F8, M8, W};
+use crate::simd::lanes::{F8, W};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx512};
 use glam::Vec3;
@@ -364,6 +367,197 @@ impl Scene {
         self.with_nearest_shapes(rays, nearest)
     }
 
+    /// Whether eight rays may walk the BVH together ([`Scene::nearest_of_packet`]): scenes of
+    /// triangles only, each seen by every ray.
+    pub(crate) fn traces_packets(&self) -> bool {
+        self.all_visible && self.only_triangles
+    }
+
+    /// The nearest hits of eight rays ending at `t_max` (-∞ for a lane without a ray), the
+    /// eight walking the BVH together ([`crate::accel::WideBvh::packet_leaves`]), and the
+    /// nodes visited. Each ray finds the distance its own walk would find (the same triangle
+    /// tests, to the bit, and boxes skipped only where its own walk would skip them); of
+    /// several triangles at exactly that distance it may report another. Pays where the rays
+    /// go the same way. Only for scenes where [`Scene::traces_packets`].
+    pub(crate) fn nearest_of_packet(&self, rays: &RayLanes, t_max: F8) -> (Nearest, u32) {
+        let t_max = Self::packet_ends(t_max);
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx512) = Avx512::detect() {
+            // SAFETY: `nearest_of_packet_avx512` requires AVX-512 F, VL and DQ, AVX2 and FMA,
+            // which `avx512` proves this CPU has. Its body is safe code.
+            return unsafe { self.nearest_of_packet_avx512(avx512, rays, t_max) };
+        }
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx2) = Avx2::detect() {
+            // SAFETY: `nearest_of_packet_avx2` requires AVX2 and FMA, which `avx2` proves
+            // this CPU has. Its body is safe code.
+            return unsafe { self.nearest_of_packet_avx2(avx2, rays, t_max) };
+        }
+        self.nearest_of_packet_lanes(rays, t_max)
+    }
+
+    /// The lanes of `rays` that have a ray (`t_max` above -∞), and their interval ray, if one
+    /// bounds them.
+    #[inline(always)]
+    fn packet_bounds(rays: &RayLanes, t_max: F8) -> (u32, Option<PacketBounds>) {
+        let active = (0..W).fold(0u32, |m, i| {
+            m | u32::from(t_max.0[i] > f32::NEG_INFINITY) << i
+        });
+        (active, PacketBounds::new(rays, active))
+    }
+
+    /// `t_max` with -∞ in the lanes that have no ray (NaN included), so that the packet's
+    /// farthest end is that of its rays.
+    #[inline(always)]
+    fn packet_ends(t_max: F8) -> F8 {
+        let none = F8::splat(f32::NEG_INFINITY);
+        t_max.gt(none).select(t_max, none)
+    }
+
+    /// The nearest hits of the lanes `active` of `rays`, each walking the BVH alone (packets
+    /// that no interval ray bounds).
+    #[cold]
+    fn nearest_one_by_one(&self, rays: &RayLanes, t_max: F8, active: u32) -> (Nearest, u32) {
+        let mut nearest = Nearest::new(t_max);
+        let mut visited = 0;
+        for i in (0..W).filter(|&i| active & (1 << i) != 0) {
+            let mut ray = Ray {
+                o: rays.o.get(i),
+                d: rays.d.get(i),
+                t_min: rays.t_min.0[i],
+                t_max: t_max.0[i],
+            };
+            let hit = self.closest_hit(&mut ray, RayKind::Indirect);
+            visited += hit.visited();
+            if hit.found() {
+                let (b1, b2) = hit.barycentrics();
+                nearest.t.0[i] = ray.t_max;
+                nearest.b1.0[i] = b1;
+                nearest.b2.0[i] = b2;
+                nearest.slot.0[i] = f32::from_bits(hit.slot());
+            }
+        }
+        (nearest, visited)
+    }
+
+    /// [`Scene::nearest_of_packet`] compiled for AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn nearest_of_packet_avx2(&self, _: Avx2, rays_in: &RayLanes, t_max: F8) -> (Nearest, u32) {
+        let (active, bounds) = Self::packet_bounds(rays_in, t_max);
+        let Some(bounds) = bounds else {
+            return self.nearest_one_by_one(rays_in, t_max, active);
+        };
+        use crate::accel::{AvxNearest, AvxRays};
+        let rays = AvxRays::new(rays_in);
+        let mut nearest = AvxNearest::new(t_max);
+        let visited = self.packet_triangles(
+            &bounds,
+            &mut nearest,
+            |n| n.t(),
+            |n, block, lane, slot| block.nearest_for_rays_avx(lane, slot, &rays, n),
+            |_| {},
+        );
+        (nearest.lanes(), visited)
+    }
+
+    /// [`Scene::nearest_of_packet`] with AVX-512: a leaf's triangles in pairs, as
+    /// [`Scene::nearest_of_rays`] tests them (an odd last one paired with itself).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+    fn nearest_of_packet_avx512(&self, _: Avx512, rays_in: &RayLanes, t_max: F8) -> (Nearest, u32) {
+        let (active, bounds) = Self::packet_bounds(rays_in, t_max);
+        let Some(bounds) = bounds else {
+            return self.nearest_one_by_one(rays_in, t_max, active);
+        };
+        use crate::accel::{nearest_for_rays_pair_avx512, Avx512Nearest, Avx512Rays, AvxRays};
+        let rays = Avx512Rays::new(&AvxRays::new(rays_in));
+        // The nearest hits and a triangle waiting for its pair.
+        let mut state = (Avx512Nearest::new(t_max), None);
+        let visited = self.packet_triangles(
+            &bounds,
+            &mut state,
+            |(n, _)| n.t(),
+            |(n, first), block, lane, slot| match first.take() {
+                None => *first = Some((block, lane, slot)),
+                Some(a) => nearest_for_rays_pair_avx512(a, (block, lane, slot), &rays, n),
+            },
+            // The leaf's last triangle before the walk reads the distances again.
+            |(n, first)| {
+                if let Some(a) = first.take() {
+                    nearest_for_rays_pair_avx512(a, a, &rays, n);
+                }
+            },
+        );
+        (state.0.lanes(), visited)
+    }
+
+    #[inline(always)]
+    fn nearest_of_packet_lanes(&self, rays: &RayLanes, t_max: F8) -> (Nearest, u32) {
+        let (active, bounds) = Self::packet_bounds(rays, t_max);
+        let Some(bounds) = bounds else {
+            return self.nearest_one_by_one(rays, t_max, active);
+        };
+        let mut nearest = Nearest::new(t_max);
+        let visited = self.packet_triangles(
+            &bounds,
+            &mut nearest,
+            |n| n.t,
+            |n, block, lane, slot| block.nearest_for_rays(lane, slot, rays, n),
+            |_| {},
+        );
+        (nearest, visited)
+    }
+
+    /// [`Scene::nearest_of_packet`] at every SIMD level this CPU has, named, for the tests.
+    #[cfg(test)]
+    fn nearest_of_packet_each_level(&self, rays: &RayLanes, t_max: F8) -> Vec<(&str, Nearest)> {
+        let mut all = vec![("portable", self.nearest_of_packet_lanes(rays, t_max).0)];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if let Some(avx2) = Avx2::detect() {
+                // SAFETY: `avx2` proves the features `nearest_of_packet_avx2` requires.
+                all.push(("AVX2", unsafe {
+                    self.nearest_of_packet_avx2(avx2, rays, t_max).0
+                }));
+            }
+            if let Some(avx512) = Avx512::detect() {
+                // SAFETY: `avx512` proves the features `nearest_of_packet_avx512` requires.
+                all.push(("AVX-512", unsafe {
+                    self.nearest_of_packet_avx512(avx512, rays, t_max).0
+                }));
+            }
+        }
+        all
+    }
+
+    /// `f(nearest, block, lane, leaf slot)` for every triangle of every leaf the packet
+    /// bounded by `bounds` reaches, walking the BVH together
+    /// ([`crate::accel::WideBvh::packet_leaves`]); `end_leaf(nearest)` after each leaf.
+    /// Returns the nodes visited.
+    #[inline(always)]
+    fn packet_triangles<'a, N>(
+        &'a self,
+        bounds: &PacketBounds,
+        nearest: &mut N,
+        t_now: impl Fn(&N) -> F8,
+        mut f: impl FnMut(&mut N, &'a TriBlock, usize, u32),
+        mut end_leaf: impl FnMut(&mut N),
+    ) -> u32 {
+        self.bvh.packet_leaves(bounds, nearest, t_now, |n, word| {
+            let (first, count) = Bvh8::leaf_range(word);
+            for b in first as usize..(first + count) as usize {
+                let info = &self.block_info[b];
+                for lane in 0..TRIS_PER_BLOCK {
+                    if info.used & (1 << lane) != 0 {
+                        f(n, &self.blocks[b], lane, info.slot(lane));
+                    }
+                }
+            }
+            end_leaf(n);
+        })
+    }
+
     /// `nearest` (the triangles' nearest hits of eight rays) with the other shapes tested
     /// too: a lane's hit is replaced by a shape's where the shape is nearer. Spheres are
     /// tested eight rays at once ([`crate::shape::Sphere::intersect_lanes`], compiled with
@@ -449,53 +643,6 @@ impl Scene {
                     || (shapes != 0 && self.hits_shape(b, shapes, r))
             })
         })
-    }
-}
-
-/// Eight rays set up for testing boxes, a lane each: the BVH's slab test ([`BoxTest`]'s
-/// portable one), with the lanes being rays instead of boxes.
-struct RayBoxLanes {
-    o: [F8; 3],
-    inv_d: [F8; 3],
-    /// `inv_d` widened by [`FAR_SCALE`], for far planes.
-    inv_far: [F8; 3],
-    /// Lanes whose direction is negative on the axis (they enter by the upper plane).
-    negative: [M8; 3],
-    /// Where entry distances start: `t_min`, or +0 where it is not positive.
-    t_min: F8,
-}
-
-impl RayBoxLanes {
-    #[inline(always)]
-    fn new(rays: &RayLanes) -> RayBoxLanes {
-        let d = [rays.d.x, rays.d.y, rays.d.z];
-        let inv_d = d.map(|d| F8::splat(1.0) / d);
-        let zero = F8::splat(0.0);
-        RayBoxLanes {
-            o: [rays.o.x, rays.o.y, rays.o.z],
-            inv_d,
-            inv_far: inv_d.map(|i| i * F8::splat(FAR_SCALE)),
-            negative: d.map(|d| M8(d.0.map(|x| if x.is_sign_negative() { !0 } else { 0 }))),
-            t_min: rays.t_min.gt(zero).select(rays.t_min, zero),
-        }
-    }
-
-    /// Whether some lane's ray meets `bounds` between its `t_min` and `t_max`.
-    #[inline(always)]
-    fn meets(&self, bounds: &Aabb, t_max: F8) -> bool {
-        let (mut t_near, mut t_far) = (self.t_min, t_max);
-        for axis in 0..3 {
-            let (lo, hi) = (F8::splat(bounds.min[axis]), F8::splat(bounds.max[axis]));
-            let near = self.negative[axis].select(hi, lo);
-            let far = self.negative[axis].select(lo, hi);
-            let tn = (near - self.o[axis]) * self.inv_d[axis];
-            let tf = (far - self.o[axis]) * self.inv_far[axis];
-            // As the BVH's test: a NaN (0 · ∞ for a ray in a box's plane) leaves the running
-            // value unchanged.
-            t_near = tn.gt(t_near).select(tn, t_near);
-            t_far = tf.lt(t_far).select(tf, t_far);
-        }
-        t_near.le(t_far).0.iter().fold(0, |any, &m| any | m) != 0
     }
 }
 

@@ -17,11 +17,13 @@
 //!
 //! One concept per file: the node layout (`node`), the box tests (`box_test`), the traversal
 //! stack (`stack`), the build (`build`: binned SAH binary tree, collapsed into wide nodes), its
-//! spatial splits (`spatial`) and the traversals (`traverse`).
+//! spatial splits (`spatial`), the traversals of one ray (`traverse`) and of eight rays
+//! together (`packet`).
 
 mod box_test;
 mod build;
 mod node;
+mod packet;
 mod spatial;
 mod stack;
 mod traverse;
@@ -29,6 +31,7 @@ mod traverse;
 pub use box_test::{BoxTest, Portable, FAR_SCALE};
 use node::{leaf_range, leaf_word, LEAF, MAX_LEAF};
 pub use node::{Node, MAX_PRIMITIVES};
+pub(crate) use packet::{PacketBounds, RayBoxLanes};
 pub use spatial::{split_box, SplitPrim, SPLIT_BUDGET};
 
 use crate::geometry::Aabb;

@@ -413,3 +413,103 @@ fn every_simd_level_finds_the_same_triangles_to_the_bit() {
     }
     assert!(hits > 15_000, "{hits} hits");
 }
+
+#[test]
+fn packets_walking_the_bvh_find_what_each_ray_finds() {
+    // The boxes and a few hundred random triangles (too many to test them all): eight rays
+    // walking the BVH together, at every SIMD level, find each ray's own nearest distance,
+    // and the same triangle but for ties. Packets from one point towards nearby points (a
+    // pixel's camera rays), from spread points in one octant, and in every direction (which
+    // no interval ray bounds: the rays walk alone); some lanes idle or with finite extents.
+    let mut desc = boxes();
+    let mut rng = pathlab_mc::rng::Pcg32::new(21, 5);
+    let mut point = || Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+    let mut positions = Vec::new();
+    for _ in 0..300 {
+        let c = point() * 4.0 - 2.0;
+        positions.extend([c, c + (point() - 0.5) * 0.4, c + (point() - 0.5) * 0.4]);
+    }
+    desc.meshes.push(MeshDesc {
+        name: "soup".into(),
+        indices: (0..positions.len() as u32).collect(),
+        positions,
+        ..Default::default()
+    });
+    let scene = Scene::build(&desc).unwrap();
+    assert!(scene.traces_packets() && !scene.tests_every_primitive());
+    let (mut hits, mut ties, mut bounded) = (0, 0, 0);
+    for k in 0..3000 {
+        let mut rays = RayLanes::default();
+        let mut t_max = F8::splat(f32::INFINITY);
+        let mut each = [Ray::new(Vec3::ZERO, Vec3::X); 8];
+        let (o0, target) = (point() * 6.0 - 3.0, point() * 2.0 - 1.0);
+        for (i, ray) in each.iter_mut().enumerate() {
+            *ray = match k % 3 {
+                0 => Ray::new(o0, target + (point() - 0.5) * 0.05 - o0),
+                1 => {
+                    let o = o0 + (point() - 0.5) * 0.5;
+                    Ray::new(o, target + (point() - 0.5) * 0.3 - o)
+                }
+                _ => Ray::new(point() * 3.0 - 1.5, point() - 0.5),
+            };
+            if (k + i) % 5 == 4 {
+                ray.t_max = 1.5;
+            }
+            if (k + i) % 7 == 6 {
+                ray.t_min = 0.25;
+            }
+            rays.o.set(i, ray.o);
+            rays.d.set(i, ray.d);
+            rays.t_min.0[i] = ray.t_min;
+            // Some lanes idle.
+            t_max.0[i] = if (k + i) % 11 == 10 {
+                f32::NEG_INFINITY
+            } else {
+                ray.t_max
+            };
+        }
+        let active = (0..8).fold(0u32, |m, i| {
+            m | u32::from(t_max.0[i] > f32::NEG_INFINITY) << i
+        });
+        bounded += usize::from(PacketBounds::new(&rays, active).is_some());
+        let (dispatched, _) = scene.nearest_of_packet(&rays, t_max);
+        let levels = scene.nearest_of_packet_each_level(&rays, t_max);
+        for (i, ray) in each.iter().enumerate() {
+            let lane = dispatched.lane(i);
+            for (name, nearest) in &levels {
+                assert_eq!(nearest.lane(i), lane, "{name} against the dispatched walk");
+            }
+            if active & (1 << i) == 0 {
+                assert_eq!(lane, None, "an idle lane finds nothing");
+                continue;
+            }
+            let mut r = *ray;
+            let alone = scene.closest_hit(&mut r, RayKind::Indirect);
+            hits += usize::from(alone.found());
+            assert_eq!(
+                lane.map(|(_, t, _, _)| t),
+                alone.found().then_some(r.t_max),
+                "packet {k}, ray {i}"
+            );
+            let Some((slot, t, b1, b2)) = lane else {
+                continue;
+            };
+            if slot == alone.slot() {
+                assert_eq!((b1, b2), alone.barycentrics());
+            } else {
+                let Prim::Triangle(j) = scene.prims[slot as usize].get() else {
+                    panic!("not a triangle at lane {i}")
+                };
+                let (block, l) = scene.triangle_block(j);
+                assert_eq!(block.intersect(ray, 1 << l).map(|h| h.t), Some(t));
+                ties += 1;
+            }
+        }
+    }
+    assert!(hits > 8000, "only {hits} hits");
+    assert!(
+        bounded > 1500,
+        "only {bounded} packets bounded by an interval ray"
+    );
+    assert!(ties < hits / 100, "{ties} ties of {hits} hits");
+}
