@@ -91,7 +91,6 @@ if rows:
         o = d["binary_bvh_baseline"]["obvhs"]
         sets = {s["rays"]: s for s in d["sets"]}
         p1 = sets["primary"]["mrays_per_s_1_thread"]
-    p8 = sets["primary"]["mrays_per_s_1_thread_packets"]
         b1 = sets["bounce"]["mrays_per_s_1_thread"]
         print(f"{m:<12} | {o['build_seconds']:13.3f} | {o['primary']['mrays_per_s']:17.2f} "
               f"{p1 / o['primary']['mrays_per_s']:14.2f} | {o['bounce']['mrays_per_s']:16.2f} "

@@ -381,19 +381,23 @@ impl Scene {
     /// go the same way. Only for scenes where [`Scene::traces_packets`].
     pub(crate) fn nearest_of_packet(&self, rays: &RayLanes, t_max: F8) -> (Nearest, u32) {
         let t_max = Self::packet_ends(t_max);
+        let (active, bounds) = Self::packet_bounds(rays, t_max);
+        let Some(bounds) = &bounds else {
+            return self.nearest_one_by_one(rays, t_max, active);
+        };
         #[cfg(target_arch = "x86_64")]
         if let Some(avx512) = Avx512::detect() {
             // SAFETY: `nearest_of_packet_avx512` requires AVX-512 F, VL and DQ, AVX2 and FMA,
             // which `avx512` proves this CPU has. Its body is safe code.
-            return unsafe { self.nearest_of_packet_avx512(avx512, rays, t_max) };
+            return unsafe { self.nearest_of_packet_avx512(avx512, bounds, rays, t_max) };
         }
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = Avx2::detect() {
             // SAFETY: `nearest_of_packet_avx2` requires AVX2 and FMA, which `avx2` proves
             // this CPU has. Its body is safe code.
-            return unsafe { self.nearest_of_packet_avx2(avx2, rays, t_max) };
+            return unsafe { self.nearest_of_packet_avx2(avx2, bounds, rays, t_max) };
         }
-        self.nearest_of_packet_lanes(rays, t_max)
+        self.nearest_of_packet_lanes(bounds, rays, t_max)
     }
 
     /// The lanes of `rays` that have a ray (`t_max` above -∞), and their interval ray, if one
@@ -443,16 +447,18 @@ impl Scene {
     /// [`Scene::nearest_of_packet`] compiled for AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    fn nearest_of_packet_avx2(&self, _: Avx2, rays_in: &RayLanes, t_max: F8) -> (Nearest, u32) {
-        let (active, bounds) = Self::packet_bounds(rays_in, t_max);
-        let Some(bounds) = bounds else {
-            return self.nearest_one_by_one(rays_in, t_max, active);
-        };
+    fn nearest_of_packet_avx2(
+        &self,
+        _: Avx2,
+        bounds: &PacketBounds,
+        rays_in: &RayLanes,
+        t_max: F8,
+    ) -> (Nearest, u32) {
         use crate::accel::{AvxNearest, AvxRays};
         let rays = AvxRays::new(rays_in);
         let mut nearest = AvxNearest::new(t_max);
         let visited = self.packet_triangles(
-            &bounds,
+            bounds,
             &mut nearest,
             |n| n.t(),
             |n, block, lane, slot| block.nearest_for_rays_avx(lane, slot, &rays, n),
@@ -465,17 +471,19 @@ impl Scene {
     /// [`Scene::nearest_of_rays`] tests them (an odd last one paired with itself).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
-    fn nearest_of_packet_avx512(&self, _: Avx512, rays_in: &RayLanes, t_max: F8) -> (Nearest, u32) {
-        let (active, bounds) = Self::packet_bounds(rays_in, t_max);
-        let Some(bounds) = bounds else {
-            return self.nearest_one_by_one(rays_in, t_max, active);
-        };
+    fn nearest_of_packet_avx512(
+        &self,
+        _: Avx512,
+        bounds: &PacketBounds,
+        rays_in: &RayLanes,
+        t_max: F8,
+    ) -> (Nearest, u32) {
         use crate::accel::{nearest_for_rays_pair_avx512, Avx512Nearest, Avx512Rays, AvxRays};
         let rays = Avx512Rays::new(&AvxRays::new(rays_in));
         // The nearest hits and a triangle waiting for its pair.
         let mut state = (Avx512Nearest::new(t_max), None);
         let visited = self.packet_triangles(
-            &bounds,
+            bounds,
             &mut state,
             |(n, _)| n.t(),
             |(n, first), block, lane, slot| match first.take() {
@@ -493,14 +501,15 @@ impl Scene {
     }
 
     #[inline(always)]
-    fn nearest_of_packet_lanes(&self, rays: &RayLanes, t_max: F8) -> (Nearest, u32) {
-        let (active, bounds) = Self::packet_bounds(rays, t_max);
-        let Some(bounds) = bounds else {
-            return self.nearest_one_by_one(rays, t_max, active);
-        };
+    fn nearest_of_packet_lanes(
+        &self,
+        bounds: &PacketBounds,
+        rays: &RayLanes,
+        t_max: F8,
+    ) -> (Nearest, u32) {
         let mut nearest = Nearest::new(t_max);
         let visited = self.packet_triangles(
-            &bounds,
+            bounds,
             &mut nearest,
             |n| n.t,
             |n, block, lane, slot| block.nearest_for_rays(lane, slot, rays, n),
@@ -512,19 +521,23 @@ impl Scene {
     /// [`Scene::nearest_of_packet`] at every SIMD level this CPU has, named, for the tests.
     #[cfg(test)]
     fn nearest_of_packet_each_level(&self, rays: &RayLanes, t_max: F8) -> Vec<(&str, Nearest)> {
-        let mut all = vec![("portable", self.nearest_of_packet_lanes(rays, t_max).0)];
+        let (active, bounds) = Self::packet_bounds(rays, t_max);
+        let Some(b) = &bounds else {
+            return vec![("one by one", self.nearest_one_by_one(rays, t_max, active).0)];
+        };
+        let mut all = vec![("portable", self.nearest_of_packet_lanes(b, rays, t_max).0)];
         #[cfg(target_arch = "x86_64")]
         {
             if let Some(avx2) = Avx2::detect() {
                 // SAFETY: `avx2` proves the features `nearest_of_packet_avx2` requires.
                 all.push(("AVX2", unsafe {
-                    self.nearest_of_packet_avx2(avx2, rays, t_max).0
+                    self.nearest_of_packet_avx2(avx2, b, rays, t_max).0
                 }));
             }
             if let Some(avx512) = Avx512::detect() {
                 // SAFETY: `avx512` proves the features `nearest_of_packet_avx512` requires.
                 all.push(("AVX-512", unsafe {
-                    self.nearest_of_packet_avx512(avx512, rays, t_max).0
+                    self.nearest_of_packet_avx512(avx512, b, rays, t_max).0
                 }));
             }
         }

@@ -70,12 +70,18 @@ impl RayBoxes {
                 t_far[lane] = if tf < t_far[lane] { tf } else { t_far[lane] };
             }
         }
-        let mut mask = 0u32;
-        for lane in 0..W {
-            mask |= u32::from(t_near[lane] <= t_far[lane]) << lane;
-        }
-        (t_near, mask & n.valid)
+        (t_near, met_mask(&t_near, &t_far, n.valid))
     }
+}
+
+/// The lanes of `valid` whose box is met: entry at most exit (a NaN compares false).
+#[inline(always)]
+pub(super) fn met_mask<const W: usize>(t_near: &[f32; W], t_far: &[f32; W], valid: u32) -> u32 {
+    let mut mask = 0u32;
+    for lane in 0..W {
+        mask |= u32::from(t_near[lane] <= t_far[lane]) << lane;
+    }
+    mask & valid
 }
 
 /// How a traversal tests a ray against a node's `W` boxes: [`Portable`] on any CPU, or with

@@ -11,6 +11,7 @@
 //!
 //! [`RayBoxLanes`] tests eight rays exactly against one box (the small scenes' block culling).
 
+use super::box_test::met_mask;
 use super::node::LEAF;
 use super::stack::{stack_entry, Stack, STACK_SIZE};
 use super::{Node, WideBvh, FAR_SCALE};
@@ -99,9 +100,8 @@ pub(crate) struct PacketBounds {
 impl PacketBounds {
     /// The interval ray of the lanes `active` of `rays`; none where their directions differ
     /// in sign on some axis, or a direction or origin component is zero or not finite (the
-    /// bounds would need NaN's rules; such packets walk one ray at a time). Inlined into
-    /// callers compiled for the CPU's vector unit, which divide all lanes at once.
-    #[inline(always)]
+    /// bounds would need NaN's rules; such packets walk one ray at a time). Written over whole
+    /// lanes (one division of all eight per axis), not lane by lane.
     pub(crate) fn new(rays: &RayLanes, active: u32) -> Option<PacketBounds> {
         if active == 0 {
             return None;
@@ -189,11 +189,7 @@ impl PacketBounds {
                 t_far[lane] = if tf < t_far[lane] { tf } else { t_far[lane] };
             }
         }
-        let mut mask = 0u32;
-        for lane in 0..W {
-            mask |= u32::from(t_near[lane] <= t_far[lane]) << lane;
-        }
-        (t_near, mask & n.valid)
+        (t_near, met_mask(&t_near, &t_far, n.valid))
     }
 }
 

@@ -242,6 +242,23 @@ fn boxes() -> SceneDesc {
     }
 }
 
+/// Whether the hit `(slot, t, b1, b2)` that eight rays tested together report for `ray` is
+/// another primitive than the one the ray's own BVH walk found, `alone`: it must then be a
+/// triangle at exactly the same distance (a shared edge); the same one, at the same
+/// barycentrics.
+fn is_tie(scene: &Scene, ray: &Ray, (slot, t, b1, b2): (u32, f32, f32, f32), alone: &Hit) -> bool {
+    if slot == alone.slot() {
+        assert_eq!((b1, b2), alone.barycentrics());
+        return false;
+    }
+    let Prim::Triangle(i) = scene.prims[slot as usize].get() else {
+        panic!("a shape other than the BVH's in slot {slot}")
+    };
+    let (block, lane) = scene.triangle_block(i);
+    assert_eq!(block.intersect(ray, 1 << lane).map(|h| h.t), Some(t));
+    true
+}
+
 /// Rays from inside and outside the boxes against `scene` by testing every primitive (at
 /// every SIMD level) and by the BVH: the same distances, and the same primitive but for
 /// ties (another triangle at exactly the same distance). Returns (hits, ties, sphere
@@ -299,22 +316,11 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
                 assert_eq!(nearest.lane(i), lane, "{name} against the dispatched test");
             }
             assert_eq!(lane.map(|(_, t, _, _)| t), bvh.found().then_some(r.t_max));
-            let Some((slot, t, b1, b2)) = lane else {
+            let Some(hit) = lane else {
                 continue;
             };
-            spheres += usize::from(matches!(scene.prims[slot as usize].get(), Prim::Sphere(_)));
-            if slot == bvh.slot() {
-                assert_eq!((b1, b2), bvh.barycentrics());
-            } else {
-                // Another triangle at exactly the same distance (a shared edge).
-                let Prim::Triangle(i) = scene.prims[slot as usize].get() else {
-                    panic!("a shape other than the BVH's at lane {i}")
-                };
-                let (block, lane) = scene.triangle_block(i);
-                let own = block.intersect(ray, 1 << lane);
-                assert_eq!(own.map(|h| h.t), Some(t));
-                ties += 1;
-            }
+            spheres += usize::from(matches!(scene.prims[hit.0 as usize].get(), Prim::Sphere(_)));
+            ties += usize::from(is_tie(scene, ray, hit, &bvh));
         }
     }
     assert!(
@@ -491,19 +497,10 @@ fn packets_walking_the_bvh_find_what_each_ray_finds() {
                 alone.found().then_some(r.t_max),
                 "packet {k}, ray {i}"
             );
-            let Some((slot, t, b1, b2)) = lane else {
+            let Some(hit) = lane else {
                 continue;
             };
-            if slot == alone.slot() {
-                assert_eq!((b1, b2), alone.barycentrics());
-            } else {
-                let Prim::Triangle(j) = scene.prims[slot as usize].get() else {
-                    panic!("not a triangle at lane {i}")
-                };
-                let (block, l) = scene.triangle_block(j);
-                assert_eq!(block.intersect(ray, 1 << l).map(|h| h.t), Some(t));
-                ties += 1;
-            }
+            ties += usize::from(is_tie(&scene, ray, hit, &alone));
         }
     }
     assert!(hits > 8000, "only {hits} hits");
