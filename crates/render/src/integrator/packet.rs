@@ -3,11 +3,9 @@
 //! after another through the BVH (its own SIMD traversal), or, in scenes of a few dozen
 //! triangles and a few spheres, all eight against every primitive at once (skipping the
 //! blocks of triangles none of them meets where the rays go one way: camera rays and first
-//! bounces, since the lanes take consecutive samples of a pixel). In scenes of triangles
-//! only, camera rays are made and traced ahead, eight consecutive samples at a time walking
-//! the BVH together, and a lane whose path ends takes a queued sample with its hit
-//! ([`CameraQueue`]). The lanes that start together make their camera rays together, and the
-//! sampler draws each bounce's random numbers for all lanes at once.
+//! bounces, since the lanes take consecutive samples of a pixel). The lanes that start
+//! together make their camera rays together, and the sampler draws each bounce's random
+//! numbers for all lanes at once.
 //!
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
 //! for every lane and bounce, except where a lane's surface is Lambertian and its light an
@@ -172,24 +170,9 @@ impl PathIntegrator {
         let mut more = true;
         let every_primitive = scene.tests_every_primitive();
         let mut rays = RayLanes::default();
-        // Camera rays traced ahead, eight at a time, in scenes whose BVH packets walk.
-        let mut queue =
-            (!every_primitive && scene.traces_packets()).then(|| CameraQueue::new(sampler));
-        // Lanes whose camera ray the queue traced: its nearest hit.
-        let mut traced: [Option<NearestLane>; W] = [None; W];
         loop {
             if more {
-                more = match &mut queue {
-                    Some(q) => q.start_paths(
-                        scene,
-                        &mut lanes,
-                        &mut samplers,
-                        &mut traced,
-                        samples,
-                        stats,
-                    ),
-                    None => start_paths(scene, &mut lanes, &mut samplers, samples),
-                };
+                more = start_paths(scene, &mut lanes, &mut samplers, samples);
             }
             if lanes.iter().all(Option::is_none) {
                 break;
@@ -208,18 +191,14 @@ impl PathIntegrator {
                 let st = &mut lane.st;
                 // The surface interaction is made in place and read a field at a time.
                 stats.rays += 1;
-                match (traced[i].take(), &nearest) {
-                    (Some(Some((slot, t, b1, b2))), _) => {
-                        scene.interaction_into(&st.ray, slot, t, b1, b2, &mut hits[i])
-                    }
-                    (Some(None), _) => hits[i] = None,
-                    (None, Some(nearest)) => match nearest.lane(i) {
+                match &nearest {
+                    Some(nearest) => match nearest.lane(i) {
                         Some((slot, t, b1, b2)) => {
                             scene.interaction_into(&st.ray, slot, t, b1, b2, &mut hits[i])
                         }
                         None => hits[i] = None,
                     },
-                    (None, None) => {
+                    None => {
                         stats.nodes_visited +=
                             scene.intersect_into(&st.ray, RayKind::at_depth(st.depth), &mut hits[i])
                                 as u64
@@ -367,129 +346,6 @@ fn start_paths(
         }
     }
     more
-}
-
-/// A camera ray's nearest hit as [`crate::accel::Nearest::lane`] gives it (leaf slot,
-/// distance, barycentrics), or none.
-type NearestLane = Option<(u32, f32, f32, f32)>;
-
-/// The next samples' camera rays, made and traced eight at a time, the eight walking the BVH
-/// together ([`Scene::nearest_of_packet`]): the consecutive samples of a pixel go the same way,
-/// but lanes whose paths end take new samples one or two at a time, too few to walk together.
-/// Each queued sample keeps the sampler that drew its camera sample, which goes with it to
-/// the lane that takes it (the lane's own goes back to the queue), so a path draws the same
-/// numbers as if its lane had started it.
-struct CameraQueue {
-    samplers: [AnySampler; W],
-    /// The queued samples' paths and their camera rays' nearest hits. (Made whole when the
-    /// queue fills: a lane copies a path written long before, where copying one just made
-    /// field by field would wait for its narrow stores.)
-    entries: [(Lane, NearestLane); W],
-    /// `entries[next..len]` are waiting.
-    next: usize,
-    len: usize,
-}
-
-impl CameraQueue {
-    fn new(sampler: &AnySampler) -> CameraQueue {
-        CameraQueue {
-            samplers: std::array::from_fn(|_| sampler.clone()),
-            entries: [(
-                Lane {
-                    tag: 0,
-                    st: PathState::new(Ray::new(glam::Vec3::ZERO, glam::Vec3::ZERO)),
-                    weight: 0.0,
-                },
-                None,
-            ); W],
-            next: 0,
-            len: 0,
-        }
-    }
-
-    /// Idle lanes take the next queued samples, the queue refilled from `samples` when it runs
-    /// out (`traced[i]`: lane `i`'s camera ray's hit); returns whether samples remain.
-    fn start_paths(
-        &mut self,
-        scene: &Scene,
-        lanes: &mut [Option<Lane>; W],
-        samplers: &mut [AnySampler; W],
-        traced: &mut [Option<NearestLane>; W],
-        samples: &mut dyn Iterator<Item = SampleRef>,
-        stats: &mut PathStats,
-    ) -> bool {
-        let mut more = true;
-        for (i, lane) in lanes.iter_mut().enumerate() {
-            if lane.is_some() {
-                continue;
-            }
-            if self.next == self.len {
-                more = self.refill(scene, samples, stats);
-                if self.len == 0 {
-                    break;
-                }
-            }
-            let (queued, hit) = &self.entries[self.next];
-            *lane = Some(*queued);
-            traced[i] = Some(*hit);
-            std::mem::swap(&mut samplers[i], &mut self.samplers[self.next]);
-            self.next += 1;
-        }
-        more || self.next < self.len
-    }
-
-    /// Up to eight next samples' camera rays, made together where the camera allows and
-    /// traced together; returns whether `samples` may hold more.
-    fn refill(
-        &mut self,
-        scene: &Scene,
-        samples: &mut dyn Iterator<Item = SampleRef>,
-        stats: &mut PathStats,
-    ) -> bool {
-        let mut cam = [CameraSample::default(); W];
-        let mut tags = [0u32; W];
-        let mut n = 0;
-        let mut more = true;
-        while n < W {
-            let Some(s) = samples.next() else {
-                more = false;
-                break;
-            };
-            cam[n] = camera_sample(scene, &mut self.samplers[n], s);
-            tags[n] = s.tag;
-            n += 1;
-        }
-        (self.next, self.len) = (0, n);
-        if n == 0 {
-            return more;
-        }
-        let camera = scene.camera();
-        let rays = camera
-            .generate_rays(cam.map(|c| c.film))
-            .unwrap_or_else(|| {
-                std::array::from_fn(|k| camera.generate_ray(cam[k].film, cam[k].u_lens))
-            });
-        // Lanes past the last sample get an empty interval.
-        let mut lanes = RayLanes::default();
-        let mut t_max = F8::splat(f32::NEG_INFINITY);
-        for (k, ray) in rays.iter().enumerate().take(n) {
-            lanes.o.set(k, ray.o);
-            lanes.d.set(k, ray.d);
-            lanes.t_min.0[k] = ray.t_min;
-            t_max.0[k] = ray.t_max;
-        }
-        let (nearest, visited) = scene.nearest_of_packet(&lanes, t_max);
-        stats.nodes_visited += u64::from(visited);
-        for k in 0..n {
-            let path = Lane {
-                tag: tags[k],
-                st: PathState::new(rays[k]),
-                weight: cam[k].weight,
-            };
-            self.entries[k] = (path, nearest.lane(k));
-        }
-        more
-    }
 }
 
 /// Every busy lane's ray against every primitive at once (the small scenes' trace); idle lanes

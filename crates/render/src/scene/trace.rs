@@ -5,7 +5,9 @@
 //! Small scenes skip the BVH for camera and bounce rays: eight rays against every primitive
 //! at once ([`Scene::nearest_of_rays`]), at the best SIMD level the CPU has. In scenes of
 //! triangles only, eight rays that go the same way can walk the BVH together
-//! ([`Scene::nearest_of_packet`]), each tested exactly at the leaves.
+//! ([`Scene::nearest_of_packet`]), each tested exactly at the leaves: the ray benchmark's
+//! packets ([`Scene::hit_distances`]); renders trace their rays alone (a pixel's camera rays
+//! over a finely tessellated mesh reach many leaves between them, each testing all eight).
 
 use super::{Prim, Scene};
 use crate::accel::{
