@@ -388,9 +388,7 @@ impl Scene {
         let mut lanes = crate::accel::RayLanes::default();
         let mut t_max = crate::simd::lanes::F8::splat(0.0);
         for (i, r) in rays.iter().enumerate() {
-            lanes.o.set(i, r.o);
-            lanes.d.set(i, r.d);
-            lanes.t_min.0[i] = r.t_min;
+            lanes.set(i, r);
             t_max.0[i] = r.t_max;
         }
         let (nearest, _) = self.nearest_of_packet(&lanes, t_max);

@@ -363,11 +363,8 @@ fn nearest_of_lanes(
     for (i, lane) in lanes.iter().enumerate() {
         if let Some(lane) = lane {
             coherent &= lane.st.depth <= 1;
-            let ray = &lane.st.ray;
-            rays.o.set(i, ray.o);
-            rays.d.set(i, ray.d);
-            rays.t_min.0[i] = ray.t_min;
-            t_max.0[i] = ray.t_max;
+            rays.set(i, &lane.st.ray);
+            t_max.0[i] = lane.st.ray.t_max;
         }
     }
     scene.nearest_of_rays(rays, t_max, coherent)

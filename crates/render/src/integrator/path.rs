@@ -144,6 +144,13 @@ impl PathIntegrator {
         self.only_bounce.is_none_or(|k| k == bounce)
     }
 
+    /// Whether [`PathIntegrator::bsdf_weight`] reads the light-sampling density of what the
+    /// BSDF sample that left `prev` finds (MIS, from a vertex, not along a delta lobe), so that
+    /// it need not be looked up otherwise.
+    fn weighs_by_light_pdf(&self, prev: Option<&PrevVertex>) -> bool {
+        self.lighting == PathLighting::Mis && prev.is_some_and(|v| !v.delta)
+    }
+
     /// MIS weight of emission found by the BSDF sample that left `prev`, which light
     /// sampling would find with density `pdf_light`.
     fn bsdf_weight(&self, prev: &PrevVertex, pdf_light: f32) -> f32 {
@@ -168,9 +175,7 @@ impl PathIntegrator {
         hit: Option<&SurfaceInteraction>,
     ) -> bool {
         let Some(si) = hit else {
-            // The density of the direction only matters to `bsdf_weight`'s power heuristic.
-            let pdf_needed =
-                self.lighting == PathLighting::Mis && st.prev.is_some_and(|v| !v.delta);
+            let pdf_needed = self.weighs_by_light_pdf(st.prev.as_ref());
             if let Some(found) = escaped(scene, &st.ray, pdf_needed) {
                 self.add_found_light(st, found);
             }

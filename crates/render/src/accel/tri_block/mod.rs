@@ -637,6 +637,17 @@ pub struct RayLanes {
     pub t_min: F8,
 }
 
+impl RayLanes {
+    /// Lane `i` set to `ray`'s origin, direction and near end (its far end is the caller's:
+    /// the nearest hits start from it).
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, ray: &Ray) {
+        self.o.set(i, ray.o);
+        self.d.set(i, ray.d);
+        self.t_min.0[i] = ray.t_min;
+    }
+}
+
 /// Each ray lane's nearest hit so far: its distance (the ray's far end before any hit), the
 /// barycentrics of vertices 1 and 2, and the hit primitive's leaf slot (as `f32` bits;
 /// `u32::MAX` for none).

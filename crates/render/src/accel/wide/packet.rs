@@ -48,13 +48,12 @@ impl RayBoxLanes {
         }
     }
 
-    /// Each ray's entry distance into the box from `lo` to `hi`, and the lanes whose ray meets
-    /// it between its `t_min` and `t_max`.
+    /// Whether some lane's ray meets `bounds` between its `t_min` and `t_max`.
     #[inline(always)]
-    fn enter(&self, lo: [f32; 3], hi: [f32; 3], t_max: F8) -> (F8, M8) {
+    pub(crate) fn meets(&self, bounds: &Aabb, t_max: F8) -> bool {
         let (mut t_near, mut t_far) = (self.t_min, t_max);
         for axis in 0..3 {
-            let (lo, hi) = (F8::splat(lo[axis]), F8::splat(hi[axis]));
+            let (lo, hi) = (F8::splat(bounds.min[axis]), F8::splat(bounds.max[axis]));
             let near = self.negative[axis].select(hi, lo);
             let far = self.negative[axis].select(lo, hi);
             let tn = (near - self.o[axis]) * self.inv_d[axis];
@@ -64,20 +63,8 @@ impl RayBoxLanes {
             t_near = tn.gt(t_near).select(tn, t_near);
             t_far = tf.lt(t_far).select(tf, t_far);
         }
-        (t_near, t_near.le(t_far))
+        t_near.le(t_far).0.iter().fold(0, |any, &m| any | m) != 0
     }
-
-    /// Whether some lane's ray meets `bounds` between its `t_min` and `t_max`.
-    #[inline(always)]
-    pub(crate) fn meets(&self, bounds: &Aabb, t_max: F8) -> bool {
-        let (_, met) = self.enter(bounds.min.to_array(), bounds.max.to_array(), t_max);
-        any(met)
-    }
-}
-
-#[inline(always)]
-fn any(m: M8) -> bool {
-    m.0.iter().fold(0, |any, &m| any | m) != 0
 }
 
 /// The interval ray that bounds a packet of rays going the same way (see the module notes).
@@ -315,9 +302,7 @@ mod tests {
     fn lanes(rays: &[Ray; 8]) -> RayLanes {
         let mut l = RayLanes::default();
         for (i, r) in rays.iter().enumerate() {
-            l.o.set(i, r.o);
-            l.d.set(i, r.d);
-            l.t_min.0[i] = r.t_min;
+            l.set(i, r);
         }
         l
     }

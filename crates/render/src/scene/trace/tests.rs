@@ -294,9 +294,7 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
             if i % 4 == 3 {
                 ray.t_max = 0.5;
             }
-            rays.o.set(i, ray.o);
-            rays.d.set(i, ray.d);
-            rays.t_min.0[i] = ray.t_min;
+            rays.set(i, ray);
             t_max.0[i] = ray.t_max;
         }
         // Every SIMD level, with and without culling blocks, finds the same.
@@ -464,9 +462,7 @@ fn packets_walking_the_bvh_find_what_each_ray_finds() {
             if (k + i) % 7 == 6 {
                 ray.t_min = 0.25;
             }
-            rays.o.set(i, ray.o);
-            rays.d.set(i, ray.d);
-            rays.t_min.0[i] = ray.t_min;
+            rays.set(i, ray);
             // Some lanes idle.
             t_max.0[i] = if (k + i) % 11 == 10 {
                 f32::NEG_INFINITY
