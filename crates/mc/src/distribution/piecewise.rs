@@ -157,11 +157,23 @@ impl Pieces<'_> {
         }
     }
 
+    /// Whether the domain is [0, 1], where the maps between x and the fraction of the domain
+    /// before it are the identity.
+    #[inline]
+    fn unit_domain(&self) -> bool {
+        self.min == 0.0 && self.max == 1.0
+    }
+
     /// The index of the piece containing `x` (clamped to the domain).
     #[inline]
     fn offset_of(&self, x: f32) -> usize {
         let n = self.len();
-        let t = (x - self.min) / (self.max - self.min);
+        // On [0, 1], (x - 0) / 1 is x itself: subtracting 0 and dividing by 1 are exact.
+        let t = if self.unit_domain() {
+            x
+        } else {
+            (x - self.min) / (self.max - self.min)
+        };
         ((t * n as f32) as isize).clamp(0, n as isize - 1) as usize
     }
 
@@ -173,8 +185,14 @@ impl Pieces<'_> {
         if c1 - c0 > 0.0 {
             du /= c1 - c0;
         }
-        let t = ((o as f32 + du.clamp(0.0, 1.0)) / self.len() as f32).min(1.0);
-        let mut x = (self.min + t * (self.max - self.min)).min(self.max.next_down());
+        let t = (divide_by_count(o as f32 + du.clamp(0.0, 1.0), self.len())).min(1.0);
+        // On [0, 1], 0 + t · 1 is t itself (t ≥ +0: o + du is never -0).
+        let x = if self.unit_domain() {
+            t
+        } else {
+            self.min + t * (self.max - self.min)
+        };
+        let mut x = x.min(self.max.next_down());
         // Rounding can put a point at a piece's edge into the neighbouring piece, whose density
         // differs (or is zero); step to the nearest float inside piece `o`.
         for _ in 0..8 {
@@ -198,6 +216,19 @@ impl Pieces<'_> {
         let frac = t - o as f32;
         let (c0, c1) = (self.entries[o].cdf, self.entries[o + 1].cdf);
         c0 + frac * (c1 - c0)
+    }
+}
+
+/// `a / n`, by a product with 1/n where `n` is a power of two: 1/n is then exact, and `a · 1/n`
+/// and `a / n` are both the correctly rounded value of the same real number, so they are the
+/// same float (subnormal results included); a division where it is not.
+#[inline]
+fn divide_by_count(a: f32, n: usize) -> f32 {
+    if n.is_power_of_two() {
+        // 2^-k from its exponent bits (k < 64 < 127: a normal float).
+        a * f32::from_bits((127 - n.trailing_zeros()) << 23)
+    } else {
+        a / n as f32
     }
 }
 
@@ -527,6 +558,32 @@ mod tests {
                     cdf.partition_point(|&c| c <= u),
                     "n = {n}, u = {u}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn the_shortcuts_compute_what_the_divisions_compute() {
+        let mut rng = Pcg32::new(9, 2);
+        let mut xs: Vec<f32> = vec![0.0, -0.0, 1.0, 1.0f32.next_down(), 1e-40, 1e-45, 0.5, 7.0];
+        xs.extend((0..5000).map(|_| rng.uniform_f32()));
+        xs.extend((0..5000).map(|_| f32::from_bits(rng.next_u32() & 0x7fff_ffff)));
+        for n in (0..63).map(|k| 1usize << k).chain([3, 255, 1000]) {
+            for &x in &xs {
+                let a = x * (n.min(1 << 20)) as f32;
+                assert_eq!(
+                    divide_by_count(a, n).to_bits(),
+                    (a / n as f32).to_bits(),
+                    "{a} / {n}"
+                );
+            }
+        }
+        // The unit domain's identities, as `offset_of` and `sample` use them.
+        for &x in xs.iter().filter(|x| !x.is_nan()) {
+            assert_eq!(((x - 0.0) / (1.0 - 0.0)).to_bits(), x.to_bits(), "{x}");
+            // (`sample`'s t = (o + du) / n is never -0: o + du adds to o ≥ +0.)
+            if x.is_sign_positive() {
+                assert_eq!((0.0 + x * (1.0 - 0.0)).to_bits(), x.to_bits(), "{x}");
             }
         }
     }

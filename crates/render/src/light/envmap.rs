@@ -30,6 +30,8 @@ pub struct EnvironmentMap {
     distribution: PiecewiseConstant2D,
     /// ∫ luminance dω over the sphere.
     luminance_integral: f32,
+    /// Half a texel in u, 0.5 / W: grid column i sits at u = (i + ½) / W.
+    half_texel: f32,
 }
 
 /// Why an environment map cannot be built.
@@ -116,6 +118,7 @@ impl EnvironmentMap {
             to_local: to_world.inverse(),
             distribution,
             luminance_integral: luminance_integral as f32,
+            half_texel: 0.5 / width as f32,
         })
     }
 
@@ -139,11 +142,6 @@ impl EnvironmentMap {
         Self::uv_to_direction(uv).0
     }
 
-    /// Half a texel in u: grid column i sits at u = (i + ½) / W.
-    fn half_texel(&self) -> f32 {
-        0.5 / self.width as f32
-    }
-
     /// (u, v) of a local direction.
     fn direction_to_uv(d: Vec3) -> Vec2 {
         let u = d.x.atan2(-d.z) / TAU;
@@ -163,7 +161,7 @@ impl EnvironmentMap {
     /// Grid coordinates (x in [0, W), y in [0, H - 1]) of (u, v).
     fn grid(&self, uv: Vec2) -> Vec2 {
         Vec2::new(
-            wrap_u(uv.x - self.half_texel()) * self.width as f32,
+            wrap_u(uv.x - self.half_texel) * self.width as f32,
             uv.y * (self.height - 1) as f32,
         )
     }
@@ -208,7 +206,7 @@ impl EnvironmentMap {
             return None;
         }
         // Cells start at grid column 0, half a texel into u.
-        let uv = Vec2::new(wrap_u(cell_uv.x + self.half_texel()), cell_uv.y);
+        let uv = Vec2::new(wrap_u(cell_uv.x + self.half_texel), cell_uv.y);
         let (d, sin_t) = Self::uv_to_direction(uv);
         if sin_t <= 0.0 {
             return None;
@@ -230,7 +228,7 @@ impl EnvironmentMap {
         if sin2 <= 0.0 {
             return 0.0;
         }
-        let cell_uv = Vec2::new(wrap_u(uv.x - self.half_texel()), uv.y);
+        let cell_uv = Vec2::new(wrap_u(uv.x - self.half_texel), uv.y);
         self.distribution.pdf(cell_uv) / (2.0 * PI * PI * sin2.sqrt())
     }
 }
