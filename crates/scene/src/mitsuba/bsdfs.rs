@@ -448,6 +448,8 @@ fn principled(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
     })))
 }
 
+/// Mitsuba's `twosided` around one BSDF: a diffuse one reflects on both sides, any other
+/// reflective one is the same material on its back as on its front.
 fn two_sided(m: MaterialDesc) -> MaterialDesc {
     match m {
         MaterialDesc::Diffuse { reflectance, .. } => MaterialDesc::Diffuse {
@@ -459,7 +461,16 @@ fn two_sided(m: MaterialDesc) -> MaterialDesc {
             scale,
             two_sided: true,
         },
-        other => other,
+        // Transmission has no back side to mirror (Mitsuba refuses it there).
+        m @ (MaterialDesc::Glass { .. }
+        | MaterialDesc::ThinGlass { .. }
+        | MaterialDesc::RoughGlass { .. }
+        | MaterialDesc::DiffuseTransmission { .. }) => m,
+        // The same material seen from behind as from the front.
+        other => MaterialDesc::TwoSided {
+            front: Box::new(other.clone()),
+            back: Box::new(other),
+        },
     }
 }
 
