@@ -2,6 +2,7 @@
 
 mod compare_cmd;
 mod converge_cmd;
+mod export_cmd;
 mod farm;
 mod flags;
 mod image_cmd;
@@ -33,6 +34,8 @@ enum Command {
     Converge(converge_cmd::ConvergeArgs),
     /// Show what a scene contains (shapes, materials, lights, camera, bounds, warnings).
     Info(info_cmd::InfoArgs),
+    /// Write a scene (any format pathlab reads) as Mitsuba 3 XML, its meshes as PLY beside it.
+    Export(export_cmd::ExportArgs),
     /// Draw samples from a distribution or warp and compare them with its exact pdf.
     Sample(sample::SampleArgs),
     /// Estimate an integral over a box by Monte Carlo, with its error.
@@ -61,6 +64,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => farm::run_merge(args),
         Command::View(args) => view_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
+        Command::Export(args) => export_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
         Command::Converge(args) => converge_cmd::run(args),
         Command::Sample(args) => sample::run(args),

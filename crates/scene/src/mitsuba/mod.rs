@@ -13,6 +13,7 @@
 
 mod bsdfs;
 mod emitters;
+pub mod export;
 pub mod ior;
 mod parse;
 mod sensors;
