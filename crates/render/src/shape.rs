@@ -6,6 +6,10 @@ use glam::{Vec2, Vec3};
 use pathlab_mc::warp::sample_uniform_sphere;
 use std::f32::consts::PI;
 
+/// Relative margin of squared distance within which a point counts as on a sphere (and is
+/// sampled by area rather than by cone: [`Sphere::sample_cone`]).
+const ON_SPHERE: f32 = 1e-3;
+
 /// A triangle's vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Triangle {
@@ -219,6 +223,68 @@ impl Sphere {
         SphereQuadratic { a, b, c, disc }
     }
 
+    /// The cone of directions in which the sphere is seen from `p`, outside it: its axis
+    /// (towards the centre, unit), sin² of its half-angle and 1 - cos of it (computed as
+    /// sin² / (1 + cos), accurate for small spheres far away, where 1 - cos would cancel).
+    /// `None` from inside or on the sphere, where it fills a hemisphere or more.
+    #[inline]
+    fn cone_from(&self, p: Vec3) -> Option<(Vec3, f32, f32)> {
+        let to_center = self.center - p;
+        let dist2 = to_center.length_squared();
+        let r2 = self.radius * self.radius;
+        // Points on the sphere (within rounding, with a wide margin) count as inside: there
+        // the cone is a hemisphere whose apex the sphere itself bends away from.
+        if dist2 <= r2 * (1.0 + ON_SPHERE) || !dist2.is_finite() {
+            return None;
+        }
+        let sin2_max = r2 / dist2;
+        let cos_max = (1.0 - sin2_max).sqrt();
+        Some((
+            to_center / dist2.sqrt(),
+            sin2_max,
+            sin2_max / (1.0 + cos_max),
+        ))
+    }
+
+    /// A point of the part of the sphere seen from `p`, whose direction from `p` is uniform
+    /// in the cone the sphere subtends there (pbrt-v4's and Mitsuba 3's sphere sampling): the
+    /// point and its outward normal, and the density per unit solid angle,
+    /// 1 / (2π (1 - cos θmax)). `None` from inside or on the sphere (sample the surface by area
+    /// there: [`Sphere::sample`]).
+    ///
+    /// cos θ is uniform in [cos θmax, 1] and φ in [0, 2π); the ray from `p` at angle θ from the
+    /// axis meets the sphere first at the point whose angle α from the axis, seen from the
+    /// centre towards `p`, has cos α = sin²θ / sin θmax + cos θ √(1 - sin²θ / sin²θmax). Every
+    /// quantity is written so as not to cancel when the cone is narrow (1 - cos θ as a
+    /// product, sin²θ as (1 - cos θ)(1 + cos θ)).
+    #[inline]
+    pub fn sample_cone(&self, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32)> {
+        let (axis, sin2_max, one_minus_cos_max) = self.cone_from(p)?;
+        let one_minus_cos = u.x * one_minus_cos_max;
+        let cos_theta = 1.0 - one_minus_cos;
+        let sin2_theta = one_minus_cos * (2.0 - one_minus_cos);
+        let cos_alpha = sin2_theta / sin2_max.sqrt()
+            + cos_theta * (1.0 - sin2_theta / sin2_max).max(0.0).sqrt();
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (std::f32::consts::TAU * u.y).sin_cos();
+        let (t, b) = pathlab_mc::warp::coordinate_system(axis);
+        // The normal points back along the axis, tilted by α.
+        let n = (-cos_alpha * axis + sin_alpha * (cos_phi * t + sin_phi * b)).normalize();
+        Some((
+            self.center + self.radius * n,
+            n,
+            1.0 / (std::f32::consts::TAU * one_minus_cos_max),
+        ))
+    }
+
+    /// The density per unit solid angle of [`Sphere::sample_cone`] from `p` (the same for
+    /// every direction of the cone), or `None` from inside or on the sphere.
+    #[inline]
+    pub fn cone_pdf(&self, p: Vec3) -> Option<f32> {
+        let (_, _, one_minus_cos_max) = self.cone_from(p)?;
+        Some(1.0 / (std::f32::consts::TAU * one_minus_cos_max))
+    }
+
     /// A point uniform over the surface.
     pub fn sample(&self, u: Vec2) -> ShapeSample {
         let n = sample_uniform_sphere(u);
@@ -233,6 +299,84 @@ impl Sphere {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Angle between unit-ish vectors `a` and `b`, accurate for small angles (`f64`).
+    fn angle(a: Vec3, b: Vec3) -> f64 {
+        let (a, b) = (a.as_dvec3().normalize(), b.as_dvec3().normalize());
+        a.cross(b).length().atan2(a.dot(b))
+    }
+
+    /// Directions of [`Sphere::sample_cone`] against its density: uniform in the cone, i.e.
+    /// (1 - cos θ) / (1 - cos θmax) and φ / 2π uniform on the unit square (a chi-square test),
+    /// for a large sphere close by and a small one far away (where 1 - cos θmax is 1e-5).
+    /// Every point lies on the sphere, faces the reference point, and is what a ray from the
+    /// reference point towards it meets first.
+    #[test]
+    fn cone_samples_are_uniform_in_the_solid_angle_the_sphere_subtends() {
+        use pathlab_mc::rng::Pcg32;
+        use pathlab_mc::stats::chi2_test_2d;
+        let mut rng = Pcg32::new(8, 3);
+        for (center, radius) in [
+            (Vec3::new(0.3, -0.2, 1.5), 1.2f32),
+            (Vec3::new(7.0, 6.0, -2.0), 0.05),
+        ] {
+            let sphere = Sphere { center, radius };
+            let p = Vec3::new(0.1, 0.2, -0.3);
+            let axis = center - p;
+            let sin_max = radius as f64 / axis.as_dvec3().length();
+            let one_minus_cos_max = 1.0 - (1.0 - sin_max * sin_max).sqrt();
+            let pdf = sphere.cone_pdf(p).expect("outside");
+            let expected = 1.0 / (std::f64::consts::TAU * one_minus_cos_max);
+            assert!((pdf as f64 - expected).abs() <= 1e-5 * expected);
+            let (t, _) = pathlab_mc::warp::coordinate_system(axis.normalize());
+            let n = 100_000;
+            let mut points = Vec::with_capacity(n);
+            for _ in 0..n {
+                let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+                let (point, normal, cone_pdf) = sphere.sample_cone(p, u).expect("outside");
+                assert_eq!(cone_pdf, pdf);
+                let s = ShapeSample {
+                    p: point,
+                    n: normal,
+                    pdf_area: 0.0,
+                };
+                assert!(((s.p - center).length() - radius).abs() <= 1e-5 * radius.max(1.0));
+                let to_p = p - s.p;
+                assert!(s.n.dot(to_p) >= -1e-4 * to_p.length(), "{s:?}");
+                let d = (s.p - p).normalize();
+                let hit = sphere.intersect(&Ray::new(p, d)).expect("the ray meets it");
+                assert!(
+                    (p + d * hit - s.p).length() <= 1e-4 * (1.0 + radius),
+                    "{s:?}"
+                );
+                let theta = angle(d, axis);
+                let one_minus_cos = 2.0 * (theta * 0.5).sin().powi(2);
+                // φ about the axis, from the frame's first tangent.
+                let perp = d.as_dvec3()
+                    - d.as_dvec3().dot(axis.as_dvec3().normalize()) * axis.as_dvec3().normalize();
+                let phi =
+                    angle(t, perp.as_vec3()).copysign(t.cross(perp.as_vec3()).dot(axis) as f64);
+                let phi = phi.rem_euclid(std::f64::consts::TAU);
+                points.push([
+                    one_minus_cos / one_minus_cos_max,
+                    phi / std::f64::consts::TAU,
+                ]);
+            }
+            let test = chi2_test_2d(points, |_, _| 1.0, [[0.0, 1.0], [0.0, 1.0]], [16, 16]);
+            assert!(test.passes(1e-3), "radius {radius}: {test:?}");
+        }
+        // Inside or on it: no cone.
+        let sphere = Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        };
+        assert!(sphere
+            .sample_cone(Vec3::new(0.5, 0.0, 0.0), Vec2::splat(0.5))
+            .is_none());
+        assert!(sphere.cone_pdf(Vec3::X).is_none());
+        assert!(sphere.cone_pdf(Vec3::X * 1.0001).is_none());
+        assert!(sphere.cone_pdf(Vec3::X * 1.01).is_some());
+    }
 
     #[test]
     fn triangle_hits_inside_and_misses_outside() {
