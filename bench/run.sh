@@ -10,6 +10,7 @@
 #   bench/run.sh render     # Mitsuba, the Cornell box in detail
 #   bench/run.sh scenes     # Mitsuba, every reference scene (speed and equal-time error)
 #   bench/run.sh suite      # Mitsuba, the scenes of Mitsuba's own test suite (the same)
+#   bench/run.sh pbrt       # Mitsuba, Bitterli's pbrt-v4 scenes written as Mitsuba XML (the same)
 #   bench/run.sh python     # the Python module against the command line, same render
 #
 # Results go to target/bench/ (JSON per measurement) and a table on stdout.
@@ -94,6 +95,13 @@ if [ "$what" = all ] || [ "$what" = suite ]; then
         --pathlab "$pathlab" --suite "$root/tests/data/mitsuba-suite/tests/scenes" \
         --work "$work/suite" --spp "${PATHLAB_BENCH_SUITE_SPP:-1024}" \
         --reps "${PATHLAB_BENCH_REPS:-3}"
+fi
+
+if [ "$what" = all ] || [ "$what" = pbrt ]; then
+    mitsuba_venv
+    DRJIT_LIBLLVM_PATH="$llvm" "$venv/bin/python" "$root/bench/pbrt_scenes.py" \
+        --pathlab "$pathlab" --data "$root/tests/data" --work "$work/pbrt" \
+        --spp "${PATHLAB_BENCH_SPP:-256}" --reps "${PATHLAB_BENCH_REPS:-3}"
 fi
 
 if [ "$what" = all ] || [ "$what" = python ]; then
