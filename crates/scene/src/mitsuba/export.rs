@@ -156,6 +156,34 @@ impl Writer {
         self.line(depth, &format!(r#"<float name="{name}" value="{v}"/>"#));
     }
 
+    /// `<TAG name="NAME" x=".." y=".." z=".."/>`, for `(TAG, NAME, v)`.
+    fn xyz(&mut self, depth: usize, (tag, name, v): (&str, &str, glam::Vec3)) {
+        self.line(
+            depth,
+            &format!(
+                r#"<{tag} name="{name}" x="{}" y="{}" z="{}"/>"#,
+                v.x, v.y, v.z
+            ),
+        );
+    }
+
+    /// An `<emitter>` of `kind` placed by `at` (a point or a direction, see [`Writer::xyz`]),
+    /// whose colour property `name` is `value`.
+    fn emitter(
+        &mut self,
+        kind: &str,
+        at: Option<(&str, &str, glam::Vec3)>,
+        name: &str,
+        value: Rgb,
+    ) {
+        self.line(1, &format!(r#"<emitter type="{kind}">"#));
+        if let Some(at) = at {
+            self.xyz(2, at);
+        }
+        self.rgb(2, name, value);
+        self.line(1, "</emitter>");
+    }
+
     fn integrator(&mut self, desc: &SceneDesc) {
         let h = &desc.hints;
         let kind = match h.integrator {
@@ -366,6 +394,46 @@ impl Writer {
         );
     }
 
+    /// A conductor's `<bsdf>` opening and properties (`open` gives its opening tag): smooth
+    /// where both roughnesses are 0, else rough (one α or α along u and v).
+    #[allow(clippy::too_many_arguments)]
+    fn conductor(
+        &mut self,
+        open: &dyn Fn(&str) -> String,
+        d: usize,
+        (alpha_u, alpha_v): (f32, f32),
+        distribution: NormalDistribution,
+        eta: Rgb,
+        k: Rgb,
+        specular: Option<Rgb>,
+    ) {
+        if alpha_u > 0.0 || alpha_v > 0.0 {
+            self.line(d - 1, &open("roughconductor"));
+            self.distribution(d, distribution);
+            if alpha_u == alpha_v {
+                self.float(d, "alpha", alpha_u);
+            } else {
+                self.float(d, "alpha_u", alpha_u);
+                self.float(d, "alpha_v", alpha_v);
+            }
+        } else {
+            self.line(d - 1, &open("conductor"));
+        }
+        self.rgb(d, "eta", eta);
+        self.rgb(d, "k", k);
+        if let Some(s) = specular {
+            self.rgb(d, "specular_reflectance", s);
+        }
+    }
+
+    /// A dielectric interface's index (inside relative to outside, outside 1) and scales.
+    fn interface(&mut self, d: usize, ior: f32, reflectance: Rgb, transmittance: Rgb) {
+        self.float(d, "int_ior", ior);
+        self.float(d, "ext_ior", 1.0);
+        self.rgb(d, "specular_reflectance", reflectance);
+        self.rgb(d, "specular_transmittance", transmittance);
+    }
+
     /// `<bsdf>` of material `m` (with `id` where given), at indentation `depth`.
     fn material(
         &mut self,
@@ -407,17 +475,7 @@ impl Writer {
                 eta,
                 k,
                 distribution,
-            } => {
-                if *alpha > 0.0 {
-                    self.line(depth, &open("roughconductor"));
-                    self.distribution(d, *distribution);
-                    self.float(d, "alpha", *alpha);
-                } else {
-                    self.line(depth, &open("conductor"));
-                }
-                self.rgb(d, "eta", *eta);
-                self.rgb(d, "k", *k);
-            }
+            } => self.conductor(&open, d, (*alpha, *alpha), *distribution, *eta, *k, None),
             MaterialDesc::RoughConductor {
                 alpha_u,
                 alpha_v,
@@ -426,26 +484,12 @@ impl Writer {
                 specular,
                 distribution,
             } => {
-                let (au, av) = (
+                let alphas = (
                     Self::constant(alpha_u, "roughness")?.x,
                     Self::constant(alpha_v, "roughness")?.x,
                 );
-                if au > 0.0 || av > 0.0 {
-                    self.line(depth, &open("roughconductor"));
-                    self.distribution(d, *distribution);
-                    if au == av {
-                        self.float(d, "alpha", au);
-                    } else {
-                        self.float(d, "alpha_u", au);
-                        self.float(d, "alpha_v", av);
-                    }
-                } else {
-                    self.line(depth, &open("conductor"));
-                }
-                self.rgb(d, "eta", *eta);
-                self.rgb(d, "k", *k);
-                let s = Self::constant(specular, "specular reflectance")?;
-                self.rgb(d, "specular_reflectance", s);
+                let specular = Self::constant(specular, "specular reflectance")?;
+                self.conductor(&open, d, alphas, *distribution, *eta, *k, Some(specular));
             }
             MaterialDesc::Glass {
                 reflectance,
@@ -465,10 +509,7 @@ impl Writer {
                 } else {
                     self.line(depth, &open("dielectric"));
                 }
-                self.float(d, "int_ior", *ior);
-                self.float(d, "ext_ior", 1.0);
-                self.rgb(d, "specular_reflectance", *reflectance);
-                self.rgb(d, "specular_transmittance", *transmittance);
+                self.interface(d, *ior, *reflectance, *transmittance);
             }
             MaterialDesc::ThinGlass {
                 reflectance,
@@ -476,10 +517,7 @@ impl Writer {
                 ior,
             } => {
                 self.line(depth, &open("thindielectric"));
-                self.float(d, "int_ior", *ior);
-                self.float(d, "ext_ior", 1.0);
-                self.rgb(d, "specular_reflectance", *reflectance);
-                self.rgb(d, "specular_transmittance", *transmittance);
+                self.interface(d, *ior, *reflectance, *transmittance);
             }
             MaterialDesc::Plastic {
                 diffuse,
@@ -592,13 +630,7 @@ impl Writer {
                 return unsupported(format!("{what}: material {} does not exist", s.material));
             }
             self.line(1, r#"<shape type="sphere">"#);
-            self.line(
-                2,
-                &format!(
-                    r#"<point name="center" x="{}" y="{}" z="{}"/>"#,
-                    s.center.x, s.center.y, s.center.z
-                ),
-            );
+            self.xyz(2, ("point", "center", s.center));
             self.float(2, "radius", s.radius);
             self.line(2, &format!(r#"<ref id="mat{}"/>"#, s.material));
             self.area_emitter(s.emission.as_ref(), s.emission_texture.is_some(), &what)?;
@@ -621,33 +653,15 @@ impl Writer {
             if p.attenuation != INVERSE_SQUARE {
                 return unsupported("a point light whose falloff is not the inverse square");
             }
-            self.line(1, r#"<emitter type="point">"#);
-            self.line(
-                2,
-                &format!(
-                    r#"<point name="position" x="{}" y="{}" z="{}"/>"#,
-                    p.position.x, p.position.y, p.position.z
-                ),
-            );
-            self.rgb(2, "intensity", p.intensity);
-            self.line(1, "</emitter>");
+            let at = ("point", "position", p.position);
+            self.emitter("point", Some(at), "intensity", p.intensity);
         }
         for l in &desc.directional_lights {
-            self.line(1, r#"<emitter type="directional">"#);
-            self.line(
-                2,
-                &format!(
-                    r#"<vector name="direction" x="{}" y="{}" z="{}"/>"#,
-                    l.direction.x, l.direction.y, l.direction.z
-                ),
-            );
-            self.rgb(2, "irradiance", l.irradiance);
-            self.line(1, "</emitter>");
+            let along = ("vector", "direction", l.direction);
+            self.emitter("directional", Some(along), "irradiance", l.irradiance);
         }
         if let Some(radiance) = desc.environment {
-            self.line(1, r#"<emitter type="constant">"#);
-            self.rgb(2, "radiance", radiance);
-            self.line(1, "</emitter>");
+            self.emitter("constant", None, "radiance", radiance);
         }
         Ok(())
     }
