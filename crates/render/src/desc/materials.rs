@@ -364,6 +364,15 @@ pub enum MaterialDesc {
 }
 
 impl MaterialDesc {
+    /// `m` on the front and, seen as its front, on the back: a material that reflects alike
+    /// from both sides.
+    pub fn on_both_sides(m: MaterialDesc) -> MaterialDesc {
+        MaterialDesc::TwoSided {
+            front: Box::new(m.clone()),
+            back: Box::new(m),
+        }
+    }
+
     /// The kind of material, for summaries.
     pub fn kind(&self) -> &'static str {
         match self {

@@ -467,10 +467,7 @@ fn two_sided(m: MaterialDesc) -> MaterialDesc {
         | MaterialDesc::RoughGlass { .. }
         | MaterialDesc::DiffuseTransmission { .. }) => m,
         // The same material seen from behind as from the front.
-        other => MaterialDesc::TwoSided {
-            front: Box::new(other.clone()),
-            back: Box::new(other),
-        },
+        other => MaterialDesc::on_both_sides(other),
     }
 }
 

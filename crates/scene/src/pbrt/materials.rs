@@ -311,7 +311,8 @@ impl Builder {
         let roughness = self.surface_roughness(params)?;
         let (eta, k) = self.conductor_optics(params, "eta", "k")?;
         let distribution = NormalDistribution::Ggx;
-        Ok(two_sided(match roughness {
+        // pbrt-v4's materials are two-sided.
+        Ok(MaterialDesc::on_both_sides(match roughness {
             Roughness::Isotropic(alpha) => MaterialDesc::Conductor {
                 alpha,
                 eta,
@@ -526,13 +527,5 @@ impl Builder {
                 two_sided: true,
             },
         })
-    }
-}
-
-/// A material with the same BSDF on both sides (pbrt-v4's materials are two-sided).
-fn two_sided(m: MaterialDesc) -> MaterialDesc {
-    MaterialDesc::TwoSided {
-        front: Box::new(m.clone()),
-        back: Box::new(m),
     }
 }
