@@ -432,6 +432,23 @@ fn what_mitsuba_cannot_express_is_an_error_naming_it() {
 }
 
 #[test]
+fn a_mesh_shaded_by_its_faces_stays_so() {
+    // Normals that are not one per vertex: the renderer shades with face normals, and so
+    // does the written mesh (where Mitsuba would otherwise make smooth ones).
+    let mut desc = everything();
+    desc.meshes[0].normals = vec![Vec3::Y; 3];
+    let scene = to_mitsuba(&desc, "meshes").expect("written");
+    let first_shape = scene.xml.split("<shape").nth(1).expect("a shape");
+    assert!(first_shape.contains("face_normals"), "{first_shape}");
+    let dir = scratch("face-normals");
+    let xml = dir.join("scene.xml");
+    write_mitsuba(&desc, &xml).expect("written");
+    let back = pathlab_scene::load(xml.to_str().expect("a UTF-8 path")).expect("read back");
+    assert!(back.meshes[0].normals.is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn approximations_are_warned_of() {
     let mut desc = everything();
     desc.filter = PixelFilter::Gaussian {

@@ -78,7 +78,7 @@ pub fn to_mitsuba(desc: &SceneDesc, mesh_folder: &str) -> Result<MitsubaScene, E
     for (i, mesh) in desc.meshes.iter().enumerate() {
         w.mesh(desc, i, mesh, mesh_folder)?;
     }
-    w.spheres(desc)?;
+    w.other_shapes(desc)?;
     w.lights(desc)?;
     w.line(0, "</scene>");
     Ok(MitsubaScene {
@@ -156,6 +156,10 @@ impl Writer {
         self.line(depth, &format!(r#"<float name="{name}" value="{v}"/>"#));
     }
 
+    fn integer(&mut self, depth: usize, name: &str, v: impl std::fmt::Display) {
+        self.line(depth, &format!(r#"<integer name="{name}" value="{v}"/>"#));
+    }
+
     /// `<TAG name="NAME" x=".." y=".." z=".."/>`, for `(TAG, NAME, v)`.
     fn xyz(&mut self, depth: usize, (tag, name, v): (&str, &str, glam::Vec3)) {
         self.line(
@@ -186,45 +190,31 @@ impl Writer {
 
     fn integrator(&mut self, desc: &SceneDesc) {
         let h = &desc.hints;
-        let kind = match h.integrator {
-            None | Some(IntegratorHint::Path) => "path".to_string(),
+        match h.integrator {
             Some(IntegratorHint::Direct {
                 emitter_samples,
                 bsdf_samples,
             }) => {
                 self.line(1, r#"<integrator type="direct">"#);
-                self.line(
-                    2,
-                    &format!(r#"<integer name="emitter_samples" value="{emitter_samples}"/>"#),
-                );
-                self.line(
-                    2,
-                    &format!(r#"<integer name="bsdf_samples" value="{bsdf_samples}"/>"#),
-                );
-                if h.hide_emitters {
-                    self.line(2, r#"<boolean name="hide_emitters" value="true"/>"#);
+                self.integer(2, "emitter_samples", emitter_samples);
+                self.integer(2, "bsdf_samples", bsdf_samples);
+            }
+            other => {
+                if other == Some(IntegratorHint::Bdpt) {
+                    self.warnings.push(
+                        "Mitsuba 3 has no bidirectional path tracer: the scene names the path \
+                         tracer instead (same image, other noise)"
+                            .into(),
+                    );
                 }
-                self.line(1, "</integrator>");
-                return;
+                self.line(1, r#"<integrator type="path">"#);
+                if h.max_depth.is_some() {
+                    self.integer(2, "max_depth", "$max_depth");
+                }
+                if let Some(d) = h.rr_depth {
+                    self.integer(2, "rr_depth", i64::from(d) + 1);
+                }
             }
-            Some(IntegratorHint::Bdpt) => {
-                self.warnings.push(
-                    "Mitsuba 3 has no bidirectional path tracer: the scene names the path \
-                     tracer instead (same image, other noise)"
-                        .into(),
-                );
-                "path".to_string()
-            }
-        };
-        self.line(1, &format!(r#"<integrator type="{kind}">"#));
-        if h.max_depth.is_some() {
-            self.line(2, r#"<integer name="max_depth" value="$max_depth"/>"#);
-        }
-        if let Some(d) = h.rr_depth {
-            self.line(
-                2,
-                &format!(r#"<integer name="rr_depth" value="{}"/>"#, i64::from(d) + 1),
-            );
         }
         if h.hide_emitters {
             self.line(2, r#"<boolean name="hide_emitters" value="true"/>"#);
@@ -240,12 +230,12 @@ impl Writer {
         let [width, height] = desc.resolution;
         let (fov, axis) = match c.focal_pixels {
             // The course's cameras: the image plane `f` pixels away, so the vertical field
-            // of view follows from the height.
-            Some(f) => (
+            // of view follows from the height (where `f` is usable, as the camera takes it).
+            Some(f) if f > 0.0 && f.is_finite() => (
                 2.0 * (height as f32 * 0.5 / f).atan().to_degrees(),
                 FovAxis::Y,
             ),
-            None => (c.fov_degrees, c.fov_axis),
+            _ => (c.fov_degrees, c.fov_axis),
         };
         let axis = match axis {
             FovAxis::X => "x",
@@ -306,11 +296,11 @@ impl Writer {
             SamplerKind::Sobol => "ldsampler",
         };
         self.line(2, &format!(r#"<sampler type="{sampler}">"#));
-        self.line(3, r#"<integer name="sample_count" value="$spp"/>"#);
+        self.integer(3, "sample_count", "$spp");
         self.line(2, "</sampler>");
         self.line(2, r#"<film type="hdrfilm">"#);
-        self.line(3, &format!(r#"<integer name="width" value="{width}"/>"#));
-        self.line(3, &format!(r#"<integer name="height" value="{height}"/>"#));
+        self.integer(3, "width", width);
+        self.integer(3, "height", height);
         self.line(3, r#"<string name="pixel_format" value="rgb"/>"#);
         if let Some(crop) = h.crop.and_then(|c| c.window_for(desc.resolution)) {
             let [x0, y0, x1, y1] = crop;
@@ -320,7 +310,7 @@ impl Writer {
                 ("crop_width", x1 - x0),
                 ("crop_height", y1 - y0),
             ] {
-                self.line(3, &format!(r#"<integer name="{name}" value="{v}"/>"#));
+                self.integer(3, name, v);
             }
         }
         self.filter(desc.filter);
@@ -368,10 +358,7 @@ impl Writer {
                     ));
                 }
                 self.line(3, r#"<rfilter type="lanczos">"#);
-                self.line(
-                    4,
-                    &format!(r#"<integer name="lobes" value="{}"/>"#, tau.round() as i64),
-                );
+                self.integer(4, "lobes", tau.round() as i64);
                 self.line(3, "</rfilter>");
             }
         }
@@ -426,12 +413,29 @@ impl Writer {
         }
     }
 
-    /// A dielectric interface's index (inside relative to outside, outside 1) and scales.
-    fn interface(&mut self, d: usize, ior: f32, reflectance: Rgb, transmittance: Rgb) {
+    /// An index of refraction inside relative to outside, as Mitsuba's pair (outside 1).
+    fn ior(&mut self, d: usize, ior: f32) {
         self.float(d, "int_ior", ior);
         self.float(d, "ext_ior", 1.0);
+    }
+
+    /// A dielectric interface's index and scales.
+    fn interface(&mut self, d: usize, ior: f32, reflectance: Rgb, transmittance: Rgb) {
+        self.ior(d, ior);
         self.rgb(d, "specular_reflectance", reflectance);
         self.rgb(d, "specular_transmittance", transmittance);
+    }
+
+    /// What a plastic and a rough plastic share: the base, the coat's scale and index, and
+    /// whether internal reflections tint.
+    fn plastic(&mut self, d: usize, diffuse: Rgb, specular: Rgb, ior: f32, nonlinear: bool) {
+        self.rgb(d, "diffuse_reflectance", diffuse);
+        self.rgb(d, "specular_reflectance", specular);
+        self.ior(d, ior);
+        self.line(
+            d,
+            &format!(r#"<boolean name="nonlinear" value="{nonlinear}"/>"#),
+        );
     }
 
     /// `<bsdf>` of material `m` (with `id` where given), at indentation `depth`.
@@ -526,14 +530,7 @@ impl Writer {
                 nonlinear,
             } => {
                 self.line(depth, &open("plastic"));
-                self.rgb(d, "diffuse_reflectance", *diffuse);
-                self.rgb(d, "specular_reflectance", *specular);
-                self.float(d, "int_ior", *ior);
-                self.float(d, "ext_ior", 1.0);
-                self.line(
-                    d,
-                    &format!(r#"<boolean name="nonlinear" value="{nonlinear}"/>"#),
-                );
+                self.plastic(d, *diffuse, *specular, *ior, *nonlinear);
             }
             MaterialDesc::RoughPlastic {
                 diffuse,
@@ -547,14 +544,7 @@ impl Writer {
                 self.distribution(d, *distribution);
                 self.float(d, "alpha", *alpha);
                 let diffuse = Self::constant(diffuse, "plastic base")?;
-                self.rgb(d, "diffuse_reflectance", diffuse);
-                self.rgb(d, "specular_reflectance", *specular);
-                self.float(d, "int_ior", *ior);
-                self.float(d, "ext_ior", 1.0);
-                self.line(
-                    d,
-                    &format!(r#"<boolean name="nonlinear" value="{nonlinear}"/>"#),
-                );
+                self.plastic(d, diffuse, *specular, *ior, *nonlinear);
             }
             MaterialDesc::TwoSided { front, back } => {
                 self.line(depth, &open("twosided"));
@@ -603,17 +593,14 @@ impl Writer {
         if !(mesh.visibility.camera && mesh.visibility.indirect) {
             return unsupported(format!("{what}: a shape some rays do not see"));
         }
-        if mesh.material >= desc.materials.len() {
-            return unsupported(format!("{what}: material {} does not exist", mesh.material));
-        }
         let name = format!("{folder}/mesh{index:04}.ply");
         self.meshes.push((name.clone(), ply(mesh)));
         self.line(1, r#"<shape type="ply">"#);
         self.line(2, &format!(r#"<string name="filename" value="{name}"/>"#));
-        if mesh.normals.is_empty() {
+        if !has_vertex_normals(mesh) {
             self.line(2, r#"<boolean name="face_normals" value="true"/>"#);
         }
-        self.line(2, &format!(r#"<ref id="mat{}"/>"#, mesh.material));
+        self.material_ref(desc, mesh.material, &what)?;
         self.area_emitter(
             mesh.emission.as_ref(),
             mesh.emission_texture.is_some(),
@@ -623,16 +610,32 @@ impl Writer {
         Ok(())
     }
 
-    fn spheres(&mut self, desc: &SceneDesc) -> Result<(), ExportError> {
+    /// A shape's reference to material `index` of `desc` (an error naming shape `what` where
+    /// there is no such material).
+    fn material_ref(
+        &mut self,
+        desc: &SceneDesc,
+        index: usize,
+        what: &str,
+    ) -> Result<(), ExportError> {
+        if index >= desc.materials.len() {
+            return unsupported(format!("{what}: material {index} does not exist"));
+        }
+        self.line(2, &format!(r#"<ref id="mat{index}"/>"#));
+        Ok(())
+    }
+
+    /// The shapes besides meshes: spheres (signed distance grids are not written).
+    fn other_shapes(&mut self, desc: &SceneDesc) -> Result<(), ExportError> {
+        if !desc.sdf_grids.is_empty() {
+            return unsupported("a signed distance grid");
+        }
         for (i, s) in desc.spheres.iter().enumerate() {
             let what = format!("sphere {i}");
-            if s.material >= desc.materials.len() {
-                return unsupported(format!("{what}: material {} does not exist", s.material));
-            }
             self.line(1, r#"<shape type="sphere">"#);
             self.xyz(2, ("point", "center", s.center));
             self.float(2, "radius", s.radius);
-            self.line(2, &format!(r#"<ref id="mat{}"/>"#, s.material));
+            self.material_ref(desc, s.material, &what)?;
             self.area_emitter(s.emission.as_ref(), s.emission_texture.is_some(), &what)?;
             self.line(1, "</shape>");
         }
@@ -640,9 +643,6 @@ impl Writer {
     }
 
     fn lights(&mut self, desc: &SceneDesc) -> Result<(), ExportError> {
-        if !desc.sdf_grids.is_empty() {
-            return unsupported("a signed distance grid");
-        }
         if !desc.spot_lights.is_empty() || !desc.projectors.is_empty() {
             return unsupported("a spot light or projector");
         }
@@ -667,12 +667,18 @@ impl Writer {
     }
 }
 
+/// Whether the mesh's shading normals are its vertex normals: one per vertex, as the renderer
+/// takes them (otherwise it shades with face normals).
+fn has_vertex_normals(mesh: &MeshDesc) -> bool {
+    !mesh.positions.is_empty() && mesh.normals.len() == mesh.positions.len()
+}
+
 /// A mesh as binary little-endian PLY: positions, normals and texture coordinates where it has
 /// them (v flipped: pathlab's v runs the other way from a PLY file's, see the loader), and its
 /// triangles.
 fn ply(mesh: &MeshDesc) -> Vec<u8> {
     let n = mesh.positions.len();
-    let normals = mesh.normals.len() == n && n > 0;
+    let normals = has_vertex_normals(mesh);
     let uvs = mesh.uvs.len() == n && n > 0;
     let mut header = format!(
         "ply\nformat binary_little_endian 1.0\ncomment written by pathlab\nelement vertex {n}\n\
