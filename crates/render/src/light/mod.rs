@@ -23,7 +23,6 @@ pub use sampler::LightSampler;
 use crate::color::luminance;
 use crate::desc::Rgb;
 use crate::geometry::Aabb;
-use crate::shape::ShapeSample;
 use crate::texture::{Tex, TexPoint};
 use envmap::EnvironmentMap;
 use glam::{Vec2, Vec3};
@@ -185,7 +184,7 @@ impl Light {
         p: Vec3,
         u: Vec2,
     ) -> Option<LightLiSample> {
-        let (s, cone_pdf) = match shape {
+        let sph = match shape {
             AreaShape::Triangle(t) => {
                 let s = t.emitter(radiance, two_sided).sample_li(p, u.x, u.y);
                 if s.dist2 == 0.0 || s.abs_cos_light == 0.0 {
@@ -207,37 +206,35 @@ impl Light {
                     is_delta: false,
                 });
             }
-            // From outside, uniform in the cone the sphere subtends (its density per unit
-            // solid angle comes with it); from inside, uniform over its area.
-            AreaShape::Sphere(sph) => match sph.sample_cone(p, u) {
-                Some((p_light, n, pdf)) => (
-                    ShapeSample {
-                        p: p_light,
-                        n,
-                        pdf_area: 0.0,
-                    },
-                    Some(pdf),
-                ),
-                None => (sph.sample(u), None),
-            },
+            AreaShape::Sphere(sph) => sph,
         };
-        let to_light = s.p - p;
+        // From outside, uniform in the cone the sphere subtends (its density per unit solid
+        // angle comes with it); from inside, uniform over its area.
+        let (p_light, n, cone_pdf) = match sph.sample_cone(p, u) {
+            Some((p_light, n, pdf)) => (p_light, n, Some(pdf)),
+            None => {
+                let s = sph.sample(u);
+                (s.p, s.n, None)
+            }
+        };
+        let to_light = p_light - p;
         let dist2 = to_light.length_squared();
         if dist2 == 0.0 {
             return None;
         }
         let wi = to_light / dist2.sqrt();
-        let cos_l = s.n.dot(-wi).abs();
+        let cos_l = n.dot(-wi).abs();
         if cos_l == 0.0 {
             return None;
         }
-        let pdf = cone_pdf.unwrap_or(s.pdf_area * dist2 / cos_l);
+        // (By area: the uniform density 1 / area per unit area, as `Sphere::sample` gives it.)
+        let pdf = cone_pdf.unwrap_or_else(|| 1.0 / sph.area() * dist2 / cos_l);
         let li = match texture {
-            None => self.le(s.n, -wi, Vec2::ZERO),
+            None => self.le(n, -wi, Vec2::ZERO),
             Some(t) => {
-                let c = s.n.dot(-wi);
+                let c = n.dot(-wi);
                 if c > 0.0 || (two_sided && c < 0.0) {
-                    radiance * t.tex.eval(&TexPoint::uv(t.uv(&shape, s.p, [0.0; 3])))
+                    radiance * t.tex.eval(&TexPoint::uv(t.uv(&shape, p_light, [0.0; 3])))
                 } else {
                     Rgb::ZERO
                 }
@@ -247,8 +244,8 @@ impl Light {
             li,
             wi,
             pdf,
-            p_light: s.p,
-            n_light: Some(s.n),
+            p_light,
+            n_light: Some(n),
             is_delta: false,
         })
     }
