@@ -86,8 +86,9 @@ def unwrapped(integrator):
     return mi.load_dict(settings), f"{name}{ {k: v for k, v in settings.items() if k != 'type'} }"
 
 
-def compare(reps, spp, pixels, ref, mitsuba, pathlab):
-    """One scene measured both ways, as bench/scenes.py and bench/suite.py report it.
+def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None):
+    """One scene measured both ways, as bench/scenes.py, bench/suite.py and
+    bench/pbrt_scenes.py report it.
 
     Speed: `reps` renders at `spp` by each renderer, taking turns (`mitsuba(rep)` gives
     (seconds, image); `pathlab(flags, kind)` gives (its JSON statistics, image), pathlab with
@@ -97,11 +98,15 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab):
     render as long as the speed runs (`spp`): a short probe counts the start of a render
     (threads, film) against too few samples and would leave part of the budget unused.
     Errors are RMSE against `ref`, medians over the repetitions on each side: a scene's error
-    is heavy-tailed (a few bright pixels), so one image's RMSE says little."""
+    is heavy-tailed (a few bright pixels), so one image's RMSE says little. Where the scene's
+    own settings differ from the speed runs' (`mitsuba_settings(rep)`, rendering them, as
+    `mitsuba` does), Mitsuba's budget and error come from renders at those settings."""
     rates_m, rates_p, times_m, errs_m = [], [], [], []
     for rep in range(reps):
         t_m, img_m = mitsuba(rep)
         rates_m.append(pixels * spp / t_m)
+        if mitsuba_settings is not None:
+            t_m, img_m = mitsuba_settings(rep)
         times_m.append(t_m)
         errs_m.append(rmse(img_m, ref))
         stats, _ = pathlab(["-s", str(spp), "--sampler", "independent"], "speed")

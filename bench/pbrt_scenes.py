@@ -44,10 +44,6 @@ def export(pbrt, xml, w, h):
                    check=True, capture_output=True, text=True)
 
 
-def pathlab(scene, flags, out):
-    return mitsuba_runs.pathlab_render(args.pathlab, scene, flags, out)
-
-
 print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; pathlab on all threads; {args.spp} spp;"
       f" rates are medians of {args.reps} runs taken in turns")
 print(f"{'scene':<12} {'Mitsuba S/s':>12} {'pathlab S/s':>12} {'ratio':>6}   {'Mitsuba RMSE':>12}"
@@ -70,40 +66,20 @@ for name, w, h in CASES:
         np.save(ref_path, ref)
     ref = np.load(ref_path).astype(np.float64)[..., :3]
 
-    rates_m, rates_p = [], []
-    for rep in range(args.reps):
-        t, _, _ = mitsuba_runs.timed(variant, independent, "-", args.spp, {}, rep)
-        rates_m.append(pixels * args.spp / t)
-        stats, _ = pathlab(pbrt, ["-r", str(w), str(h), "-s", str(args.spp), "--sampler",
-                                  "independent", "--integrator", "path"],
-                           f"{args.work}/speed-{name}.exr")
-        rates_p.append(stats["samples_per_second"])
-    times_m, errs_m = [], []
-    for rep in range(args.reps):
-        t, img, _ = mitsuba_runs.timed(variant, xml, "-", args.spp, {}, rep)
-        times_m.append(t)
-        errs_m.append(mitsuba_runs.rmse(img, ref))
-    t_m = float(np.median(times_m))
-    probe, _ = pathlab(pbrt, ["-r", str(w), str(h), "-s", str(args.spp)],
-                       f"{args.work}/probe-{name}.exr")
-    spp_p = max(1, int(t_m * probe["samples_per_second"] / pixels))
-    errs_p, secs_p = [], []
-    for rep in range(args.reps):
-        stats, img = pathlab(pbrt, ["-r", str(w), str(h), "-s", str(spp_p), "--seed",
-                                    str(rep + 1)], f"{args.work}/equal-time-{name}.exr")
-        errs_p.append(mitsuba_runs.rmse(img, ref))
-        secs_p.append(stats["seconds"])
-    c = {
-        "mitsuba_rate": float(np.median(rates_m)), "pathlab_rate": float(np.median(rates_p)),
-        "mitsuba_runs": rates_m, "pathlab_runs": rates_p, "mitsuba_seconds": t_m,
-        "mitsuba_rmses": errs_m, "pathlab_spp": spp_p, "pathlab_rmses": errs_p,
-        "pathlab_seconds": float(np.median(secs_p)),
-    }
-    c["ratio"] = c["pathlab_rate"] / c["mitsuba_rate"]
-    c["mitsuba_rmse"], c["pathlab_rmse"] = float(np.median(errs_m)), float(np.median(errs_p))
-    c["rmse_ratio"] = c["pathlab_rmse"] / c["mitsuba_rmse"]
+    def mitsuba(scene):
+        return lambda rep: mitsuba_runs.timed(variant, scene, "-", args.spp, {}, rep)[:2]
+
+    def pathlab(flags, kind):
+        # The speed runs trace paths as Mitsuba does; the others take the file's integrator.
+        extra = ["--integrator", "path"] if kind == "speed" else []
+        return mitsuba_runs.pathlab_render(args.pathlab, pbrt, ["-r", str(w), str(h)] + flags
+                                           + extra, f"{args.work}/{kind}-{name}.exr")
+
+    c = mitsuba_runs.compare(args.reps, args.spp, pixels, ref, mitsuba(independent), pathlab,
+                             mitsuba_settings=mitsuba(xml))
     results["cases"][name] = c
     print(f"{name:<12} {c['mitsuba_rate']:12.3e} {c['pathlab_rate']:12.3e} {c['ratio']:6.2f}"
-          f"   {c['mitsuba_rmse']:12.5f} {spp_p:11d} {c['pathlab_seconds'] / t_m:9.2f}"
+          f"   {c['mitsuba_rmse']:12.5f} {c['pathlab_spp']:11d}"
+          f" {c['pathlab_seconds'] / c['mitsuba_seconds']:9.2f}"
           f" {c['pathlab_rmse']:12.5f} {c['rmse_ratio']:10.2f}", flush=True)
 json.dump(results, open(f"{args.work}/pbrt.json", "w"), indent=1)
