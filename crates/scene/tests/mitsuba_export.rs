@@ -373,7 +373,7 @@ type Change = Box<dyn Fn(&mut SceneDesc)>;
 fn what_mitsuba_cannot_express_is_an_error_naming_it() {
     let cases: Vec<(&str, Change)> = vec![
         (
-            "textured",
+            "material 0: a textured diffuse",
             Box::new(|d| {
                 d.materials[0] = MaterialDesc::TexturedDiffuse {
                     texture: TextureDesc::Checkerboard {

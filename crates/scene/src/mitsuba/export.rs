@@ -73,7 +73,13 @@ pub fn to_mitsuba(desc: &SceneDesc, mesh_folder: &str) -> Result<MitsubaScene, E
     w.integrator(desc);
     w.sensor(desc)?;
     for (i, m) in desc.materials.iter().enumerate() {
-        w.material(m, Some(&format!("mat{i}")), 1)?;
+        w.material(m, Some(&format!("mat{i}")), 1)
+            .map_err(|e| match e {
+                ExportError::Unsupported(what) => {
+                    ExportError::Unsupported(format!("material {i}: {what}"))
+                }
+                other => other,
+            })?;
     }
     for (i, mesh) in desc.meshes.iter().enumerate() {
         w.mesh(desc, i, mesh, mesh_folder)?;
