@@ -121,7 +121,8 @@ pub struct SurfaceInteraction {
     pub material: u32,
     /// Index of the light the surface belongs to, if it emits.
     pub light: Option<u32>,
-    /// Texture coordinates (the mesh's, else barycentric; spherical on spheres).
+    /// Texture coordinates (the mesh's, else barycentric; spherical on spheres, where they
+    /// are computed only if the sphere's material or light reads a texture: (0, 0) otherwise).
     pub uv: Vec2,
     /// The triangle hit, in the scene's order (`u32::MAX` on a sphere or an SDF grid), for
     /// mesh attributes.
@@ -173,6 +174,9 @@ pub struct Scene {
     sphere_light: Vec<u32>,
     /// Each sphere's rotation from world to its own frame (for its texture coordinates).
     sphere_to_object: Vec<Mat3>,
+    /// Whether each sphere's material or light reads a texture, at its (u, v): the angles
+    /// cost an `atan2` and an `acos` per hit, wasted on the others.
+    sphere_reads_uv: Vec<bool>,
     grids: Vec<SdfGrid>,
     grid_material: Vec<u32>,
     voxels: Vec<Voxel>,
@@ -236,6 +240,7 @@ impl Scene {
             + size_of_val(self.sphere_material.as_slice())
             + size_of_val(self.sphere_light.as_slice())
             + size_of_val(self.sphere_to_object.as_slice())
+            + size_of_val(self.sphere_reads_uv.as_slice())
             + size_of_val(self.voxels.as_slice())
             + self
                 .attributes
@@ -503,7 +508,11 @@ impl Scene {
         // Project onto the surface to remove the rounding of the ray parameter.
         let p = s.center + ng * s.radius;
         let light = self.sphere_light[i as usize];
-        let uv = sphere_uv(self.sphere_to_object[i as usize] * ng);
+        let uv = if self.sphere_reads_uv[i as usize] {
+            sphere_uv(self.sphere_to_object[i as usize] * ng)
+        } else {
+            Vec2::ZERO
+        };
         SurfaceInteraction {
             p,
             t,
@@ -573,6 +582,49 @@ mod tests {
             ..Default::default()
         };
         Scene::build(&desc).unwrap()
+    }
+
+    #[test]
+    fn spheres_find_their_texture_coordinates_where_a_texture_reads_them() {
+        // Sphere 0 plain, sphere 1 textured, sphere 2 plain but with a textured emission.
+        let checker = crate::desc::TextureDesc::Checkerboard {
+            color0: Vec3::ZERO,
+            color1: Vec3::ONE,
+            to_uv: glam::Affine2::IDENTITY,
+        };
+        let desc = SceneDesc {
+            spheres: (0..3)
+                .map(|k| crate::desc::SphereDesc {
+                    center: Vec3::new(3.0 * k as f32, 0.0, 0.0),
+                    material: usize::from(k == 1),
+                    emission: (k == 2).then_some(crate::desc::Emission {
+                        radiance: Vec3::ONE,
+                        two_sided: false,
+                    }),
+                    emission_texture: (k == 2).then(|| checker.clone()),
+                    ..Default::default()
+                })
+                .collect(),
+            materials: vec![
+                diffuse(Vec3::ONE, false),
+                MaterialDesc::TexturedDiffuse {
+                    texture: checker.clone(),
+                    scale: Vec3::ONE,
+                    two_sided: false,
+                },
+            ],
+            resolution: [4, 4],
+            ..Default::default()
+        };
+        let scene = Scene::build(&desc).unwrap();
+        let d = Vec3::new(0.3, -0.4, -1.0).normalize();
+        for k in 0..3 {
+            let o = Vec3::new(3.0 * k as f32, 0.0, 0.0) - 3.0 * d;
+            let si = scene.intersect(&Ray::new(o, d)).0.unwrap();
+            let expected = if k == 0 { Vec2::ZERO } else { sphere_uv(si.ng) };
+            assert_eq!(si.uv, expected, "sphere {k}");
+            assert_ne!(sphere_uv(si.ng), Vec2::ZERO);
+        }
     }
 
     #[test]

@@ -299,6 +299,19 @@ impl Material {
         }
     }
 
+    /// Whether evaluating the material may read a texture at the surface's (u, v): every
+    /// material but one of fixed models (or two, one per side) is taken to.
+    pub fn reads_textures(&self) -> bool {
+        match self {
+            Material::Leaf(l) => !matches!(l.model, Model::Fixed(_)),
+            Material::TwoSided(ab) => ab.0.reads_textures() || ab.1.reads_textures(),
+            Material::Mask(..)
+            | Material::Blend(..)
+            | Material::NormalMap(..)
+            | Material::BumpMap(..) => true,
+        }
+    }
+
     /// Whether evaluating the material needs the surface's tangents.
     pub fn needs_tangents(&self) -> bool {
         match self {

@@ -144,6 +144,17 @@ impl Light {
         }
     }
 
+    /// Whether the light's emission reads a texture at its surface's (u, v).
+    pub fn reads_texture(&self) -> bool {
+        matches!(
+            self,
+            Light::Area {
+                texture: Some(_),
+                ..
+            }
+        )
+    }
+
     /// Radiance leaving an area light at a point with normal `n` and texture coordinates `uv`
     /// in direction `w` (away from the light).
     #[inline]

@@ -74,6 +74,18 @@ impl Scene {
             tri_uv: triangles.uv,
             tri_normals: triangles.normals,
             spheres: spheres.spheres,
+            sphere_reads_uv: spheres
+                .material
+                .iter()
+                .zip(&spheres.light)
+                .map(|(&m, &l)| {
+                    materials[m as usize].reads_textures()
+                        || lights
+                            .lights
+                            .get(l as usize)
+                            .is_some_and(Light::reads_texture)
+                })
+                .collect(),
             sphere_material: spheres.material,
             sphere_light: spheres.light,
             sphere_to_object: spheres.to_object,
