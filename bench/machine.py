@@ -13,3 +13,10 @@ def cpu_line():
     flags = next((l.split(":", 1)[1].split() for l in info.splitlines() if l.startswith("flags")), [])
     isa = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
     return f"{model}, {os.cpu_count()} threads, {isa}"
+
+
+def pathlab_build(pathlab):
+    """`pathlab --version`: its version and which build runs (the baseline, or the variant for
+    this CPU that deploy/build-variants.sh put beside it)."""
+    import subprocess
+    return subprocess.run([pathlab, "--version"], capture_output=True, text=True).stdout.strip()

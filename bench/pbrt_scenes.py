@@ -21,7 +21,7 @@ import argparse, json, os, re, subprocess
 import numpy as np
 import mitsuba as mi
 import mitsuba_runs
-from machine import cpu_line
+from machine import cpu_line, pathlab_build
 
 # (name, quarter resolution of the file's)
 CASES = [("cornell-box", 256, 256), ("veach-mis", 320, 180), ("veach-bidir", 256, 256)]
@@ -44,7 +44,7 @@ def export(pbrt, xml, w, h):
                    check=True, capture_output=True, text=True)
 
 
-print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; pathlab on all threads; {args.spp} spp;"
+print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; {pathlab_build(args.pathlab)} on all threads; {args.spp} spp;"
       f" rates are medians of {args.reps} runs taken in turns")
 print(f"{'scene':<12} {'Mitsuba S/s':>12} {'pathlab S/s':>12} {'ratio':>6}   {'Mitsuba RMSE':>12}"
       f" {'pathlab spp':>11} {'time used':>9} {'pathlab RMSE':>12} {'RMSE ratio':>10}")

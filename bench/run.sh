@@ -13,7 +13,9 @@
 #   bench/run.sh pbrt       # Mitsuba, Bitterli's pbrt-v4 scenes written as Mitsuba XML (the same)
 #   bench/run.sh python     # the Python module against the command line, same render
 #
-# Results go to target/bench/ (JSON per measurement) and a table on stdout.
+# Results go to target/bench/ (JSON per measurement) and a table on stdout. The renders run
+# `pathlab` with the build for this CPU (deploy/build-variants.sh makes it first);
+# PATHLAB_BENCH_BASELINE=1 runs the baseline build.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 shared="${PATHLAB_SHARED:-$root/../shared}"
@@ -25,6 +27,14 @@ cd "$root"
 cargo build --release --quiet -p pathlab -p pathlab-bench --features pathlab-bench/obvhs
 pathlab="$root/target/release/pathlab"
 bench="$root/target/release/pathlab-bench"
+# `pathlab` as its users run it: with the build for this CPU beside it (deploy/build-variants.sh,
+# which checks that it renders what the baseline renders). PATHLAB_BENCH_BASELINE=1 measures
+# the baseline build instead.
+if [ -n "${PATHLAB_BENCH_BASELINE:-}" ]; then
+    export PATHLAB_NO_VARIANT=1
+elif [ "$what" != rays ]; then
+    bash "$root/deploy/build-variants.sh"
+fi
 
 apt_install() {
     local sudo=""
@@ -111,5 +121,6 @@ if [ "$what" = all ] || [ "$what" = python ]; then
     rm -rf "$work/wheels"
     "$pyvenv/bin/maturin" build --quiet --release -m "$root/crates/python/Cargo.toml" -o "$work/wheels"
     "$pyvenv/bin/pip" install --quiet --force-reinstall --no-deps "$work"/wheels/pathlab-*.whl
-    "$pyvenv/bin/python" "$root/bench/python_vs_cli.py" "$pathlab" --reps "${PATHLAB_BENCH_REPS:-9}"
+    # The module is one build for every CPU: the command line's baseline build is its peer.
+    PATHLAB_NO_VARIANT=1 "$pyvenv/bin/python" "$root/bench/python_vs_cli.py" "$pathlab" --reps "${PATHLAB_BENCH_REPS:-9}"
 fi

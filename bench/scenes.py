@@ -18,7 +18,7 @@ import argparse, json, os
 import numpy as np
 import mitsuba as mi
 import mitsuba_runs
-from machine import cpu_line
+from machine import cpu_line, pathlab_build
 
 
 # (name in the table, folder under tests/data, pathlab -m, reference's depth)
@@ -52,7 +52,7 @@ def pathlab_render(scene, depth, extra, name):
                                        f"{args.work}/{name}.exr")
 
 
-print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; pathlab on all threads; {args.spp} spp;"
+print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; {pathlab_build(args.pathlab)} on all threads; {args.spp} spp;"
       f" rates are medians of {args.reps} runs taken in turns")
 print(f"{'scene':<18} {'Mitsuba S/s':>12} {'pathlab S/s':>12} {'ratio':>6}   {'Mitsuba RMSE':>12}"
       f" {'pathlab spp':>11} {'time used':>9} {'pathlab RMSE':>12} {'RMSE ratio':>10}")

@@ -20,7 +20,7 @@ import argparse, glob, json, os, subprocess
 import numpy as np
 import mitsuba as mi
 import mitsuba_runs
-from machine import cpu_line
+from machine import cpu_line, pathlab_build
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--pathlab", required=True)
@@ -40,7 +40,7 @@ def pathlab_render(scene, integrator, extra, out):
 
 
 files = sorted(glob.glob(os.path.join(args.suite, "*", "*.xml")))
-print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; pathlab on all threads; {args.spp} spp;"
+print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; {pathlab_build(args.pathlab)} on all threads; {args.spp} spp;"
       f" rates are medians of {args.reps} runs taken in turns")
 print(f"{'scene':<52} {'Mitsuba S/s':>11} {'pathlab S/s':>11} {'ratio':>6}   {'Mitsuba RMSE':>12}"
       f" {'pathlab spp':>11} {'pathlab RMSE':>12} {'RMSE ratio':>10}")

@@ -10,6 +10,7 @@ mod info_cmd;
 mod integrate;
 mod render_cmd;
 mod sample;
+mod variant;
 mod view_cmd;
 
 use clap::error::ErrorKind;
@@ -18,7 +19,7 @@ use std::process::ExitCode;
 
 /// pathlab: a physically based Monte Carlo renderer and Monte Carlo toolkit.
 #[derive(Parser, Debug)]
-#[command(name = "pathlab", version, about, long_about = None)]
+#[command(name = "pathlab", version = variant::VERSION, about, long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -51,6 +52,8 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // A build for this CPU's instruction set, where one lies beside this binary, runs instead.
+    variant::exec_best();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => return argument_error(e),

@@ -90,7 +90,12 @@ pub(super) fn written(
 /// `--json` object on stdout.
 pub(super) fn summary(args: &RenderArgs, s: &Summary) -> Result<()> {
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&s.json())?);
+        let mut json = s.json();
+        // Which build ran: the baseline, or a variant for this CPU (`crate::variant`).
+        if let Some(fields) = json.as_object_mut() {
+            fields.insert("build".into(), crate::variant::BUILD_LEVEL.into());
+        }
+        println!("{}", serde_json::to_string_pretty(&json)?);
     } else if !args.quiet {
         eprintln!("{}", s.text());
         if s.stats.nonfinite_samples > 0 {
