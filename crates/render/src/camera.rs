@@ -253,6 +253,9 @@ pub struct FilterSampler {
     /// Cumulative f at the same edges, on the same scale; `None` where f ≥ 0 (it equals
     /// `cdf`, and every weight is one).
     signed: Option<Vec<f32>>,
+    /// `cumulative_at(&cdf, x)` at x = -radius and x = radius, where the interval of a pixel
+    /// away from the image's edges starts and ends: computed once rather than per sample.
+    cdf_at_ends: [f32; 2],
 }
 
 /// Mitchell and Netravali's cubic at |x| ≤ 2.
@@ -356,11 +359,17 @@ impl FilterSampler {
             .iter()
             .any(|v| *v < 0.0)
             .then(|| scale(cumulative(&|v| v)));
-        Some(FilterSampler {
+        let mut sampler = FilterSampler {
             radius,
             cdf: scale(abs),
             signed,
-        })
+            cdf_at_ends: [0.0; 2],
+        };
+        sampler.cdf_at_ends = [
+            sampler.cumulative_at(&sampler.cdf, -radius),
+            sampler.cumulative_at(&sampler.cdf, radius),
+        ];
+        Some(sampler)
     }
 
     /// The filter's radius in pixels.
@@ -381,10 +390,17 @@ impl FilterSampler {
     /// weight (one for filters without negative lobes).
     pub fn sample(&self, u: f32, lo: f32, hi: f32) -> (f32, f32) {
         let (lo, hi) = (lo.max(-self.radius), hi.min(self.radius));
-        let (a, b) = (
-            self.cumulative_at(&self.cdf, lo),
-            self.cumulative_at(&self.cdf, hi),
-        );
+        // The same values as `cumulative_at` at the ends, computed once.
+        let a = if lo == -self.radius {
+            self.cdf_at_ends[0]
+        } else {
+            self.cumulative_at(&self.cdf, lo)
+        };
+        let b = if hi == self.radius {
+            self.cdf_at_ends[1]
+        } else {
+            self.cumulative_at(&self.cdf, hi)
+        };
         let target = a + u * (b - a);
         // The bin holding `target`, then linear within it (the density is constant per bin).
         let i = self
