@@ -25,39 +25,16 @@ type Level = (&'static str, fn() -> bool);
 #[cfg(all(target_arch = "x86_64", unix))]
 const LEVELS: [Level; 2] = [("x86-64-v4", has_v4), ("x86-64-v3", has_v3)];
 
-/// Whether this CPU runs x86-64-v3 code (AVX2, FMA, BMI and the rest of the level).
+/// Whether this CPU runs x86-64-v3 code.
 #[cfg(all(target_arch = "x86_64", unix))]
 fn has_v3() -> bool {
-    use std::arch::is_x86_feature_detected as has;
-    has!("sse3")
-        && has!("ssse3")
-        && has!("sse4.1")
-        && has!("sse4.2")
-        && has!("popcnt")
-        && has!("cmpxchg16b")
-        && has!("avx")
-        && has!("avx2")
-        && has!("bmi1")
-        && has!("bmi2")
-        && has!("f16c")
-        && has!("fma")
-        && has!("lzcnt")
-        && has!("movbe")
-        && has!("xsave")
+    pathlab_mc::simd::runs_x86_64_v3()
 }
 
-/// Whether this CPU runs x86-64-v4 code (v3 and AVX-512 F, BW, CD, DQ, VL), and AVX-512 is
-/// not turned off.
+/// Whether this CPU runs x86-64-v4 code, and AVX-512 is not turned off.
 #[cfg(all(target_arch = "x86_64", unix))]
 fn has_v4() -> bool {
-    use std::arch::is_x86_feature_detected as has;
-    std::env::var_os("PATHLAB_NO_AVX512").is_none()
-        && has_v3()
-        && has!("avx512f")
-        && has!("avx512bw")
-        && has!("avx512cd")
-        && has!("avx512dq")
-        && has!("avx512vl")
+    std::env::var_os("PATHLAB_NO_AVX512").is_none() && pathlab_mc::simd::runs_x86_64_v4()
 }
 
 /// The level this binary was built for: `baseline`, or the variant's level.
@@ -112,17 +89,4 @@ fn best_beside_this() -> Option<std::path::PathBuf> {
         let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok()?;
         (modified >= built && runs()).then_some(path)
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[cfg(all(target_arch = "x86_64", unix))]
-    #[test]
-    fn a_cpu_that_runs_level_4_runs_level_3() {
-        if has_v4() {
-            assert!(has_v3());
-        }
-    }
 }

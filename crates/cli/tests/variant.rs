@@ -8,21 +8,7 @@ use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Whether this CPU runs x86-64-v3 code.
-fn runs_v3() -> bool {
-    use std::arch::is_x86_feature_detected as has;
-    has!("sse4.2")
-        && has!("popcnt")
-        && has!("cmpxchg16b")
-        && has!("avx2")
-        && has!("bmi1")
-        && has!("bmi2")
-        && has!("f16c")
-        && has!("fma")
-        && has!("lzcnt")
-        && has!("movbe")
-        && has!("xsave")
-}
+use pathlab_mc::simd::{runs_x86_64_v3, runs_x86_64_v4};
 
 /// A folder holding `pathlab` (a link to the built binary) and nothing else.
 fn folder(name: &str) -> PathBuf {
@@ -67,7 +53,7 @@ fn a_variant_beside_pathlab_runs_in_its_place_with_the_same_arguments() {
     let dir = folder("variant-v3");
     fake_variant(&dir, "x86-64-v3");
     let v = version(&dir, &[]);
-    if runs_v3() {
+    if runs_x86_64_v3() {
         assert_eq!(v, "variant x86-64-v3: --version");
     } else {
         assert!(v.ends_with("(baseline)"), "{v}");
@@ -98,17 +84,11 @@ fn the_avx512_variant_stands_aside_when_avx512_is_turned_off() {
     fake_variant(&dir, "x86-64-v4");
     fake_variant(&dir, "x86-64-v3");
     let off = version(&dir, &[("PATHLAB_NO_AVX512", "1")]);
-    if runs_v3() {
+    if runs_x86_64_v3() {
         assert_eq!(off, "variant x86-64-v3: --version");
     }
     let on = version(&dir, &[]);
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512bw")
-        && std::arch::is_x86_feature_detected!("avx512cd")
-        && std::arch::is_x86_feature_detected!("avx512dq")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-        && runs_v3()
-    {
+    if runs_x86_64_v4() {
         assert_eq!(on, "variant x86-64-v4: --version");
     }
 }

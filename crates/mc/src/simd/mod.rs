@@ -20,6 +20,42 @@ pub mod lanes;
 /// routines: one lane of [`lanes::F8`] each.
 pub const PATH_LANES: usize = lanes::W;
 
+/// Whether this CPU runs code built for x86-64 psABI level 3 (`-C target-cpu=x86-64-v3`):
+/// AVX2, FMA, BMI1 and BMI2, F16C, LZCNT, MOVBE and XSAVE, with level 2's SSE3 to SSE4.2,
+/// POPCNT and CMPXCHG16B.
+#[cfg(target_arch = "x86_64")]
+pub fn runs_x86_64_v3() -> bool {
+    use std::arch::is_x86_feature_detected as has;
+    has!("sse3")
+        && has!("ssse3")
+        && has!("sse4.1")
+        && has!("sse4.2")
+        && has!("popcnt")
+        && has!("cmpxchg16b")
+        && has!("avx")
+        && has!("avx2")
+        && has!("bmi1")
+        && has!("bmi2")
+        && has!("f16c")
+        && has!("fma")
+        && has!("lzcnt")
+        && has!("movbe")
+        && has!("xsave")
+}
+
+/// Whether this CPU runs code built for x86-64 psABI level 4 (`-C target-cpu=x86-64-v4`):
+/// level 3 and AVX-512 F, BW, CD, DQ and VL.
+#[cfg(target_arch = "x86_64")]
+pub fn runs_x86_64_v4() -> bool {
+    use std::arch::is_x86_feature_detected as has;
+    runs_x86_64_v3()
+        && has!("avx512f")
+        && has!("avx512bw")
+        && has!("avx512cd")
+        && has!("avx512dq")
+        && has!("avx512vl")
+}
+
 /// Proof that this CPU has AVX2 and FMA: only [`Avx2::detect`] makes one, after checking.
 /// Code that holds one may run instructions of those extensions.
 #[cfg(target_arch = "x86_64")]
@@ -69,5 +105,21 @@ impl Avx512 {
     #[inline]
     pub fn avx2(self) -> Avx2 {
         Avx2 { _checked: () }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_levels_nest_and_agree_with_the_kernels_tokens() {
+        if runs_x86_64_v4() {
+            assert!(runs_x86_64_v3());
+        }
+        if runs_x86_64_v3() {
+            // Level 3 code may run the AVX2 kernels.
+            assert!(Avx2::detect().is_some());
+        }
     }
 }
