@@ -79,14 +79,33 @@ pub fn exec_best() {
 }
 
 /// The best variant beside this binary that this CPU runs and that is not older than it.
+/// A better one that is older (a build left from before `pathlab` was rebuilt) is named on
+/// stderr where that is a terminal: scripts and tests that read stderr see nothing extra.
 #[cfg(all(target_arch = "x86_64", unix))]
 fn best_beside_this() -> Option<std::path::PathBuf> {
     let this = std::env::current_exe().ok()?;
     let name = this.file_name()?.to_str()?.to_owned();
     let built = std::fs::metadata(&this).and_then(|m| m.modified()).ok()?;
-    LEVELS.iter().find_map(|(level, runs)| {
+    let mut stale = None;
+    let best = LEVELS.iter().find_map(|(level, runs)| {
         let path = this.with_file_name(format!("{name}-{level}"));
         let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok()?;
-        (modified >= built && runs()).then_some(path)
-    })
+        if !runs() {
+            return None;
+        }
+        if modified < built {
+            stale.get_or_insert(path);
+            return None;
+        }
+        Some(path)
+    });
+    let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    if let (Some(stale), None, true) = (&stale, &best, terminal) {
+        eprintln!(
+            "note: {} is older than {name} and is not used; rebuild it with \
+             deploy/build-variants.sh (or set PATHLAB_NO_VARIANT=1)",
+            stale.display()
+        );
+    }
+    best
 }
