@@ -9,11 +9,13 @@
 # script fails. One this CPU cannot run is not installed either (it could not be checked).
 #
 #   bash deploy/build-variants.sh             # beside target/release/pathlab
-#   bash deploy/build-variants.sh --install   # also beside the `pathlab` on PATH (after
-#                                             # `cargo install --path crates/cli`)
+#   bash deploy/build-variants.sh --install   # and install pathlab and its variants into the
+#                                             # folder of the `pathlab` on PATH (else
+#                                             # ~/.cargo/bin), all three of this checkout
 #
 # Each variant builds in a target folder of its own (target/variants/LEVEL): the first build
-# takes as long as the baseline's, later ones only recompile what changed.
+# takes as long as the baseline's, later ones only recompile what changed. A level whose
+# extensions this CPU lacks (as /proc/cpuinfo lists them) is not built.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -62,10 +64,37 @@ same() {
 }
 
 failed=""
+into=""
+if [ -n "$install" ]; then
+    installed="$(command -v pathlab || true)"
+    into="$(dirname "${installed:-$HOME/.cargo/bin/pathlab}")"
+    mkdir -p "$into"
+    # The baseline first, so that the variants copied after it are the newer files, and all
+    # three come from this checkout.
+    if [ "$(realpath "$base")" != "$(realpath "$into/pathlab" 2>/dev/null || true)" ]; then
+        cp "$base" "$into/pathlab"
+    fi
+    echo "build-variants: installed pathlab into $into"
+fi
+# With an explicit --target, RUSTFLAGS reach only the build's own code, not the build scripts
+# that run on this CPU during the build (a v4 build script dies on a CPU without AVX-512).
+host="$(rustc -vV | sed -n 's/^host: //p')"
+# The extensions whose absence rules a level out at once, before a build that could not be
+# checked (the variant's own test of its level, `--version` below, is the one that counts).
+declare -A needs=([x86-64-v3]="avx2 fma bmi2 movbe" [x86-64-v4]="avx512f avx512bw avx512dq avx512vl")
 for level in x86-64-v3 x86-64-v4; do
+    missing=""
+    for flag in ${needs[$level]}; do
+        grep -qw "$flag" /proc/cpuinfo 2>/dev/null || missing="$missing $flag"
+    done
+    if [ -n "$missing" ]; then
+        echo "build-variants: this CPU lacks$missing: $level not built"
+        rm -f "$root/target/release/pathlab-$level"
+        continue
+    fi
     RUSTFLAGS="-C target-cpu=$level" CARGO_TARGET_DIR="$root/target/variants/$level" \
-        cargo build --release --quiet -p pathlab
-    built="$root/target/variants/$level/release/pathlab"
+        cargo build --release --quiet -p pathlab --target "$host"
+    built="$root/target/variants/$level/$host/release/pathlab"
     # A variant says its level in `--version`; one this CPU cannot run dies of an illegal
     # instruction instead.
     if ! "$built" --version 2>/dev/null | grep -q "($level)"; then
@@ -82,15 +111,9 @@ for level in x86-64-v3 x86-64-v4; do
     # one is taken for a stale build and not run).
     cp "$built" "$root/target/release/pathlab-$level"
     echo "build-variants: $level renders the ${#checks[@]} checks as the baseline does; installed as target/release/pathlab-$level"
-    if [ -n "$install" ]; then
-        installed="$(command -v pathlab || true)"
-        if [ -z "$installed" ]; then
-            echo "build-variants: no pathlab on PATH to install beside (cargo install --path crates/cli first)" >&2
-            failed=1
-        else
-            cp "$built" "$(dirname "$installed")/pathlab-$level"
-            echo "build-variants: installed beside $installed"
-        fi
+    if [ -n "$into" ]; then
+        cp "$built" "$into/pathlab-$level"
+        echo "build-variants: installed pathlab-$level into $into"
     fi
 done
 echo "build-variants: on this CPU \`pathlab\` runs the $("$base" --version | sed 's/.*(\(.*\))/\1/') build"
