@@ -55,7 +55,7 @@ def pathlab_render(scene, depth, extra, name):
 print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; {pathlab_build(args.pathlab)} on all threads; {args.spp} spp;"
       f" rates are medians of {args.reps} runs taken in turns")
 print(f"{'scene':<18} {'Mitsuba S/s':>12} {'pathlab S/s':>12} {'ratio':>6}   {'Mitsuba RMSE':>12}"
-      f" {'pathlab spp':>11} {'time used':>9} {'pathlab RMSE':>12} {'RMSE ratio':>10}")
+      f" {'pathlab spp':>11} {'time used':>9} {'pathlab RMSE':>12} {'RMSE ratio':>10} {'at budget':>9}")
 results = {"cpu": cpu_line(), "variant": variant, "spp": args.spp, "cases": {}}
 os.makedirs(args.work, exist_ok=True)
 for name, folder, depth, ref_depth in CASES:
@@ -75,5 +75,5 @@ for name, folder, depth, ref_depth in CASES:
     print(f"{name:<18} {c['mitsuba_rate']:12.3e} {c['pathlab_rate']:12.3e} {c['ratio']:6.2f}"
           f"   {c['mitsuba_rmse']:12.5f} {c['pathlab_spp']:11d}"
           f" {c['pathlab_seconds'] / c['mitsuba_seconds']:9.2f} {c['pathlab_rmse']:12.5f}"
-          f" {c['rmse_ratio']:10.2f}", flush=True)
+          f" {c['rmse_ratio']:10.2f} {c['rmse_ratio_at_budget']:9.2f}", flush=True)
 json.dump(results, open(f"{args.work}/scenes.json", "w"), indent=1)
