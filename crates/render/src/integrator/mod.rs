@@ -318,8 +318,10 @@ pub(crate) fn visible_light_sample(
 ) -> Option<VisibleLightSample> {
     let (index, pmf) = scene.light_sampler().sample(u_select)?;
     let light = &scene.lights()[index];
-    let ls = light.sample_li(si.p, u_light)?;
-    if ls.pdf <= 0.0 || ls.li.max_element() <= 0.0 {
+    // An environment map's radiance is read last, once the sample is known to count.
+    let deferred = light.sample_li_deferred(si.p, u_light)?;
+    let ls = deferred.ls;
+    if ls.pdf <= 0.0 || (deferred.has_li() && ls.li.max_element() <= 0.0) {
         return None;
     }
     let f = bsdf.f_cos(wo, ls.wi);
@@ -335,7 +337,16 @@ pub(crate) fn visible_light_sample(
     if scene.occluded(&shadow) {
         return None;
     }
-    Some(VisibleLightSample { index, pmf, ls, f })
+    let li = light.deferred_li(&deferred);
+    if li.max_element() <= 0.0 {
+        return None;
+    }
+    Some(VisibleLightSample {
+        index,
+        pmf,
+        ls: LightLiSample { li, ..ls },
+        f,
+    })
 }
 
 /// A light sample's contribution f · Li · |cos θi| / p at a surface point, weighted by MIS

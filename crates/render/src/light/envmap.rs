@@ -201,6 +201,15 @@ impl EnvironmentMap {
 
     /// A world direction, its density per solid angle and the radiance from it.
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32, Rgb)> {
+        let (wi, pdf, uv) = self.sample_direction(u)?;
+        Some((wi, pdf, self.radiance_at(uv)))
+    }
+
+    /// [`EnvironmentMap::sample`] without the radiance: the world direction, its density per
+    /// solid angle and its (u, v), where [`EnvironmentMap::radiance_at`] reads the radiance.
+    /// The texel lookup is a cache miss more often than not in a large map; a caller that may
+    /// reject the direction (the BSDF is zero there, a shadow ray is blocked) reads it after.
+    pub fn sample_direction(&self, u: Vec2) -> Option<(Vec3, f32, Vec2)> {
         let (cell_uv, pdf_uv) = self.distribution.sample(u);
         if pdf_uv <= 0.0 {
             return None;
@@ -212,7 +221,13 @@ impl EnvironmentMap {
             return None;
         }
         let pdf = pdf_uv / (2.0 * PI * PI * sin_t);
-        Some(((self.to_world * d).normalize(), pdf, self.eval_uv(uv)))
+        Some(((self.to_world * d).normalize(), pdf, uv))
+    }
+
+    /// Radiance at the map's (u, v), as [`EnvironmentMap::sample_direction`] gives them.
+    #[inline]
+    pub fn radiance_at(&self, uv: Vec2) -> Rgb {
+        self.eval_uv(uv)
     }
 
     /// Density per solid angle with which [`EnvironmentMap::sample`] returns `w`.

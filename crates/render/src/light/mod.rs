@@ -112,6 +112,22 @@ pub struct LightLiSample {
     pub is_delta: bool,
 }
 
+/// A light sample whose radiance may not have been read yet ([`Light::sample_li_deferred`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeferredLiSample {
+    /// The sample; its `li` is zero while `at` holds where to read it.
+    pub ls: LightLiSample,
+    /// An environment map's (u, v) whose radiance [`Light::deferred_li`] reads.
+    at: Option<Vec2>,
+}
+
+impl DeferredLiSample {
+    /// Whether `ls.li` is the radiance already (otherwise [`Light::deferred_li`] reads it).
+    pub fn has_li(&self) -> bool {
+        self.at.is_none()
+    }
+}
+
 /// 1 / (c + l d + q d²), or 0 where that is not positive.
 #[inline]
 fn attenuate(attenuation: [f32; 3], dist2: f32) -> f32 {
@@ -356,20 +372,49 @@ impl Light {
                     is_delta: false,
                 })
             }
-            Light::EnvironmentMap {
-                ref map,
-                scene_radius,
-            } => {
-                let (wi, pdf, li) = map.sample(u)?;
+            Light::EnvironmentMap { .. } => {
+                let deferred = self.sample_li_deferred(p, u)?;
                 Some(LightLiSample {
-                    li,
-                    wi,
-                    pdf,
-                    p_light: p + wi * (4.0 * scene_radius.max(1.0)),
-                    n_light: None,
-                    is_delta: false,
+                    li: self.deferred_li(&deferred),
+                    ..deferred.ls
                 })
             }
+        }
+    }
+
+    /// [`Light::sample_li`], except that an environment map's radiance is left to
+    /// [`Light::deferred_li`]: its texel lookup, often a cache miss, is then skipped for the
+    /// samples a caller rejects first (a zero BSDF value, a blocked shadow ray). The same
+    /// sample and the same radiance as [`Light::sample_li`].
+    pub fn sample_li_deferred(&self, p: Vec3, u: Vec2) -> Option<DeferredLiSample> {
+        let Light::EnvironmentMap {
+            ref map,
+            scene_radius,
+        } = *self
+        else {
+            return self
+                .sample_li(p, u)
+                .map(|ls| DeferredLiSample { ls, at: None });
+        };
+        let (wi, pdf, uv) = map.sample_direction(u)?;
+        Some(DeferredLiSample {
+            ls: LightLiSample {
+                li: Rgb::ZERO,
+                wi,
+                pdf,
+                p_light: p + wi * (4.0 * scene_radius.max(1.0)),
+                n_light: None,
+                is_delta: false,
+            },
+            at: Some(uv),
+        })
+    }
+
+    /// The radiance of a sample [`Light::sample_li_deferred`] of this light gave.
+    pub fn deferred_li(&self, s: &DeferredLiSample) -> Rgb {
+        match (self, s.at) {
+            (Light::EnvironmentMap { map, .. }, Some(uv)) => map.radiance_at(uv),
+            _ => s.ls.li,
         }
     }
 
@@ -542,6 +587,52 @@ mod tests {
                 t.p_value > 1e-4,
                 "radius {radius}: {mean} ± {se} vs {truth}"
             );
+        }
+    }
+
+    #[test]
+    fn deferred_samples_are_the_samples_and_radiance_sample_li_gives() {
+        let (w, h) = (16, 9);
+        let texels: Vec<Rgb> = (0..w * h)
+            .map(|i| Vec3::new(1.0 + (i % 5) as f32, (i % 3) as f32, 0.5))
+            .collect();
+        let map = EnvironmentMap::new(texels, w, h, glam::Mat3::from_rotation_y(0.4), 1.5)
+            .expect("a map");
+        let lights = [
+            Light::EnvironmentMap {
+                map: Arc::new(map),
+                scene_radius: 3.0,
+            },
+            Light::Environment {
+                radiance: Vec3::ONE,
+                scene_radius: 3.0,
+            },
+            Light::Point {
+                position: Vec3::new(0.0, 2.0, 0.0),
+                intensity: Vec3::splat(4.0),
+                attenuation: [0.0, 0.0, 1.0],
+            },
+        ];
+        let mut rng = Pcg32::new(7, 1);
+        let p = Vec3::new(0.1, -0.2, 0.3);
+        for (k, light) in lights.iter().enumerate() {
+            let mut read = 0;
+            for _ in 0..2000 {
+                let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+                let whole = light.sample_li(p, u);
+                let deferred = light.sample_li_deferred(p, u);
+                assert_eq!(whole.is_some(), deferred.is_some());
+                let (Some(whole), Some(d)) = (whole, deferred) else {
+                    continue;
+                };
+                // Only the environment map leaves its radiance to be read.
+                assert_eq!(d.has_li(), k != 0);
+                read += usize::from(!d.has_li());
+                let li = light.deferred_li(&d);
+                assert_eq!(whole, LightLiSample { li, ..d.ls });
+                assert!(li.max_element() > 0.0);
+            }
+            assert!(k != 0 || read > 1900, "{read} deferred samples");
         }
     }
 }
