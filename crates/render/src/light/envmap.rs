@@ -169,17 +169,11 @@ impl EnvironmentMap {
         )
     }
 
-    /// Bilinear radiance at (u, v).
+    /// The four texels that (u, v) interpolates between, which are the corners of the cell the
+    /// distribution finds for (u, v) too (the same products and truncations pick its row and
+    /// column), and where (u, v) lies between them.
     #[inline]
-    fn eval_uv(&self, uv: Vec2) -> Rgb {
-        self.lookup(uv).0
-    }
-
-    /// Bilinear radiance at (u, v), and the sampling weight of the cell it lies in (the cell
-    /// between the four texels it interpolates, the one the distribution finds for (u, v)
-    /// too: the same products and truncations pick its row and column).
-    #[inline]
-    fn lookup(&self, uv: Vec2) -> (Rgb, f32) {
+    fn texels_around(&self, uv: Vec2) -> TexelCell {
         let g = self.grid(uv);
         let x0 = (g.x as usize).min(self.width - 1);
         let y0 = (g.y as usize).min(self.height - 2);
@@ -187,13 +181,12 @@ impl EnvironmentMap {
         // The next column, wrapping around in u (a comparison, not an integer division).
         let x1 = if x0 + 1 == self.width { 0 } else { x0 + 1 };
         let at = |x: usize, y: usize| self.texels[y * self.width + x];
-        let corners = [at(x0, y0), at(x1, y0), at(x0, y0 + 1), at(x1, y0 + 1)];
-        let top = corners[0] * (1.0 - fx) + corners[1] * fx;
-        let bottom = corners[2] * (1.0 - fx) + corners[3] * fx;
-        (
-            top * (1.0 - fy) + bottom * fy,
-            cell_weight(corners, self.bands[y0]),
-        )
+        TexelCell {
+            corners: [at(x0, y0), at(x1, y0), at(x0, y0 + 1), at(x1, y0 + 1)],
+            fx,
+            fy,
+            row: y0,
+        }
     }
 
     /// The local direction of world direction `w`, and its (u, v).
@@ -205,7 +198,7 @@ impl EnvironmentMap {
 
     /// Radiance arriving from world direction `w` (pointing into the environment).
     pub fn eval(&self, w: Vec3) -> Rgb {
-        self.eval_uv(self.local(w).1)
+        self.radiance_at(self.local(w).1)
     }
 
     /// [`EnvironmentMap::eval`] and [`EnvironmentMap::pdf`] of one direction, which find its
@@ -215,15 +208,15 @@ impl EnvironmentMap {
         // The density from the cell's weight, found from the texels the radiance reads rather
         // than from the distribution's table (one lookup in memory instead of two; the same
         // number: the table holds the same weight of the same cell).
-        let (le, weight) = self.lookup(uv);
+        let cell = self.texels_around(uv);
         let integral = self.distribution.integral();
         let pdf_uv = if integral > 0.0 {
-            weight / integral
+            cell_weight(cell.corners, self.bands[cell.row]) / integral
         } else {
             // A black map is sampled uniformly over the unit square.
             1.0
         };
-        (le, self.solid_angle_pdf(d, pdf_uv))
+        (cell.radiance(), self.solid_angle_pdf(d, pdf_uv))
     }
 
     /// A world direction, its density per solid angle and the radiance from it.
@@ -251,10 +244,11 @@ impl EnvironmentMap {
         Some(((self.to_world * d).normalize(), pdf, uv))
     }
 
-    /// Radiance at the map's (u, v), as [`EnvironmentMap::sample_direction`] gives them.
+    /// Bilinear radiance at the map's (u, v), as [`EnvironmentMap::sample_direction`] gives
+    /// them.
     #[inline]
     pub fn radiance_at(&self, uv: Vec2) -> Rgb {
-        self.eval_uv(uv)
+        self.texels_around(uv).radiance()
     }
 
     /// Density per solid angle with which [`EnvironmentMap::sample`] returns `w`.
@@ -279,6 +273,28 @@ impl EnvironmentMap {
             return 0.0;
         }
         pdf_uv / (2.0 * PI * PI * sin2.sqrt())
+    }
+}
+
+/// A cell of the map's grid as a radiance lookup finds it ([`EnvironmentMap::texels_around`]).
+struct TexelCell {
+    /// Radiance at its corners: (x0, y0), (x1, y0), (x0, y0 + 1), (x1, y0 + 1).
+    corners: [Rgb; 4],
+    /// Where the looked-up point lies between the columns and between the rows.
+    fx: f32,
+    fy: f32,
+    /// y0, the cell's row.
+    row: usize,
+}
+
+impl TexelCell {
+    /// The bilinear interpolation of the corners.
+    #[inline]
+    fn radiance(&self) -> Rgb {
+        let (c, fx, fy) = (&self.corners, self.fx, self.fy);
+        let top = c[0] * (1.0 - fx) + c[1] * fx;
+        let bottom = c[2] * (1.0 - fx) + c[3] * fx;
+        top * (1.0 - fy) + bottom * fy
     }
 }
 
