@@ -133,6 +133,27 @@ impl Bxdf {
         }
     }
 
+    /// The relative index of refraction η' of a sample from `wo` to `wi` (local frame) that
+    /// refracts through an interface between two media (smooth or rough glass, the
+    /// transmission of a solid principled material): η entering, 1/η leaving; the radiance it
+    /// carries across is scaled by 1/η'² (pbrt-v4's `BSDFSample::eta`). One for everything
+    /// else: reflection, thin sheets, diffuse and layered transmission.
+    pub fn relative_ior(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let eta = match self {
+            Bxdf::Dielectric(b) => b.eta,
+            Bxdf::RoughDielectric(b) => b.eta,
+            Bxdf::Principled(b) if !b.thin => b.eta,
+            _ => return 1.0,
+        };
+        if wo.z * wi.z >= 0.0 {
+            1.0
+        } else if wo.z > 0.0 {
+            eta
+        } else {
+            1.0 / eta
+        }
+    }
+
     /// Whether `sample` returns an estimate (f / pdf unbiased, pdf for MIS only) rather than
     /// exact values: the layered models.
     pub fn is_stochastic(&self) -> bool {

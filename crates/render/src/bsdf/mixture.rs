@@ -24,6 +24,9 @@ pub struct BsdfSample {
     /// f · cos / pdf. (The cosine to the lobe's own shading normal, which a normal map may
     /// have moved away from the surface's.)
     pub cos: f32,
+    /// The relative index of refraction η' the sample crossed ([`Bxdf::relative_ior`]): one
+    /// unless it refracts into or out of a medium, its radiance then scaled by 1/η'² in `f`.
+    pub eta: f32,
 }
 
 /// Most lobes a [`Bsdf`] holds (a mask or blend of blends deeper than this keeps the first).
@@ -223,24 +226,6 @@ impl Bsdf {
             .sum()
     }
 
-    /// The factor that turns the weight f cos / p of a delta sample from `wo` to `wi`, which
-    /// [`Bsdf::sample_f`] gives for radiance, into the one for importance: η'² for a
-    /// refraction through smooth glass (η' the relative index along the sample; radiance is
-    /// scaled by 1/η'² crossing the interface, importance is not), one for anything else.
-    pub fn delta_importance_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
-        for l in self.lobes() {
-            if let Bxdf::Dielectric(d) = l.bxdf {
-                let (o, i) = (l.frame.to_local(wo), l.frame.to_local(wi));
-                if let Some((t, etap)) = refract(o, d.eta) {
-                    if o.z * i.z < 0.0 && t.dot(i) > 1.0 - 1e-4 {
-                        return etap * etap;
-                    }
-                }
-            }
-        }
-        1.0
-    }
-
     /// Whether every lobe is a delta distribution (light sampling can never help).
     pub fn is_delta(&self) -> bool {
         self.lobes().all(|l| l.bxdf.is_delta() || l.weight <= 0.0)
@@ -251,7 +236,8 @@ impl Bsdf {
     pub fn sample_f(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         if self.is_single() {
             let l = &self.first;
-            let s = l.bxdf.sample(l.frame.to_local(wo), uc, u)?;
+            let wo_local = l.frame.to_local(wo);
+            let s = l.bxdf.sample(wo_local, uc, u)?;
             let wi = l.frame.to_world(s.wi);
             if !l.admits(wi) {
                 return None;
@@ -266,6 +252,7 @@ impl Bsdf {
                 pdf: s.pdf,
                 delta: s.delta,
                 cos: wi.dot(l.frame.n).abs(),
+                eta: l.bxdf.relative_ior(wo_local, s.wi),
             });
         }
         // Choose a lobe by weight, and reuse the rest of `uc` within it.
@@ -290,10 +277,13 @@ impl Bsdf {
                 pdf: self.null,
                 delta: true,
                 cos: c,
+                eta: 1.0,
             });
         };
-        let s = l.bxdf.sample(l.frame.to_local(wo), uc, u)?;
+        let wo_local = l.frame.to_local(wo);
+        let s = l.bxdf.sample(wo_local, uc, u)?;
         let wi = l.frame.to_world(s.wi);
+        let eta = l.bxdf.relative_ior(wo_local, s.wi);
         if !l.admits(wi)
             || s.pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
             || !s.f.is_finite()
@@ -308,6 +298,7 @@ impl Bsdf {
                 pdf: s.pdf * l.weight,
                 delta: true,
                 cos,
+                eta,
             });
         }
         let pdf = self.pdf(wo, wi);
@@ -325,6 +316,7 @@ impl Bsdf {
                 pdf,
                 delta: false,
                 cos,
+                eta,
             });
         }
         let f = self.f_cos(wo, wi) / cos;
@@ -334,6 +326,7 @@ impl Bsdf {
             pdf,
             delta: false,
             cos,
+            eta,
         })
     }
 

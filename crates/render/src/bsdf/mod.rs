@@ -80,8 +80,10 @@ mod tests {
             if s.wi.z > 0.0 {
                 reflected += 1;
                 assert!((weight - Vec3::ONE).abs().max_element() < 1e-5);
+                assert_eq!(s.eta, 1.0);
             } else {
                 assert!((weight * 1.5 * 1.5 - Vec3::ONE).abs().max_element() < 1e-4);
+                assert_eq!(s.eta, 1.5, "the relative index the sample crossed");
             }
             assert!(s.delta);
         }

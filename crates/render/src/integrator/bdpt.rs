@@ -22,8 +22,8 @@
 //! do not emit rays (at infinity, projectors) are reached by s = 0 and s = 1 only.
 //!
 //! Light subpaths carry importance: at their vertices the BSDF is the adjoint one
-//! ([`crate::bsdf::Bsdf::f_cos_importance`],
-//! [`crate::bsdf::Bsdf::delta_importance_scale`]).
+//! ([`crate::bsdf::Bsdf::f_cos_importance`]; a delta refraction's weight without the 1/η'²
+//! that scales radiance, [`crate::bsdf::BsdfSample::eta`]).
 
 #[cfg(test)]
 mod tests;
@@ -86,6 +86,9 @@ impl BdptIntegrator {
         // The product of the BSDF weights alone, for Russian roulette (a light subpath's
         // throughput starts at the light's radiance over its density).
         let mut walk = Rgb::ONE;
+        // The product of η'² over a camera subpath's refractions: Russian roulette weighs its
+        // walk without refraction's radiance scaling, as the path tracer does.
+        let mut eta_scale = 1.0f32;
         let mut bounces = 0u32;
         while bounces < max_vertices {
             let kind = if importance {
@@ -120,10 +123,13 @@ impl BdptIntegrator {
             let weight = match (importance, bs.delta) {
                 (false, _) => bs.f * (bs.cos / bs.pdf),
                 (true, false) => bsdf.f_cos_importance(wo, bs.wi) / bs.pdf,
-                (true, true) => bs.f * (bs.cos / bs.pdf * bsdf.delta_importance_scale(wo, bs.wi)),
+                (true, true) => bs.f * (bs.cos / bs.pdf * (bs.eta * bs.eta)),
             };
             beta *= weight;
             walk *= weight;
+            if !importance {
+                eta_scale *= bs.eta * bs.eta;
+            }
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 return;
             }
@@ -131,7 +137,7 @@ impl BdptIntegrator {
                 last.delta = bs.delta;
             }
             if bounces >= self.rr_depth {
-                let q = walk.max_element().min(0.95);
+                let q = (walk * eta_scale).max_element().min(0.95);
                 if sampler.next_1d() >= q {
                     return;
                 }

@@ -26,8 +26,11 @@ use pathlab_mc::sampler::{AnySampler, Sampler};
 /// which light sampling cannot produce). All three are unbiased; they differ in variance.
 ///
 /// Russian roulette from `rr_depth` on: the path continues with probability
-/// q = min(max component of the throughput, 0.95) and its throughput is divided by q, which
-/// keeps the estimator unbiased.
+/// q = min(max component of β η², 0.95) and its throughput β is divided by q, which keeps the
+/// estimator unbiased for any such q. η² is the product of the squared relative indices of
+/// the refractions so far (pbrt-v4's `etaScale`, Mitsuba's `eta²`): refraction scales
+/// radiance by 1/η'², which inside glass would otherwise end paths for a factor that leaving
+/// the glass undoes, and so add variance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathIntegrator {
     /// Largest bounce counted (`u32::MAX`: unbounded).
@@ -100,6 +103,10 @@ pub(crate) struct PathState {
     pub(crate) l: Rgb,
     /// Throughput: the product of f |cos θ| / p (and the Russian-roulette divisions) so far.
     pub(crate) beta: Rgb,
+    /// The product of η'² over the refractions so far ([`crate::bsdf::BsdfSample::eta`]):
+    /// β η_scale is the throughput without refraction's radiance scaling, which Russian
+    /// roulette weighs.
+    pub(crate) eta_scale: f32,
     /// The ray the path follows next.
     pub(crate) ray: Ray,
     /// The vertex the path left last, and how it left it; none for the camera.
@@ -126,6 +133,7 @@ impl PathState {
         PathState {
             l: Rgb::ZERO,
             beta: Rgb::ONE,
+            eta_scale: 1.0,
             ray,
             prev: None,
             depth: 0,
@@ -247,6 +255,7 @@ impl PathIntegrator {
             return false;
         };
         st.beta *= bs.f * (bs.cos / bs.pdf);
+        st.eta_scale *= bs.eta * bs.eta;
         if st.beta.max_element() <= 0.0 || !st.beta.is_finite() {
             return false;
         }
@@ -273,7 +282,7 @@ impl PathIntegrator {
         });
         st.depth += 1;
         if st.depth >= self.rr_depth {
-            let q = st.beta.max_element().min(0.95);
+            let q = (st.beta * st.eta_scale).max_element().min(0.95);
             if u_rr >= q {
                 return false;
             }
@@ -316,5 +325,47 @@ impl Integrator for PathIntegrator {
         } else {
             li_one_at_a_time(self, scene, sampler, samples, out, stats);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec2;
+
+    #[test]
+    fn russian_roulette_weighs_the_throughput_without_refractions_radiance_scaling() {
+        let si = SurfaceInteraction {
+            p: Vec3::ZERO,
+            t: 1.0,
+            ng: Vec3::Z,
+            ns: Vec3::Z,
+            material: 0,
+            light: None,
+            uv: Vec2::ZERO,
+            prim: u32::MAX,
+            b: Vec2::ZERO,
+        };
+        let pt = PathIntegrator::default();
+        // Inside glass of index 1.5 after a refraction that kept 90% of the light: β is
+        // 0.9 / 1.5² = 0.4, η_scale 1.5². Roulette continues with q = 0.9 (not 0.4), so
+        // u = 0.8 goes on and β becomes 0.4 / 0.9.
+        let mut st = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
+        st.depth = pt.rr_depth;
+        st.beta = Rgb::splat(0.9 / 2.25);
+        st.eta_scale = 2.25;
+        assert!(pt.survive(&mut st, &si, Vec3::Z, 1.0, true, 0.8));
+        assert_eq!(st.beta, Rgb::splat(0.9 / 2.25 / 0.9));
+        // u = 0.9 ends it.
+        st.beta = Rgb::splat(0.9 / 2.25);
+        assert!(!pt.survive(&mut st, &si, Vec3::Z, 1.0, true, 0.9));
+        // Without refractions η_scale is one and q is β itself (at most 0.95).
+        let mut st = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
+        st.depth = pt.rr_depth;
+        st.beta = Rgb::new(0.2, 0.4, 0.1);
+        assert!(!pt.survive(&mut st, &si, Vec3::Z, 1.0, false, 0.4));
+        st.beta = Rgb::new(0.2, 0.4, 0.1);
+        assert!(pt.survive(&mut st, &si, Vec3::Z, 1.0, false, 0.399));
+        assert_eq!(st.beta, Rgb::new(0.2, 0.4, 0.1) / 0.4);
     }
 }
