@@ -86,7 +86,7 @@ def unwrapped(integrator):
     return mi.load_dict(settings), f"{name}{ {k: v for k, v in settings.items() if k != 'type'} }"
 
 
-def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None):
+def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None, ref_var=None):
     """One scene measured both ways, as bench/scenes.py, bench/suite.py and
     bench/pbrt_scenes.py report it.
 
@@ -102,7 +102,13 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None):
     own settings differ from the speed runs' (`mitsuba_settings(rep)`, rendering them, as
     `mitsuba` does), Mitsuba's budget and error come from renders at those settings. The
     probe's rate misses the equal-time renders' by up to a fifth on a busy machine, so the
-    error ratio is also given scaled to exactly the budget (`rmse_ratio_at_budget`)."""
+    error ratio is also given scaled to exactly the budget (`rmse_ratio_at_budget`).
+
+    An image's squared error against a reference is its own error plus the reference's: with
+    `ref_var`, the mean over pixels of the reference's variance (its standard error squared),
+    the errors net of it are given too (`rmse_ratio_net`, and at the budget): the reference's
+    noise adds the same to both sides, so it pulls the ratio towards one and flatters the
+    renderer with the larger error."""
     rates_m, rates_p, times_m, errs_m = [], [], [], []
     for rep in range(reps):
         t_m, img_m = mitsuba(rep)
@@ -125,6 +131,9 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None):
     e_p = float(np.median(errs_p))
     secs = float(np.median(secs_p))
     ratio = e_p / e_m if e_m > 0 else None
+    net = None
+    if ref_var is not None and e_m * e_m > ref_var:
+        net = max(e_p * e_p - ref_var, 0.0) ** 0.5 / (e_m * e_m - ref_var) ** 0.5
     return {
         "mitsuba_rate": rate_m, "pathlab_rate": rate_p, "ratio": rate_p / rate_m,
         "mitsuba_runs": rates_m, "pathlab_runs": rates_p, "mitsuba_seconds": t_m,
@@ -136,7 +145,22 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None):
         # up by sqrt(k) (the reference's own error being small against both).
         "rmse_ratio_at_budget": ratio * (secs / t_m) ** 0.5 if ratio is not None and t_m > 0
         else None,
+        "reference_variance": ref_var, "rmse_ratio_net": net,
+        "rmse_ratio_net_at_budget": net * (secs / t_m) ** 0.5 if net is not None and t_m > 0
+        else None,
     }
+
+
+def reference_variance(stderr_path):
+    """The mean over pixels and channels of a reference's variance, from its standard-error
+    image."""
+    se = np.asarray(mi.Bitmap(stderr_path), dtype=np.float64)[..., :3]
+    return float(np.mean(se * se))
+
+
+def fmt(x, width, digits=2):
+    """`x` to `digits` decimals in `width` columns, or a dash where it is missing."""
+    return f"{x:{width}.{digits}f}" if x is not None else f"{'-':>{width}}"
 
 
 def rmse(img, ref):

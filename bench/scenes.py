@@ -8,7 +8,8 @@ one machine (bench/run.sh scenes starts it with a venv holding `mitsuba`):
 2. equal-time error: Mitsuba renders at --spp and its time is the budget; pathlab, with its
    default settings (sampler and all), renders at the spp its own measured rate allows in that
    time; each image's RMSE against the scene's reference (Mitsuba, 16 x 256 spp), the median
-   over --reps images on each side (pathlab's with seeds 1, 2, ...)
+   over --reps images on each side (pathlab's with seeds 1, 2, ...); also net of the
+   reference's own noise (its standard-error image), which adds the same to both errors
 
 Mitsuba's variant is llvm_ad_rgb (JIT-compiled, as wide as the CPU's vectors: 16 lanes with
 AVX-512); its first render of each configuration compiles kernels and is not timed. Each
@@ -55,7 +56,8 @@ def pathlab_render(scene, depth, extra, name):
 print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; {pathlab_build(args.pathlab)} on all threads; {args.spp} spp;"
       f" rates are medians of {args.reps} runs taken in turns")
 print(f"{'scene':<18} {'Mitsuba S/s':>12} {'pathlab S/s':>12} {'ratio':>6}   {'Mitsuba RMSE':>12}"
-      f" {'pathlab spp':>11} {'time used':>9} {'pathlab RMSE':>12} {'RMSE ratio':>10} {'at budget':>9}")
+      f" {'pathlab spp':>11} {'time used':>9} {'pathlab RMSE':>12} {'RMSE ratio':>10} {'at budget':>9}"
+      f" {'net of ref':>10} {'net, budget':>11}")
 results = {"cpu": cpu_line(), "variant": variant, "spp": args.spp, "cases": {}}
 os.makedirs(args.work, exist_ok=True)
 for name, folder, depth, ref_depth in CASES:
@@ -64,16 +66,21 @@ for name, folder, depth, ref_depth in CASES:
     scene = os.path.join(args.data, folder, "scene.xml")
     ref = np.asarray(mi.Bitmap(os.path.join(args.data, folder, f"mean-maxdepth-{ref_depth}.exr")),
                      dtype=np.float64)[..., :3]
+    stderr = os.path.join(args.data, folder, f"stderr-maxdepth-{ref_depth}.exr")
+    ref_var = mitsuba_runs.reference_variance(stderr) if os.path.exists(stderr) else None
     pixels = ref.shape[0] * ref.shape[1]
     mitsuba_depth = -1 if depth == "inf" else int(depth) + 1
     tag = folder + ("" if depth == "inf" else f"-m{depth}")
     c = mitsuba_runs.compare(
         args.reps, args.spp, pixels, ref,
         lambda rep: mitsuba_render(scene, mitsuba_depth, args.spp, rep),
-        lambda flags, kind: pathlab_render(scene, depth, flags, f"{kind}-{tag}"))
+        lambda flags, kind: pathlab_render(scene, depth, flags, f"{kind}-{tag}"),
+        ref_var=ref_var)
     results["cases"][name] = c
     print(f"{name:<18} {c['mitsuba_rate']:12.3e} {c['pathlab_rate']:12.3e} {c['ratio']:6.2f}"
           f"   {c['mitsuba_rmse']:12.5f} {c['pathlab_spp']:11d}"
           f" {c['pathlab_seconds'] / c['mitsuba_seconds']:9.2f} {c['pathlab_rmse']:12.5f}"
-          f" {c['rmse_ratio']:10.2f} {c['rmse_ratio_at_budget']:9.2f}", flush=True)
+          f" {c['rmse_ratio']:10.2f} {c['rmse_ratio_at_budget']:9.2f}"
+          f" {mitsuba_runs.fmt(c['rmse_ratio_net'], 10)}"
+          f" {mitsuba_runs.fmt(c['rmse_ratio_net_at_budget'], 11)}", flush=True)
 json.dump(results, open(f"{args.work}/scenes.json", "w"), indent=1)
