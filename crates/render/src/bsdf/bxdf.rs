@@ -145,13 +145,7 @@ impl Bxdf {
             Bxdf::Principled(b) if !b.thin => b.eta,
             _ => return 1.0,
         };
-        if wo.z * wi.z >= 0.0 {
-            1.0
-        } else if wo.z > 0.0 {
-            eta
-        } else {
-            1.0 / eta
-        }
+        scattering::relative_eta(wo, wi, eta)
     }
 
     /// Whether `sample` returns an estimate (f / pdf unbiased, pdf for MIS only) rather than

@@ -283,7 +283,6 @@ impl Bsdf {
         let wo_local = l.frame.to_local(wo);
         let s = l.bxdf.sample(wo_local, uc, u)?;
         let wi = l.frame.to_world(s.wi);
-        let eta = l.bxdf.relative_ior(wo_local, s.wi);
         if !l.admits(wi)
             || s.pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
             || !s.f.is_finite()
@@ -291,6 +290,7 @@ impl Bsdf {
             return None;
         }
         let cos = wi.dot(l.frame.n).abs();
+        let eta = l.bxdf.relative_ior(wo_local, s.wi);
         if s.delta {
             return Some(BsdfSample {
                 f: s.f * (l.weight * l.attenuation(wi)),

@@ -28,6 +28,20 @@ pub fn refract_about(w: Vec3, n: Vec3, eta: f32) -> Option<(Vec3, f32)> {
     Some((wt.normalize(), etap))
 }
 
+/// The relative index η' of a pair of directions (local frame) across an interface of
+/// relative index `eta` (inside / outside): η from outside in, 1/η from inside out, one when
+/// both lie on the same side (or either on the interface).
+#[inline]
+pub fn relative_eta(wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+    if wo.z * wi.z >= 0.0 {
+        1.0
+    } else if wo.z > 0.0 {
+        eta
+    } else {
+        1.0 / eta
+    }
+}
+
 /// Refracts `wo` (local frame, z = normal) through an interface of relative index `eta`
 /// (inside / outside); `None` under total internal reflection. Returns wi and the relative
 /// index η' along the path (η for entering, 1/η for leaving).

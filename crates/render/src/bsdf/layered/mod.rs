@@ -22,6 +22,7 @@
 
 use super::microfacet::Microfacet;
 use super::phase::HenyeyGreenstein;
+use super::scattering::relative_eta;
 use super::{Conductor, Diffuse, Lobes, LocalSample, RoughDielectric, SmoothDielectric};
 use crate::desc::Rgb;
 use crate::integrator::power_heuristic;
@@ -170,10 +171,10 @@ enum Interface {
 /// η'² undone on a transmission from `wo` to `wi` (the radiance scaling of refraction, which
 /// importance does not have).
 fn adjoint(mode: Mode, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
-    if mode == Mode::Radiance || wo.z * wi.z >= 0.0 {
+    if mode == Mode::Radiance {
         return 1.0;
     }
-    let etap = if wo.z > 0.0 { eta } else { 1.0 / eta };
+    let etap = relative_eta(wo, wi, eta);
     etap * etap
 }
 
