@@ -158,6 +158,13 @@ def reference_variance(stderr_path):
     return float(np.mean(se * se))
 
 
+def reference_variance_of_mean(sample_variance_path, spp):
+    """The mean over pixels and channels of a reference's variance, from its per-sample
+    variance image (as Mitsuba's test suite stores it) and the samples per pixel it took."""
+    var = np.asarray(mi.Bitmap(sample_variance_path), dtype=np.float64)[..., :3]
+    return float(np.mean(var)) / spp
+
+
 def fmt(x, width, digits=2):
     """`x` to `digits` decimals in `width` columns, or a dash where it is missing."""
     return f"{x:{width}.{digits}f}" if x is not None else f"{'-':>{width}}"
