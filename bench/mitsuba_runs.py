@@ -134,6 +134,8 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None, ref
     net = None
     if ref_var is not None and e_m * e_m > ref_var:
         net = max(e_p * e_p - ref_var, 0.0) ** 0.5 / (e_m * e_m - ref_var) ** 0.5
+    budget = (secs / t_m) ** 0.5 if t_m > 0 else None
+    mean_ratio, mean_se = mean_square_ratio(errs_p, errs_m, ref_var or 0.0)
     return {
         "mitsuba_rate": rate_m, "pathlab_rate": rate_p, "ratio": rate_p / rate_m,
         "mitsuba_runs": rates_m, "pathlab_runs": rates_p, "mitsuba_seconds": t_m,
@@ -146,9 +148,33 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None, ref
         "rmse_ratio_at_budget": ratio * (secs / t_m) ** 0.5 if ratio is not None and t_m > 0
         else None,
         "reference_variance": ref_var, "rmse_ratio_net": net,
-        "rmse_ratio_net_at_budget": net * (secs / t_m) ** 0.5 if net is not None and t_m > 0
+        "rmse_ratio_net_at_budget": net * budget if net is not None and budget is not None
         else None,
+        # The ratio of the root mean squared errors over the repetitions (net of the
+        # reference's noise where it is known), at the budget, and its standard error.
+        "rmse_ratio_mean_net_at_budget": mean_ratio * budget
+        if mean_ratio is not None and budget is not None else None,
+        "rmse_ratio_mean_net_at_budget_se": mean_se * budget
+        if mean_se is not None and budget is not None else None,
     }
+
+
+def mean_square_ratio(errs_p, errs_m, ref_var):
+    """√(mean squared error of `errs_p` / that of `errs_m`), each less `ref_var`, and its
+    standard error (delta method, from the spread of the squared errors over the images).
+
+    The expected squared error is what an image's error is on average; the median of a few
+    images' errors is robust to one bright outlier, but where the error is heavy-tailed (a few
+    pixels catching a small bright source) it sits below the mean by more for the renderer
+    that took fewer samples, so a ratio of medians does not estimate the ratio of expected
+    errors. With three images each the standard error is itself rough."""
+    a = np.array(errs_p, dtype=np.float64) ** 2 - ref_var
+    b = np.array(errs_m, dtype=np.float64) ** 2 - ref_var
+    if len(a) < 2 or len(b) < 2 or b.mean() <= 0 or a.mean() <= 0:
+        return None, None
+    r = float((a.mean() / b.mean()) ** 0.5)
+    rel_var = (a.var(ddof=1) / len(a) / a.mean() ** 2 + b.var(ddof=1) / len(b) / b.mean() ** 2) / 4
+    return r, r * float(rel_var ** 0.5)
 
 
 def reference_variance(stderr_path):
@@ -168,6 +194,13 @@ def reference_variance_of_mean(sample_variance_path, spp):
 def fmt(x, width, digits=2):
     """`x` to `digits` decimals in `width` columns, or a dash where it is missing."""
     return f"{x:{width}.{digits}f}" if x is not None else f"{'-':>{width}}"
+
+
+def fmt_se(x, se, width, digits=2):
+    """`x ± se` to `digits` decimals in `width` columns, or a dash where `x` is missing."""
+    if x is None:
+        return f"{'-':>{width}}"
+    return f"{f'{x:.{digits}f} ± {se:.{digits}f}' if se is not None else f'{x:.{digits}f}':>{width}}"
 
 
 def rmse(img, ref):

@@ -9,7 +9,9 @@ one machine (bench/run.sh scenes starts it with a venv holding `mitsuba`):
    default settings (sampler and all), renders at the spp its own measured rate allows in that
    time; each image's RMSE against the scene's reference (Mitsuba, 16 x 256 spp), the median
    over --reps images on each side (pathlab's with seeds 1, 2, ...); also net of the
-   reference's own noise (its standard-error image), which adds the same to both errors
+   reference's own noise (its standard-error image), which adds the same to both errors; and
+   the ratio of the root mean squared errors over the images (net, at the budget) with its
+   standard error
 
 Mitsuba's variant is llvm_ad_rgb (JIT-compiled, as wide as the CPU's vectors: 16 lanes with
 AVX-512); its first render of each configuration compiles kernels and is not timed. Each
@@ -57,7 +59,7 @@ print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; {pathlab_build(args.
       f" rates are medians of {args.reps} runs taken in turns")
 print(f"{'scene':<18} {'Mitsuba S/s':>12} {'pathlab S/s':>12} {'ratio':>6}   {'Mitsuba RMSE':>12}"
       f" {'pathlab spp':>11} {'time used':>9} {'pathlab RMSE':>12} {'RMSE ratio':>10} {'at budget':>9}"
-      f" {'net of ref':>10} {'net, budget':>11}")
+      f" {'net of ref':>10} {'net, budget':>11} {'mean sq., net, budget':>21}")
 results = {"cpu": cpu_line(), "variant": variant, "spp": args.spp, "cases": {}}
 os.makedirs(args.work, exist_ok=True)
 for name, folder, depth, ref_depth in CASES:
@@ -82,5 +84,7 @@ for name, folder, depth, ref_depth in CASES:
           f" {c['pathlab_seconds'] / c['mitsuba_seconds']:9.2f} {c['pathlab_rmse']:12.5f}"
           f" {c['rmse_ratio']:10.2f} {c['rmse_ratio_at_budget']:9.2f}"
           f" {mitsuba_runs.fmt(c['rmse_ratio_net'], 10)}"
-          f" {mitsuba_runs.fmt(c['rmse_ratio_net_at_budget'], 11)}", flush=True)
+          f" {mitsuba_runs.fmt(c['rmse_ratio_net_at_budget'], 11)}"
+          f" {mitsuba_runs.fmt_se(c['rmse_ratio_mean_net_at_budget'], c['rmse_ratio_mean_net_at_budget_se'], 21)}",
+          flush=True)
 json.dump(results, open(f"{args.work}/scenes.json", "w"), indent=1)
