@@ -356,3 +356,58 @@ Shape "sphere"
     let film = render_film(&desc, 4, 1);
     assert!(film.image_mean().min_element() > 0.0 && film.image_mean().is_finite());
 }
+
+#[test]
+fn samplers_pathlab_lacks_are_rendered_by_sobol_with_a_note() {
+    use pathlab_mc::sampler::SamplerKind;
+    let scene = |sampler: &str| {
+        two_quads("LookAt 0 0 -5  0 0 0  0 1 0")
+            .replace("Sampler \"independent\"", &format!("Sampler \"{sampler}\""))
+    };
+    for (name, kind, note) in [
+        ("independent", SamplerKind::Independent, None),
+        ("stratified", SamplerKind::Stratified, None),
+        ("sobol", SamplerKind::Sobol, None),
+        (
+            "zsobol",
+            SamplerKind::Sobol,
+            Some("rendered with the Sobol sampler"),
+        ),
+        (
+            "halton",
+            SamplerKind::Sobol,
+            Some("rendered with the Sobol sampler"),
+        ),
+        (
+            "pmj02bn",
+            SamplerKind::Sobol,
+            Some("rendered with the Sobol sampler"),
+        ),
+        (
+            "lowdiscrepancy",
+            SamplerKind::Sobol,
+            Some("not a pbrt-v4 sampler"),
+        ),
+    ] {
+        let desc = load_text(name, &[("a.pbrt", &scene(name))]).unwrap();
+        assert_eq!(desc.hints.sampler, Some(kind), "{name}");
+        assert_eq!(desc.hints.spp, Some(4), "{name}");
+        let notes: Vec<&String> = desc
+            .warnings
+            .iter()
+            .filter(|w| w.contains("Sampler"))
+            .collect();
+        match note {
+            None => assert!(notes.is_empty(), "{name}: {notes:?}"),
+            Some(text) => {
+                assert_eq!(notes.len(), 1, "{name}: {notes:?}");
+                assert!(notes[0].contains(text), "{name}: {}", notes[0]);
+                assert!(
+                    notes[0].contains("a.pbrt:5:"),
+                    "the file and line: {}",
+                    notes[0]
+                );
+            }
+        }
+    }
+}

@@ -67,7 +67,21 @@ impl Builder {
                 self.desc.hints.sampler = Some(match kind.as_str() {
                     "independent" => SamplerKind::Independent,
                     "stratified" => SamplerKind::Stratified,
-                    _ => SamplerKind::Sobol,
+                    "sobol" => SamplerKind::Sobol,
+                    // pbrt-v4's other low-discrepancy samplers: another sequence, the same
+                    // image once converged.
+                    "zsobol" | "paddedsobol" | "halton" | "pmj02bn" => {
+                        self.warn(format!(
+                            "Sampler \"{kind}\": rendered with the Sobol sampler (other noise, the same image)"
+                        ));
+                        SamplerKind::Sobol
+                    }
+                    other => {
+                        self.warn(format!(
+                            "Sampler \"{other}\": not a pbrt-v4 sampler; the Sobol sampler renders the scene"
+                        ));
+                        SamplerKind::Sobol
+                    }
                 });
                 for p in ["seed", "randomization", "jitter", "xsamples", "ysamples"] {
                     params.get(p);
