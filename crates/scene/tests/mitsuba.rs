@@ -397,3 +397,53 @@ fn a_rough_dielectric_with_two_roughnesses_or_a_textured_one_is_read_as_such() {
         MaterialDesc::RoughGlass { alpha_u, alpha_v, .. }
             if constant(alpha_u).is_none() && alpha_u == alpha_v)));
 }
+
+#[test]
+fn samplers_pathlab_lacks_are_rendered_by_its_nearest_with_a_note() {
+    let text = std::fs::read_to_string(scene_xml()).unwrap();
+    assert!(text.contains(r#"<sampler type="independent">"#));
+    for (plugin, kind, note) in [
+        ("independent", SamplerKind::Independent, None),
+        ("stratified", SamplerKind::Stratified, None),
+        // What `pathlab export` writes for Sobol: read back without a note.
+        ("ldsampler", SamplerKind::Sobol, None),
+        (
+            "multijitter",
+            SamplerKind::Stratified,
+            Some("rendered with the stratified sampler"),
+        ),
+        (
+            "orthogonal",
+            SamplerKind::Sobol,
+            Some("rendered with the Sobol sampler"),
+        ),
+        (
+            "halton",
+            SamplerKind::Sobol,
+            Some("not a Mitsuba 3 sampler"),
+        ),
+    ] {
+        let file = write(
+            &format!("sampler-{plugin}.xml"),
+            &text.replace(
+                r#"<sampler type="independent">"#,
+                &format!(r#"<sampler type="{plugin}">"#),
+            ),
+        );
+        let desc = mitsuba::load(&file).unwrap();
+        assert_eq!(desc.hints.sampler, Some(kind), "{plugin}");
+        assert_eq!(desc.hints.spp, Some(256), "{plugin}");
+        match note {
+            None => assert!(desc.warnings.is_empty(), "{plugin}: {:?}", desc.warnings),
+            Some(text) => {
+                assert_eq!(desc.warnings.len(), 1, "{plugin}: {:?}", desc.warnings);
+                let w = &desc.warnings[0];
+                assert!(w.contains(text) && w.contains(plugin), "{plugin}: {w}");
+                assert!(
+                    w.contains(&format!("sampler-{plugin}.xml:")),
+                    "the file: {w}"
+                );
+            }
+        }
+    }
+}

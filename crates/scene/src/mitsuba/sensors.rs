@@ -94,11 +94,29 @@ pub(super) fn sensor(ctx: &mut Ctx, s: Obj) -> Result<(), Error> {
             }
             ctx.desc.hints.spp = Some(n as u32);
         }
-        ctx.desc.hints.sampler = Some(match sampler.plugin {
-            "independent" => SamplerKind::Independent,
-            "stratified" | "multijitter" => SamplerKind::Stratified,
-            _ => SamplerKind::Sobol,
-        });
+        // `ldsampler` (a (0, 2)-sequence) is what `pathlab export` writes for Sobol.
+        let (kind, note) = match sampler.plugin {
+            "independent" => (SamplerKind::Independent, None),
+            "stratified" => (SamplerKind::Stratified, None),
+            "ldsampler" => (SamplerKind::Sobol, None),
+            "multijitter" => (
+                SamplerKind::Stratified,
+                Some("rendered with the stratified sampler (other noise, the same image)"),
+            ),
+            "orthogonal" => (
+                SamplerKind::Sobol,
+                Some("rendered with the Sobol sampler (other noise, the same image)"),
+            ),
+            _ => (
+                SamplerKind::Sobol,
+                Some("not a Mitsuba 3 sampler; the Sobol sampler renders the scene"),
+            ),
+        };
+        if let Some(note) = note {
+            let what = ctx.what(sampler);
+            ctx.warn(sampler.loc, format!("{what}: {note}"));
+        }
+        ctx.desc.hints.sampler = Some(kind);
         // Seeds and jitter settings give other noise, not another image.
         ctx.accept(sampler, &["seed", "jitter", "scramble", "dimension"]);
     }
