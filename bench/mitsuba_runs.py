@@ -145,7 +145,7 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None, ref
         # The error ratio had pathlab used exactly Mitsuba's time: a Monte Carlo image's RMSE
         # falls as 1/sqrt(time), so a render that overran the budget by a factor k is scaled
         # up by sqrt(k) (the reference's own error being small against both).
-        "rmse_ratio_at_budget": ratio * (secs / t_m) ** 0.5 if ratio is not None and t_m > 0
+        "rmse_ratio_at_budget": ratio * budget if ratio is not None and budget is not None
         else None,
         "reference_variance": ref_var, "rmse_ratio_net": net,
         "rmse_ratio_net_at_budget": net * budget if net is not None and budget is not None

@@ -74,6 +74,41 @@ pub enum Error {
     },
 }
 
+/// How a sampler named in a scene file maps onto pathlab's samplers.
+#[derive(Clone, Copy)]
+pub(crate) enum SamplerName {
+    /// One of pathlab's own (or what `pathlab export` writes for it).
+    Own,
+    /// One of the format's samplers that pathlab lacks; another one stands in.
+    StandIn,
+    /// None of the format's samplers.
+    Unknown,
+}
+
+/// What a loader of `format` says of a sampler its file names, where `kind` renders in its
+/// place: nothing for one of pathlab's own, a note that another sequence converging to the same
+/// image renders it otherwise.
+pub(crate) fn sampler_note(
+    kind: pathlab_render::mc::sampler::SamplerKind,
+    name: SamplerName,
+    format: &str,
+) -> Option<String> {
+    use pathlab_render::mc::sampler::SamplerKind;
+    let sampler = match kind {
+        SamplerKind::Sobol => "Sobol",
+        other => other.name(),
+    };
+    match name {
+        SamplerName::Own => None,
+        SamplerName::StandIn => Some(format!(
+            "rendered with the {sampler} sampler (other noise, the same image)"
+        )),
+        SamplerName::Unknown => Some(format!(
+            "not a {format} sampler; the {sampler} sampler renders the scene"
+        )),
+    }
+}
+
 /// `:line:column`, `:line` or nothing, as far as they are known (0: unknown).
 fn location(line: usize, column: usize) -> String {
     match (line, column) {

@@ -2,7 +2,7 @@
 //! `rfilter`) and sampler, and the integrator.
 
 use super::{Ctx, Obj};
-use crate::Error;
+use crate::{sampler_note, Error, SamplerName};
 use glam::{DVec3, Vec2};
 use pathlab_render::desc::*;
 use pathlab_render::mc::sampler::SamplerKind;
@@ -95,24 +95,15 @@ pub(super) fn sensor(ctx: &mut Ctx, s: Obj) -> Result<(), Error> {
             ctx.desc.hints.spp = Some(n as u32);
         }
         // `ldsampler` (a (0, 2)-sequence) is what `pathlab export` writes for Sobol.
-        let (kind, note) = match sampler.plugin {
-            "independent" => (SamplerKind::Independent, None),
-            "stratified" => (SamplerKind::Stratified, None),
-            "ldsampler" => (SamplerKind::Sobol, None),
-            "multijitter" => (
-                SamplerKind::Stratified,
-                Some("rendered with the stratified sampler (other noise, the same image)"),
-            ),
-            "orthogonal" => (
-                SamplerKind::Sobol,
-                Some("rendered with the Sobol sampler (other noise, the same image)"),
-            ),
-            _ => (
-                SamplerKind::Sobol,
-                Some("not a Mitsuba 3 sampler; the Sobol sampler renders the scene"),
-            ),
+        let (kind, name) = match sampler.plugin {
+            "independent" => (SamplerKind::Independent, SamplerName::Own),
+            "stratified" => (SamplerKind::Stratified, SamplerName::Own),
+            "ldsampler" => (SamplerKind::Sobol, SamplerName::Own),
+            "multijitter" => (SamplerKind::Stratified, SamplerName::StandIn),
+            "orthogonal" => (SamplerKind::Sobol, SamplerName::StandIn),
+            _ => (SamplerKind::Sobol, SamplerName::Unknown),
         };
-        if let Some(note) = note {
+        if let Some(note) = sampler_note(kind, name, "Mitsuba 3") {
             let what = ctx.what(sampler);
             ctx.warn(sampler.loc, format!("{what}: {note}"));
         }

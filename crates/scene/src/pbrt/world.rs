@@ -3,7 +3,7 @@
 
 use super::params::ParamList;
 use super::Builder;
-use crate::Error;
+use crate::{sampler_note, Error, SamplerName};
 use glam::{DMat4, DVec3, Vec2};
 use pathlab_render::desc::*;
 use pathlab_render::mc::sampler::SamplerKind;
@@ -64,25 +64,20 @@ impl Builder {
                     )));
                 }
                 self.desc.hints.spp = Some(n as u32);
-                self.desc.hints.sampler = Some(match kind.as_str() {
-                    "independent" => SamplerKind::Independent,
-                    "stratified" => SamplerKind::Stratified,
-                    "sobol" => SamplerKind::Sobol,
-                    // pbrt-v4's other low-discrepancy samplers: another sequence, the same
-                    // image once converged.
+                let (sampler, name) = match kind.as_str() {
+                    "independent" => (SamplerKind::Independent, SamplerName::Own),
+                    "stratified" => (SamplerKind::Stratified, SamplerName::Own),
+                    "sobol" => (SamplerKind::Sobol, SamplerName::Own),
+                    // pbrt-v4's other low-discrepancy samplers.
                     "zsobol" | "paddedsobol" | "halton" | "pmj02bn" => {
-                        self.warn(format!(
-                            "Sampler \"{kind}\": rendered with the Sobol sampler (other noise, the same image)"
-                        ));
-                        SamplerKind::Sobol
+                        (SamplerKind::Sobol, SamplerName::StandIn)
                     }
-                    other => {
-                        self.warn(format!(
-                            "Sampler \"{other}\": not a pbrt-v4 sampler; the Sobol sampler renders the scene"
-                        ));
-                        SamplerKind::Sobol
-                    }
-                });
+                    _ => (SamplerKind::Sobol, SamplerName::Unknown),
+                };
+                if let Some(note) = sampler_note(sampler, name, "pbrt-v4") {
+                    self.warn(format!("Sampler \"{kind}\": {note}"));
+                }
+                self.desc.hints.sampler = Some(sampler);
                 for p in ["seed", "randomization", "jitter", "xsamples", "ysamples"] {
                     params.get(p);
                 }
