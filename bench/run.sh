@@ -57,6 +57,26 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
         [ -e "$work/$scene.obj" ] || "$bench" obj "$root/tests/data/cs184/$scene.dae" "$work/$scene.obj" >/dev/null
         meshes+=("$scene")
     done
+    # `pathlab-bench` built as `pathlab` runs on this CPU (the AVX-512 or AVX2 build that
+    # deploy/build-variants.sh makes; Embree picks its AVX-512 or AVX2 kernels at run time
+    # too), unless PATHLAB_BENCH_BASELINE is set.
+    if [ -z "${PATHLAB_BENCH_BASELINE:-}" ] && [ "$(uname -m)" = x86_64 ]; then
+        host="$(rustc -vV | sed -n 's/^host: //p')"
+        for level in x86-64-v4 x86-64-v3; do
+            case $level in
+                x86-64-v4) need="avx512f avx512bw avx512dq avx512vl" ;;
+                *) need="avx2 fma bmi2 movbe" ;;
+            esac
+            ok=1
+            for flag in $need; do grep -qw "$flag" /proc/cpuinfo || ok=""; done
+            [ -n "$ok" ] || continue
+            RUSTFLAGS="-C target-cpu=$level" CARGO_TARGET_DIR="$root/target/variants/$level" \
+                cargo build --release --quiet -p pathlab-bench --features obvhs --target "$host"
+            bench="$root/target/variants/$level/$host/release/pathlab-bench"
+            break
+        done
+    fi
+    echo "rays: $bench"
     threads="$(nproc)"
     # Embree and pathlab take turns, PATHLAB_BENCH_REPS times (default 3) per mesh; the table
     # takes each rate's median, so that one disturbed run moves no ratio.

@@ -1,13 +1,14 @@
 //! Eight rays walking the tree together. The packet is bounded by one interval ray: per axis
 //! the extreme origins and the range of 1/d, whose slab test against a node's eight boxes
 //! costs about what one ray's does and bounds every ray's entry and exit distances (interval
-//! arithmetic; the rounded operations are monotone, so the bounds hold for the rounded
-//! distances each ray's own test computes). A child is visited when the interval ray meets
-//! it, nearest first, and a leaf is handed to the caller once for all eight. For rays that go
-//! the same way (the camera rays of one pixel, neighbouring primary rays) the walk, its stack
-//! and its branches are paid once instead of eight times; each ray still finds its own
-//! nearest hit, since the packet visits every box any of its rays would, and a ray that
-//! misses a box the packet enters only costs its lane of the leaf's tests.
+//! arithmetic; the rounded operations are monotone, so the bounds hold for each ray's
+//! distances computed as `(p - o) · (1/d)`, rounded and widened as pbrt-v4's slab test, which
+//! is conservative). A child is visited when the interval ray meets it, nearest first, and a
+//! leaf is handed to the caller once for all eight. For rays that go the same way (the camera
+//! rays of one pixel, neighbouring primary rays) the walk, its stack and its branches are paid
+//! once instead of eight times; each ray still finds its own nearest hit, since the packet
+//! visits every box any of its rays meets, and a ray that misses a box the packet enters only
+//! costs its lane of the leaf's tests.
 //!
 //! [`RayBoxLanes`] tests eight rays exactly against one box (the small scenes' block culling).
 
@@ -260,7 +261,6 @@ impl WideBvh<LANES> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::box_test::RayBoxes;
     use super::*;
     use crate::geometry::Ray;
     use glam::Vec3;
@@ -307,11 +307,35 @@ mod tests {
         l
     }
 
+    /// One ray's slab test with its distances as `(p - o) · (1/d)`, each operation rounded
+    /// (the far ones widened by [`FAR_SCALE`]): the arithmetic whose results the interval
+    /// ray bounds, conservative as pbrt-v4's test is. (The traversal of one ray computes its
+    /// distances with fused operations, [`super::super::box_test::RayBoxes`].)
+    fn slab_test(ray: &Ray, n: &Node<8>) -> ([f32; 8], u32) {
+        let t_min = if ray.t_min > 0.0 { ray.t_min } else { 0.0 };
+        let (mut t_near, mut t_far) = ([t_min; 8], [ray.t_max; 8]);
+        for axis in 0..3 {
+            let inv = 1.0 / ray.d[axis];
+            let upper = usize::from(ray.d[axis].is_sign_negative());
+            let (near, far) = (
+                &n.planes[axis + 3 * upper],
+                &n.planes[axis + 3 * (1 - upper)],
+            );
+            for lane in 0..8 {
+                let tn = (near[lane] - ray.o[axis]) * inv;
+                let tf = (far[lane] - ray.o[axis]) * (inv * FAR_SCALE);
+                t_near[lane] = if tn > t_near[lane] { tn } else { t_near[lane] };
+                t_far[lane] = if tf < t_far[lane] { tf } else { t_far[lane] };
+            }
+        }
+        (t_near, met_mask(&t_near, &t_far, n.valid))
+    }
+
     #[test]
     fn the_interval_ray_meets_every_box_a_ray_of_the_packet_meets() {
-        // Against random nodes of eight boxes: wherever one ray's own test (the traversal's)
-        // meets a box, the packet's test meets it too, with an entry bound at most that ray's
-        // entry distance. Packets whose directions differ in sign have no interval ray.
+        // Against random nodes of eight boxes: wherever one ray's slab test meets a box, the
+        // packet's test meets it too, with an entry bound at most that ray's entry distance.
+        // Packets whose directions differ in sign have no interval ray.
         let mut rng = Pcg32::new(11, 3);
         let (mut bounded, mut met, mut unmixed) = (0, 0, 0);
         for k in 0..4000 {
@@ -349,7 +373,7 @@ mod tests {
                 if active & (1 << i) == 0 {
                     continue;
                 }
-                let (t_near, own) = RayBoxes::new(ray).test(&node, ray.t_max);
+                let (t_near, own) = slab_test(ray, &node);
                 assert_eq!(
                     own & !mask,
                     0,

@@ -50,6 +50,108 @@ fn avx2_box_test_gives_the_portable_results_to_the_bit() {
     assert!(tested > 1000);
 }
 
+/// Whether `ray` meets the box `[lo, hi]` within its extent, at a distance below 10²⁰ (the
+/// box test takes direction components below 10⁻³⁰ as that size, which bounds the distances
+/// at which it is exact), computed in `f64` from the ray's `f32` values: exact but for the
+/// divisions' rounding (2⁻⁵³ of each distance), far below the box test's margins.
+fn meets_exactly(ray: &Ray, lo: Vec3, hi: Vec3) -> bool {
+    let (mut t0, mut t1) = (f64::from(ray.t_min.max(0.0)), f64::from(ray.t_max));
+    for axis in 0..3 {
+        let (o, d) = (f64::from(ray.o[axis]), f64::from(ray.d[axis]));
+        let (lo, hi) = (f64::from(lo[axis]), f64::from(hi[axis]));
+        if d == 0.0 {
+            if o < lo || o > hi {
+                return false;
+            }
+            continue;
+        }
+        let (a, b) = ((lo - o) / d, (hi - o) / d);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+    }
+    t0 <= t1 && t0 < 1e20
+}
+
+#[test]
+fn the_box_test_meets_every_box_the_ray_meets() {
+    // The fused distances p · (1/d) - o/d with o/d rounded away from the box: wherever the
+    // exact slab test meets a box, the box test does. Hard cases on purpose: origins on a
+    // box's planes, boxes of zero thickness, directions with zero, tiny and -0 components,
+    // rays starting at or ending on a box.
+    let mut rng = Pcg32::new(21, 5);
+    let (mut met, mut tested) = (0usize, 0usize);
+    for k in 0..20_000 {
+        let mut u = || rng.uniform_f32();
+        let mut node = Node::<8>::EMPTY;
+        let mut boxes = [(Vec3::ZERO, Vec3::ZERO); 8];
+        for (lane, b) in boxes.iter_mut().enumerate() {
+            let lo = Vec3::new(u(), u(), u()) * 8.0 - 4.0;
+            let mut size = Vec3::new(u(), u(), u()) * 2.0;
+            if u() < 0.3 {
+                // Flat on one axis, like the box of a wall.
+                size[(u() * 3.0) as usize % 3] = 0.0;
+            }
+            *b = (lo, lo + size);
+            node.set_bounds(lane, &Aabb { min: b.0, max: b.1 });
+            node.child[lane] = lane as u32;
+            node.valid |= 1 << lane;
+        }
+        // From a random point or from a plane of some box, mostly towards a point of some
+        // box (the origin's own, for a ray that starts on it).
+        let mut o = Vec3::new(u(), u(), u()) * 10.0 - 5.0;
+        if k % 2 == 0 {
+            let (lane, axis) = ((u() * 8.0) as usize % 8, (u() * 3.0) as usize % 3);
+            o[axis] = if u() < 0.5 {
+                boxes[lane].0[axis]
+            } else {
+                boxes[lane].1[axis]
+            };
+        }
+        let (to, a) = (&boxes[(u() * 8.0) as usize % 8], Vec3::new(u(), u(), u()));
+        let mut d = if k % 4 == 3 {
+            Vec3::new(u() - 0.5, u() - 0.5, u() - 0.5)
+        } else {
+            to.0 + (to.1 - to.0) * a - o
+        };
+        // One or two axes flat (zero, -0 or tiny components), along the target box's slab or
+        // one of its planes.
+        for axis in 0..3 {
+            if (k / 2 + axis) % 3 == 0 || u() < 0.1 {
+                o[axis] = match k % 3 {
+                    0 => to.0[axis],
+                    1 => to.1[axis],
+                    _ => to.0[axis] + (to.1[axis] - to.0[axis]) * a[axis],
+                };
+                d[axis] = match (u() * 4.0) as u32 {
+                    0 => 0.0,
+                    1 => -0.0,
+                    2 => 1e-35 * d[axis].signum(),
+                    _ => 1e-20 * d[axis].signum(),
+                };
+            }
+        }
+        let mut ray = Ray::new(o, d);
+        if u() < 0.3 {
+            ray.t_min = u() * 2.0;
+        }
+        if u() < 0.3 {
+            ray.t_max = u() * 6.0;
+        }
+        let (_, mask) = Portable.test(&RayBoxes::new(&ray), &node, ray.t_max);
+        for (lane, b) in boxes.iter().enumerate() {
+            if meets_exactly(&ray, b.0, b.1) {
+                assert!(
+                    mask & (1 << lane) != 0,
+                    "ray {k} ({ray:?}) meets box {lane} {b:?}, the test culls it"
+                );
+                met += 1;
+            }
+            tested += 1;
+        }
+    }
+    assert!(met > tested / 20, "only {met} of {tested} boxes met");
+}
+
 #[test]
 fn entry_distances_start_at_a_non_negative_t_min() {
     // Stack entries order by the bits of their distances, so the start must be +0 for
