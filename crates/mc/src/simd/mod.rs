@@ -1,6 +1,7 @@
 //! The one home of the project's SIMD: the lane types, the names of the widths, and the
 //! proof tokens of CPU extensions that run-time dispatch hands out.
 //!
+//! - [`trig`]: trigonometric functions written over [`lanes::Real`] ([`trig::atan2`]).
 //! - [`lanes`]: eight `f32` lanes ([`lanes::F8`], [`lanes::M8`], [`lanes::V8`]) and the
 //!   [`lanes::Real`] / [`lanes::Vector3`] traits, so that code written once runs on one value
 //!   or on eight, each lane to the bit as the one-value code.
@@ -15,6 +16,7 @@
 //!   two versions bit for bit.
 
 pub mod lanes;
+pub mod trig;
 
 /// Paths traced together by the eight-lane path and drawn together by the samplers' lane
 /// routines: one lane of [`lanes::F8`] each.
