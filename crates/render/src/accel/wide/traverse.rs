@@ -63,79 +63,88 @@ impl<const W: usize> WideBvh<W> {
             return (false, 0);
         }
         let rb = RayBoxes::new(ray);
+        // The root first: a ray that meets none of its boxes (one that leaves the scene)
+        // returns before the walk's own set-up, which the compiler places ahead of its loop.
+        let mut n = &self.nodes[0];
+        let (mut t_near, mut mask) = boxes.test(&rb, n, ray.t_max);
+        if mask == 0 {
+            return (false, 1);
+        }
         let mut stack = Stack::<u64, STACK_SIZE>::new();
-        let mut word = 0u32; // the root, an inner node
-        let mut visited = 0u32;
+        let mut visited = 1u32;
         let mut any = false;
         'walk: loop {
-            if word & LEAF == 0 {
-                visited += 1;
-                let n = &self.nodes[word as usize];
-                let (t_near, mut mask) = boxes.test(&rb, n, ray.t_max);
-                if mask != 0 {
-                    let next = |mask: &mut u32| {
-                        let lane = mask.trailing_zeros() as usize;
-                        *mask &= *mask - 1;
-                        stack_entry(n.child[lane], t_near[lane])
-                    };
-                    let a = next(&mut mask);
-                    if mask == 0 {
-                        word = a as u32;
-                        continue 'walk;
-                    }
-                    // Two or more: keep the farther ones on the stack, farthest deepest, and
-                    // go to the nearest (a sorting network, no branches on distances).
-                    let (a, b) = order(a, next(&mut mask));
-                    if mask == 0 {
-                        stack.push(b);
-                        word = a as u32;
-                        continue 'walk;
-                    }
-                    let c = next(&mut mask);
-                    if mask == 0 {
-                        let (b, c) = order(b, c);
-                        let (a, b) = order(a, b);
-                        stack.push(c);
-                        stack.push(b);
-                        word = a as u32;
-                        continue 'walk;
-                    }
-                    let (c, d) = order(c, next(&mut mask));
-                    let (a, c) = order(a, c);
-                    let (b, d) = order(b, d);
-                    let (b, c) = order(b, c);
-                    if mask == 0 {
-                        stack.push(d);
-                        stack.push(c);
-                        stack.push(b);
-                        word = a as u32;
-                        continue 'walk;
-                    }
-                    // More than four (eight-wide nodes): push them all and sort the pushed
-                    // entries, farthest deepest, by insertion.
-                    let base = stack.len();
-                    for e in [a, b, c, d] {
-                        stack.push(e);
-                    }
-                    while mask != 0 {
-                        stack.push(next(&mut mask));
-                    }
-                    stack.sort_descending_from(base);
-                    // The nearest is on top now (the stack holds at least the four pushed).
-                    word = stack.pop().unwrap_or(a) as u32;
-                    continue 'walk;
+            // `n`'s children in `mask` (at least one) at entry distances `t_near`: the nearest
+            // is next, the others wait on the stack, farthest deepest (a sorting network, no
+            // branches on distances).
+            let next = |mask: &mut u32| {
+                let lane = mask.trailing_zeros() as usize;
+                *mask &= *mask - 1;
+                stack_entry(n.child[lane], t_near[lane])
+            };
+            let mut word = 'pick: {
+                let a = next(&mut mask);
+                if mask == 0 {
+                    break 'pick a as u32;
                 }
-            } else {
-                any |= leaf(word, ray);
-            }
-            // Next: the nearest kept entry that can still hold a closer hit.
+                let (a, b) = order(a, next(&mut mask));
+                if mask == 0 {
+                    stack.push(b);
+                    break 'pick a as u32;
+                }
+                let c = next(&mut mask);
+                if mask == 0 {
+                    let (b, c) = order(b, c);
+                    let (a, b) = order(a, b);
+                    stack.push(c);
+                    stack.push(b);
+                    break 'pick a as u32;
+                }
+                let (c, d) = order(c, next(&mut mask));
+                let (a, c) = order(a, c);
+                let (b, d) = order(b, d);
+                let (b, c) = order(b, c);
+                if mask == 0 {
+                    stack.push(d);
+                    stack.push(c);
+                    stack.push(b);
+                    break 'pick a as u32;
+                }
+                // More than four (eight-wide nodes): push them all and sort the pushed
+                // entries, farthest deepest, by insertion.
+                let base = stack.len();
+                for e in [a, b, c, d] {
+                    stack.push(e);
+                }
+                while mask != 0 {
+                    stack.push(next(&mut mask));
+                }
+                stack.sort_descending_from(base);
+                // The nearest is on top now (the stack holds at least the four pushed).
+                stack.pop().unwrap_or(a) as u32
+            };
+            // Down to the next node some of whose boxes the ray meets, testing the leaves on
+            // the way; the nearest kept entry that can still hold a closer hit after each
+            // dead end.
             loop {
-                let Some(e) = stack.pop() else {
-                    break 'walk;
-                };
-                if f32::from_bits((e >> 32) as u32) <= ray.t_max {
-                    word = e as u32;
-                    continue 'walk;
+                if word & LEAF == 0 {
+                    visited += 1;
+                    n = &self.nodes[word as usize];
+                    (t_near, mask) = boxes.test(&rb, n, ray.t_max);
+                    if mask != 0 {
+                        continue 'walk;
+                    }
+                } else {
+                    any |= leaf(word, ray);
+                }
+                loop {
+                    let Some(e) = stack.pop() else {
+                        break 'walk;
+                    };
+                    if f32::from_bits((e >> 32) as u32) <= ray.t_max {
+                        word = e as u32;
+                        break;
+                    }
                 }
             }
         }
@@ -161,11 +170,14 @@ impl<const W: usize> WideBvh<W> {
             return false;
         }
         let rb = RayBoxes::new(ray);
+        // The root first, as in the nearest-hit walk.
+        let mut n = &self.nodes[0];
+        let (_, mut mask) = boxes.test(&rb, n, ray.t_max);
+        if mask == 0 {
+            return false;
+        }
         let mut stack = Stack::<u32, STACK_SIZE>::new();
-        let mut node = 0u32;
         loop {
-            let n = &self.nodes[node as usize];
-            let (_, mut mask) = boxes.test(&rb, n, ray.t_max);
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -177,7 +189,10 @@ impl<const W: usize> WideBvh<W> {
                 }
             }
             match stack.pop() {
-                Some(next) => node = next,
+                Some(next) => {
+                    n = &self.nodes[next as usize];
+                    mask = boxes.test(&rb, n, ray.t_max).1;
+                }
                 None => return false,
             }
         }
