@@ -30,9 +30,9 @@ const MIN_DIRECTION: f32 = 1e-30;
 /// The bound on the rounding of `o/d` is relative, so it holds where `o/d` and `o` are normal
 /// numbers or zero; an origin coordinate in `f32`'s subnormal range (below 2⁻¹²⁶ in size, not
 /// zero) can put a plane's distance 2⁻¹⁴⁹ on the wrong side. The portable test rounds once
-/// as the fused instruction does (`f32::mul_add`), which on an x86-64 CPU without FMA (before
-/// 2013) is a library call; such CPUs have no AVX2 either, the only case in which the
-/// renderer runs the portable test.
+/// as the fused instruction does (`f32::mul_add`): one instruction on other architectures
+/// (AArch64 has it), a library call on an x86-64 CPU without FMA (before 2013), which has no
+/// AVX2 either and so is the one x86-64 CPU on which the renderer runs the portable test.
 #[doc(hidden)]
 pub struct RayBoxes {
     /// Where entry distances start: the ray's `t_min` (+0 if not positive, -0 and NaN
