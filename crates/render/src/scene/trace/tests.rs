@@ -320,7 +320,8 @@ fn every_primitive_agrees_with_the_bvh(scene: &Scene, seed: u64) -> (usize, usiz
             spheres += usize::from(matches!(scene.prims[hit.0 as usize].get(), Prim::Sphere(_)));
             // Rays aimed at the boxes' corners and edges meet several triangles at one
             // distance, and which of them each search reports depends on the order it tests
-            // them in: ties, counted only elsewhere.
+            // them in: their ties (still checked to be at exactly one distance) are not
+            // counted.
             let at_edge = k % 2 == 1 && (k + i) % 3 != 0;
             ties += usize::from(is_tie(scene, ray, hit, &bvh) && !at_edge);
         }
