@@ -62,14 +62,10 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
     # too), unless PATHLAB_BENCH_BASELINE is set.
     if [ -z "${PATHLAB_BENCH_BASELINE:-}" ] && [ "$(uname -m)" = x86_64 ]; then
         host="$(rustc -vV | sed -n 's/^host: //p')"
+        # shellcheck source=deploy/x86-levels.sh
+        source "$root/deploy/x86-levels.sh"
         for level in x86-64-v4 x86-64-v3; do
-            case $level in
-                x86-64-v4) need="avx512f avx512bw avx512dq avx512vl" ;;
-                *) need="avx2 fma bmi2 movbe" ;;
-            esac
-            ok=1
-            for flag in $need; do grep -qw "$flag" /proc/cpuinfo || ok=""; done
-            [ -n "$ok" ] || continue
+            [ -z "$(x86_level_missing "$level")" ] || continue
             RUSTFLAGS="-C target-cpu=$level" CARGO_TARGET_DIR="$root/target/variants/$level" \
                 cargo build --release --quiet -p pathlab-bench --features obvhs --target "$host"
             bench="$root/target/variants/$level/$host/release/pathlab-bench"

@@ -81,12 +81,10 @@ fi
 host="$(rustc -vV | sed -n 's/^host: //p')"
 # The extensions whose absence rules a level out at once, before a build that could not be
 # checked (the variant's own test of its level, `--version` below, is the one that counts).
-declare -A needs=([x86-64-v3]="avx2 fma bmi2 movbe" [x86-64-v4]="avx512f avx512bw avx512dq avx512vl")
+# shellcheck source=deploy/x86-levels.sh
+source "$root/deploy/x86-levels.sh"
 for level in x86-64-v3 x86-64-v4; do
-    missing=""
-    for flag in ${needs[$level]}; do
-        grep -qw "$flag" /proc/cpuinfo 2>/dev/null || missing="$missing $flag"
-    done
+    missing="$(x86_level_missing "$level")"
     if [ -n "$missing" ]; then
         echo "build-variants: this CPU lacks$missing: $level not built"
         rm -f "$root/target/release/pathlab-$level"
