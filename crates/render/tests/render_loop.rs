@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use glam::{DVec3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::desc::{MeshDesc, SceneDesc};
+use pathlab_render::desc::{EnvironmentMapDesc, MeshDesc, SceneDesc};
 use pathlab_render::film::Film;
 use pathlab_render::integrator::{BdptIntegrator, IntegratorKind};
 use pathlab_render::render::{render, RenderSettings};
@@ -121,6 +121,27 @@ fn crowded(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` under an environment map with a bright spot (the lanes look up the rays that leave
+/// the scene together).
+fn under_a_sky(mut desc: SceneDesc) -> SceneDesc {
+    let (width, height) = (16, 9);
+    let texels = (0..width * height)
+        .map(|k| {
+            let spot = if k == 2 * width + 5 { 40.0 } else { 0.0 };
+            Vec3::new(0.2 + (k % 3) as f32 * 0.1, 0.3, 0.4 + spot)
+        })
+        .collect();
+    desc.environment_map = Some(EnvironmentMapDesc {
+        source: "test sky".into(),
+        width,
+        height,
+        texels: std::sync::Arc::new(texels),
+        to_world: glam::Mat3::from_rotation_y(0.3),
+        scale: 1.0,
+    });
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -135,6 +156,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         (mixed_scene(), false),
         (crowded(mixed_scene()), true),
         (big_light(), false),
+        (under_a_sky(mixed_scene()), false),
+        (crowded(under_a_sky(mixed_scene())), true),
     ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);

@@ -1,6 +1,7 @@
 //! Trigonometric functions written once over [`Real`], so that one `f32` and eight lanes
 //! compute the same bits, and faster than the C library's where the renderer calls them
-//! often: [`atan2`] (an environment map's u of a direction).
+//! often: [`atan2`] and [`acos`] (an environment map's (u, v) of a direction) and
+//! [`sin_cos_turns`] (the direction of an environment map's (u, v)).
 
 use super::lanes::Real;
 use std::f32::consts::{FRAC_PI_2, PI};
@@ -41,6 +42,89 @@ pub fn atan2<R: Real>(y: R, x: R) -> R {
     let a = R::select(steep, R::splat(FRAC_PI_2) - a, a);
     let a = R::select(x.lt(zero), R::splat(PI) - a, a);
     a * y.sign_one()
+}
+
+/// asin(s) = s + s z A(z), z = s², on [0, ½]: A's coefficients, lowest first, a minimax fit
+/// of the relative error (Lawson's weighted least squares, in `f64`; 4.8e-9 before rounding
+/// to `f32`, 0.61 units in the last place evaluated in `f32`).
+const ASIN: [f32; 5] = [
+    0.166_667_52,
+    0.074_952_975,
+    0.045_470_376,
+    0.024_179_518,
+    0.042_166_304,
+];
+
+/// The angle whose cosine is `y`, in [0, π], as `f32::acos` (within 2 units in the last place;
+/// NaN for |y| > 1 and NaN). Branch-free: asin of |y| (at most ½) or of √((1 - |y|)/2) (from
+/// ½ to 1, where acos |y| = 2 asin √((1 - |y|)/2), the difference and the halving exact) by
+/// the polynomial [`ASIN`], then acos y = π/2 - asin y, or π - acos |y| for y < -½.
+#[inline(always)]
+pub fn acos<R: Real>(y: R) -> R {
+    let a = y.abs();
+    let far = a.gt(R::splat(0.5));
+    let z = R::select(far, (R::splat(1.0) - a) * R::splat(0.5), y * y);
+    let s = R::select(far, z.sqrt(), a);
+    let mut p = R::splat(ASIN[4]);
+    for &c in ASIN[..4].iter().rev() {
+        p = p * z + R::splat(c);
+    }
+    let asin = s + s * z * p;
+    let near_zero = R::splat(FRAC_PI_2) - asin * y.sign_one();
+    let twice = asin + asin;
+    let near_one = R::select(y.lt(R::splat(0.0)), R::splat(PI) - twice, twice);
+    R::select(far, near_one, near_zero)
+}
+
+/// sin(πr/2) = r S(r²) on [-½, ½]: S's coefficients, lowest first, a minimax fit of the
+/// relative error (Lawson's weighted least squares, in `f64`; 3.3e-9 before rounding to
+/// `f32`).
+const SIN_QUARTER: [f32; 4] = [1.570_796_4, -0.645_963_5, 0.079_680_03, -0.004_601_661];
+
+/// cos(πr/2) = C(r²) on [-½, ½], as [`SIN_QUARTER`] (5.6e-11 before rounding).
+const COS_QUARTER: [f32; 5] = [
+    1.0,
+    -1.233_700_5,
+    0.253_669_17,
+    -0.020_859_936,
+    0.000_903_363_4,
+];
+
+/// 1.5 · 2²³: adding and subtracting it rounds an `f32` of magnitude below 2²² to the nearest
+/// whole number (ties to even).
+const ROUND: f32 = 12_582_912.0;
+
+/// (sin 2πx, cos 2πx) of `x` turns, |x| < 2²⁰ (NaN beyond), within 2 units in the last
+/// place. The reduction is exact: 4x less the nearest whole number q is r in [-½, ½], so
+/// that 2πx = qπ/2 + rπ/2, and the quadrant q mod 4 swaps and negates sin(rπ/2) and
+/// cos(rπ/2), each a polynomial ([`SIN_QUARTER`], [`COS_QUARTER`]). Branch-free.
+#[inline(always)]
+pub fn sin_cos_turns<R: Real>(x: R) -> (R, R) {
+    let round = |y: R| (y + R::splat(ROUND)) - R::splat(ROUND);
+    let four_x = x * R::splat(4.0);
+    let q = round(four_x);
+    // Exact: q is within ½ of 4x, so either q = 0 or 4x lies in [q/2, 2q] (Sterbenz).
+    let r = four_x - q;
+    // m = q mod 4, exactly (q/4 and its floor are exact).
+    let h = q * R::splat(0.25);
+    let f = round(h);
+    let f = R::select(f.gt(h), f - R::splat(1.0), f);
+    let m = q - f * R::splat(4.0);
+    // The polynomials by Estrin's scheme (pairs of terms, then pairs of pairs), whose chain
+    // of dependent operations is shorter than Horner's.
+    let (r2, k) = (r * r, |i: f32| R::splat(i));
+    let r4 = r2 * r2;
+    let [s0, s1, s2, s3] = SIN_QUARTER;
+    let s = r * ((k(s0) + k(s1) * r2) + r4 * (k(s2) + k(s3) * r2));
+    let [c0, c1, c2, c3, c4] = COS_QUARTER;
+    let c = (k(c0) + k(c1) * r2) + r4 * ((k(c2) + k(c3) * r2) + r4 * k(c4));
+    // Quadrant 1: (cos, -sin); 2: (-sin, -cos); 3: (-cos, sin).
+    let (one, two) = (R::splat(1.0), R::splat(2.0));
+    let odd = m.equals(one) | m.equals(R::splat(3.0));
+    let (sin, cos) = (R::select(odd, c, s), R::select(odd, s, c));
+    let sin = R::select(m.gt(R::splat(1.5)), -sin, sin);
+    let cos = R::select(m.equals(one) | m.equals(two), -cos, cos);
+    (sin, cos)
 }
 
 #[cfg(test)]
@@ -103,6 +187,110 @@ mod tests {
             let lanes = atan2(y, x);
             for l in 0..8 {
                 assert_eq!(lanes.0[l].to_bits(), atan2(y.0[l], x.0[l]).to_bits());
+            }
+        }
+    }
+
+    #[test]
+    fn sin_cos_turns_is_within_two_units_in_the_last_place() {
+        let mut worst = 0.0f64;
+        let mut rng = crate::rng::Pcg32::new(11, 5);
+        // Every quarter's edges and their neighbours, then a fine sweep and random turns.
+        let mut xs: Vec<f32> = (-8..=8).map(|k| k as f32 / 8.0).collect();
+        xs.extend(xs.clone().iter().flat_map(|x| [x.next_up(), x.next_down()]));
+        xs.extend((0..400_000).map(|k| (k as f32 + 0.5) / 200_000.0 - 1.0));
+        xs.extend((0..100_000).map(|_| rng.uniform_f32() * 64.0 - 32.0));
+        xs.extend([1e-30, -1e-30, 1e-8, 3e-5, 1000.37]);
+        for x in xs {
+            // The reference in f64, from the nearest quarter turn (taken off exactly), so that
+            // it is exact to its own rounding at the quarters too (cos π/2 in f64 is 6e-17).
+            let four = 4.0 * f64::from(x);
+            let q = four.round();
+            let (rs, rc) = ((four - q) * std::f64::consts::FRAC_PI_2).sin_cos();
+            let (exact_s, exact_c) = match (q as i64).rem_euclid(4) {
+                0 => (rs, rc),
+                1 => (rc, -rs),
+                2 => (-rs, -rc),
+                _ => (-rc, rs),
+            };
+            let (s, c) = sin_cos_turns(x);
+            // Against the exact value, in units of the exact value's last place (a zero's
+            // neighbours are measured against the smallest normal's).
+            let (es, ec) = (ulps(s, exact_s), ulps(c, exact_c));
+            worst = worst.max(es).max(ec);
+            assert!(
+                es <= 2.0 && ec <= 2.0,
+                "x = {x}: ({s}, {c}) vs ({exact_s}, {exact_c})"
+            );
+        }
+        assert!(worst > 0.5, "the comparison measures something ({worst})");
+    }
+
+    #[test]
+    fn sin_cos_turns_is_exact_at_the_quarters_and_nan_beyond_its_range() {
+        for (x, s, c) in [
+            (0.0f32, 0.0f32, 1.0f32),
+            (0.25, 1.0, 0.0),
+            (0.5, 0.0, -1.0),
+            (0.75, -1.0, 0.0),
+            (1.0, 0.0, 1.0),
+            (-0.25, -1.0, 0.0),
+        ] {
+            assert_eq!(sin_cos_turns(x), (s, c), "x = {x}");
+        }
+        for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let (s, c) = sin_cos_turns(x);
+            assert!(s.is_nan() && c.is_nan(), "x = {x}");
+        }
+    }
+
+    #[test]
+    fn sin_cos_turns_in_eight_lanes_gives_the_one_value_bits() {
+        let mut rng = crate::rng::Pcg32::new(5, 9);
+        for _ in 0..10_000 {
+            let x = F8(std::array::from_fn(|_| (rng.uniform_f32() - 0.5) * 6.0));
+            let (s, c) = sin_cos_turns(x);
+            for l in 0..8 {
+                let (s1, c1) = sin_cos_turns(x.0[l]);
+                assert_eq!(
+                    (s.0[l].to_bits(), c.0[l].to_bits()),
+                    (s1.to_bits(), c1.to_bits())
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn acos_is_within_two_units_in_the_last_place() {
+        let mut worst = 0.0f64;
+        let mut ys: Vec<f32> = vec![-1.0, -0.5, -0.0, 0.0, 0.5, 1.0, 1e-30, -1e-30];
+        ys.extend(ys.clone().iter().flat_map(|y| [y.next_up(), y.next_down()]));
+        ys.extend((0..=1_000_000).map(|k| k as f32 / 500_000.0 - 1.0));
+        for y in ys.into_iter().filter(|y| y.abs() <= 1.0) {
+            let exact = f64::from(y).acos();
+            let got = acos(y);
+            worst = worst.max(ulps(got, exact));
+            assert!(
+                ulps(got, exact) <= 2.0,
+                "acos({y}) = {got}, exactly {exact}"
+            );
+        }
+        assert!(worst > 0.5, "the comparison measures something ({worst})");
+        assert_eq!((acos(1.0f32), acos(-1.0f32)), (0.0, PI));
+        assert_eq!((acos(0.0f32), acos(-0.0f32)), (FRAC_PI_2, FRAC_PI_2));
+        for y in [1.0f32.next_up(), -2.0, f32::NAN, f32::INFINITY] {
+            assert!(acos(y).is_nan(), "acos({y})");
+        }
+    }
+
+    #[test]
+    fn acos_in_eight_lanes_gives_the_one_value_bits() {
+        let mut rng = crate::rng::Pcg32::new(8, 1);
+        for _ in 0..10_000 {
+            let y = F8(std::array::from_fn(|_| rng.uniform_f32() * 2.0 - 1.0));
+            let lanes = acos(y);
+            for l in 0..8 {
+                assert_eq!(lanes.0[l].to_bits(), acos(y.0[l]).to_bits());
             }
         }
     }

@@ -403,11 +403,26 @@ pub(crate) fn emitted(
 /// 0 otherwise (a camera ray, a delta lobe's ray).
 #[inline]
 pub(crate) fn escaped(scene: &Scene, ray: &Ray, pdf_needed: bool) -> Option<(Rgb, f32)> {
+    escaped_looked_up(scene, ray, pdf_needed, None)
+}
+
+/// [`escaped`], where `looked_up` may hold the environment's radiance towards the ray and
+/// its density ([`Light::le_and_pdf_towards`]), found beforehand (by the eight-lane path, for
+/// several rays at once).
+#[inline]
+pub(crate) fn escaped_looked_up(
+    scene: &Scene,
+    ray: &Ray,
+    pdf_needed: bool,
+    looked_up: Option<(Rgb, f32)>,
+) -> Option<(Rgb, f32)> {
     let index = scene.environment()?;
     let light = &scene.lights()[index as usize];
     if !pdf_needed {
-        return Some((light.le_environment(ray.d), 0.0));
+        // (`le_and_pdf_towards` gives `le_environment`'s radiance, to the bit.)
+        let le = looked_up.map_or_else(|| light.le_environment(ray.d), |(le, _)| le);
+        return Some((le, 0.0));
     }
-    let (le, pdf) = light.le_and_pdf_towards(ray.d);
+    let (le, pdf) = looked_up.unwrap_or_else(|| light.le_and_pdf_towards(ray.d));
     Some((le, scene.light_sampler().pmf(index as usize) * pdf))
 }

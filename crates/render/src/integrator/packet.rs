@@ -28,6 +28,7 @@ use crate::accel::RayLanes;
 use crate::bsdf::Diffuse;
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
+use crate::light::envmap::EnvironmentMap;
 use crate::light::{AreaShape, Light, TriangleEmitter};
 use crate::scene::{Scene, SurfaceInteraction};
 use crate::simd::lanes::{F8, M8, V8, W};
@@ -179,16 +180,13 @@ impl PathIntegrator {
             }
             // Small scenes: every lane's ray against every primitive at once.
             let nearest = every_primitive.then(|| nearest_of_lanes(scene, &lanes, &mut rays));
-            // Trace every lane; scatter the ones at other materials now, and gather the
-            // Lambertian ones' inputs.
-            let mut lambert_lanes = 0u32;
+            // Trace every lane.
             for i in 0..W {
-                let Some(lane) = &mut lanes[i] else {
+                let Some(lane) = &lanes[i] else {
                     hits[i] = None;
                     continue;
                 };
-                let smp = &mut samplers[i];
-                let st = &mut lane.st;
+                let st = &lane.st;
                 // The surface interaction is made in place and read a field at a time.
                 stats.rays += 1;
                 match &nearest {
@@ -204,7 +202,20 @@ impl PathIntegrator {
                                 as u64
                     }
                 }
-                if !self.arrive(scene, st, hits[i].as_ref()) {
+            }
+            let escapes = look_up_escapes(scene, &lanes, &hits);
+            // Arrive; scatter the lanes at other materials than Lambertian ones now, and
+            // gather the Lambertian ones' inputs.
+            let mut lambert_lanes = 0u32;
+            for i in 0..W {
+                let Some(lane) = &mut lanes[i] else { continue };
+                let smp = &mut samplers[i];
+                let st = &mut lane.st;
+                let looked_up = escapes
+                    .as_ref()
+                    .filter(|e| e.active & (1 << i) != 0)
+                    .map(|e| (e.le.get(i), e.pdf.0[i]));
+                if !self.arrive_looked_up(scene, st, hits[i].as_ref(), looked_up) {
                     out(lane.tag, st.l * lane.weight);
                     lanes[i] = None;
                     hits[i] = None;
@@ -368,6 +379,65 @@ fn nearest_of_lanes(
         }
     }
     scene.nearest_of_rays(rays, t_max, coherent)
+}
+
+/// An environment map's radiance and density towards the rays of the lanes `active`, which
+/// left the scene.
+struct Escapes {
+    active: u32,
+    le: V8,
+    pdf: F8,
+}
+
+/// The environment map's radiance and density towards every lane's ray that left the scene,
+/// looked up together ([`EnvironmentMap::eval_and_pdf_lanes`]) where two or more did and the
+/// scene's environment is a map.
+fn look_up_escapes(
+    scene: &Scene,
+    lanes: &[Option<Lane>; W],
+    hits: &[Option<SurfaceInteraction>; W],
+) -> Option<Escapes> {
+    let index = scene.environment()?;
+    let Light::EnvironmentMap { map, .. } = &scene.lights()[index as usize] else {
+        return None;
+    };
+    let mut w = V8::default();
+    let mut active = 0u32;
+    for (i, (lane, hit)) in lanes.iter().zip(hits).enumerate() {
+        if let (Some(lane), None) = (lane, hit) {
+            w.set(i, lane.st.ray.d);
+            active |= 1 << i;
+        }
+    }
+    if active.count_ones() < 2 {
+        return None;
+    }
+    let (le, pdf) = eval_and_pdf_lanes(map, w, active);
+    Some(Escapes { active, le, pdf })
+}
+
+/// [`EnvironmentMap::eval_and_pdf_lanes`] on the best vector unit this CPU has.
+fn eval_and_pdf_lanes(map: &EnvironmentMap, w: V8, active: u32) -> (V8, F8) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx2) = crate::simd::Avx2::detect() {
+        // SAFETY: `eval_and_pdf_lanes_avx2` requires AVX2 and FMA, which `avx2` proves this
+        // CPU has. Its body is safe code.
+        return unsafe { eval_and_pdf_lanes_avx2(avx2, map, w, active) };
+    }
+    map.eval_and_pdf_lanes(w, active)
+}
+
+/// [`EnvironmentMap::eval_and_pdf_lanes`] compiled for AVX2 (the same bits: Rust does not fuse
+/// a product and a sum into one FMA).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn eval_and_pdf_lanes_avx2(
+    _: crate::simd::Avx2,
+    map: &EnvironmentMap,
+    w: V8,
+    active: u32,
+) -> (V8, F8) {
+    map.eval_and_pdf_lanes(w, active)
 }
 
 /// Lane `i`'s light choice from `u_select`: an emitting triangle's data go to the lane of `a`

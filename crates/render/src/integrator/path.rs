@@ -3,7 +3,7 @@
 //! sampling ([`PathLighting`]), then Russian roulette.
 
 use super::{
-    emitted, escaped, li_one_at_a_time, power_heuristic, sample_light, trace, Integrator,
+    emitted, escaped_looked_up, li_one_at_a_time, power_heuristic, sample_light, trace, Integrator,
     PathStats, SampleRef,
 };
 use crate::desc::{RayKind, Rgb};
@@ -182,9 +182,23 @@ impl PathIntegrator {
         st: &mut PathState,
         hit: Option<&SurfaceInteraction>,
     ) -> bool {
+        self.arrive_looked_up(scene, st, hit, None)
+    }
+
+    /// [`PathIntegrator::arrive`], where `looked_up` may hold the environment's radiance and
+    /// density towards a ray that left the scene, found beforehand (see
+    /// [`super::escaped_looked_up`]).
+    #[inline]
+    pub(crate) fn arrive_looked_up(
+        &self,
+        scene: &Scene,
+        st: &mut PathState,
+        hit: Option<&SurfaceInteraction>,
+        looked_up: Option<(Rgb, f32)>,
+    ) -> bool {
         let Some(si) = hit else {
             let pdf_needed = self.weighs_by_light_pdf(st.prev.as_ref());
-            if let Some(found) = escaped(scene, &st.ray, pdf_needed) {
+            if let Some(found) = escaped_looked_up(scene, &st.ray, pdf_needed, looked_up) {
                 self.add_found_light(st, found);
             }
             return false;

@@ -12,10 +12,12 @@
 //! radiance inside it) times ∫ sin θ over its rows, so the density per solid angle,
 //! p(ω) = p(u, v) / (2π² sin θ), follows the radiance and small bright suns are found.
 
-use crate::color::luminance;
+use crate::color::{luminance, LUMINANCE_WEIGHTS};
 use crate::desc::Rgb;
 use glam::{Mat3, Vec2, Vec3};
 use pathlab_mc::distribution::PiecewiseConstant2D;
+use pathlab_mc::simd::lanes::{Real, Vector3, F8, V8, W};
+use pathlab_mc::simd::trig::{acos, atan2, sin_cos_turns};
 use std::f32::consts::{PI, TAU};
 
 /// An environment map ready to evaluate and sample.
@@ -145,57 +147,108 @@ impl EnvironmentMap {
         Self::uv_to_direction(uv).0
     }
 
-    /// (u, v) of a local direction.
-    fn direction_to_uv(d: Vec3) -> Vec2 {
-        // The project's atan2, written over `Real` for the lanes; one call costs about two
-        // thirds of the C library's `atan2f` (5.4 against 8.1 ns on Zen 5).
-        let u = pathlab_mc::simd::trig::atan2(d.x, -d.z) / TAU;
-        Vec2::new(wrap_u(u), d.y.clamp(-1.0, 1.0).acos() / PI)
-    }
-
     /// The local direction of (u, v), and sin θ.
     pub fn uv_to_direction(uv: Vec2) -> (Vec3, f32) {
-        let (sin_t, cos_t) = (uv.y * PI).sin_cos();
-        let (sin_p, cos_p) = (uv.x * TAU).sin_cos();
+        direction_of_uv(uv.x, uv.y)
+    }
+
+    /// Grid coordinates (x in [0, W), y in [0, H - 1]) of (u, v), for one value or lanes.
+    #[inline(always)]
+    fn grid<R: Real>(&self, u: R, v: R) -> (R, R) {
         (
-            Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t),
-            sin_t.max(0.0),
+            wrap_u(u - R::splat(self.half_texel)) * R::splat(self.width as f32),
+            v * R::splat((self.height - 1) as f32),
         )
     }
 
-    /// Grid coordinates (x in [0, W), y in [0, H - 1]) of (u, v).
-    fn grid(&self, uv: Vec2) -> Vec2 {
-        Vec2::new(
-            wrap_u(uv.x - self.half_texel) * self.width as f32,
-            uv.y * (self.height - 1) as f32,
-        )
+    /// The cell of grid coordinates (`gx`, `gy`): its corner texels' indices, (x0, y0), (x1, y0),
+    /// (x0, y0 + 1), (x1, y0 + 1), where the point lies between its columns and between its
+    /// rows, and its row y0. The same products and truncations pick the cell the distribution
+    /// finds for (u, v).
+    #[inline(always)]
+    fn cell_at(&self, gx: f32, gy: f32) -> ([usize; 4], f32, f32, usize) {
+        let x0 = (gx as usize).min(self.width - 1);
+        let y0 = (gy as usize).min(self.height - 2);
+        let (fx, fy) = (gx - x0 as f32, (gy - y0 as f32).clamp(0.0, 1.0));
+        // The next column, wrapping around in u (a comparison, not an integer division).
+        let x1 = if x0 + 1 == self.width { 0 } else { x0 + 1 };
+        let (top, bottom) = (y0 * self.width, (y0 + 1) * self.width);
+        ([top + x0, top + x1, bottom + x0, bottom + x1], fx, fy, y0)
     }
 
     /// The four texels that (u, v) interpolates between, which are the corners of the cell the
-    /// distribution finds for (u, v) too (the same products and truncations pick its row and
-    /// column), and where (u, v) lies between them.
+    /// distribution finds for (u, v) too, and where (u, v) lies between them.
     #[inline]
     fn texels_around(&self, uv: Vec2) -> TexelCell {
-        let g = self.grid(uv);
-        let x0 = (g.x as usize).min(self.width - 1);
-        let y0 = (g.y as usize).min(self.height - 2);
-        let (fx, fy) = (g.x - x0 as f32, (g.y - y0 as f32).clamp(0.0, 1.0));
-        // The next column, wrapping around in u (a comparison, not an integer division).
-        let x1 = if x0 + 1 == self.width { 0 } else { x0 + 1 };
-        let at = |x: usize, y: usize| self.texels[y * self.width + x];
+        let (gx, gy) = self.grid(uv.x, uv.y);
+        let (corners, fx, fy, row) = self.cell_at(gx, gy);
         TexelCell {
-            corners: [at(x0, y0), at(x1, y0), at(x0, y0 + 1), at(x1, y0 + 1)],
+            corners: corners.map(|k| self.texels[k]),
             fx,
             fy,
-            row: y0,
+            row,
         }
     }
 
     /// The local direction of world direction `w`, and its (u, v).
     #[inline]
     fn local(&self, w: Vec3) -> (Vec3, Vec2) {
-        let d = (self.to_local * w).normalize_or_zero();
-        (d, Self::direction_to_uv(d))
+        let (d, u, v) = self.local_of(w);
+        (d, Vec2::new(u, v))
+    }
+
+    /// The local direction of world direction `w` and its (u, v), for one value or lanes:
+    /// `to_local · w` in glam's order of operations, normalised as glam's `normalize_or_zero`
+    /// does, u = atan2(x, -z) / 2π (mod 1) and v = acos y / π.
+    #[inline(always)]
+    fn local_of<V: Vector3>(&self, w: V) -> (V, V::R, V::R) {
+        let m = &self.to_local;
+        let d = V::splat(m.x_axis).scale(w.x())
+            + V::splat(m.y_axis).scale(w.y())
+            + V::splat(m.z_axis).scale(w.z());
+        let zero = V::R::splat(0.0);
+        let rcp = V::R::splat(1.0) / d.dot(d).sqrt();
+        let d = V::select(
+            rcp.is_finite() & rcp.gt(zero),
+            d.scale(rcp),
+            V::splat(Vec3::ZERO),
+        );
+        let u = atan2(d.x(), -d.z()) / V::R::splat(TAU);
+        let (one, y) = (V::R::splat(1.0), d.y());
+        let y = V::R::select(y.lt(-one), -one, V::R::select(y.gt(one), one, y));
+        (d, wrap_u(u), acos(y) / V::R::splat(PI))
+    }
+
+    /// [`EnvironmentMap::eval_and_pdf`] of the lanes `active` of `w`, each to the bit as one
+    /// direction at a time (the other lanes give zeros): the same functions on eight lanes,
+    /// the texels read lane by lane.
+    #[inline(always)]
+    pub fn eval_and_pdf_lanes(&self, w: V8, active: u32) -> (V8, F8) {
+        let (d, u, v) = self.local_of(w);
+        let (gx, gy) = self.grid(u, v);
+        let mut corners = [V8::default(); 4];
+        let (mut fx, mut fy, mut band) = (F8::splat(0.0), F8::splat(0.0), F8::splat(0.0));
+        for i in (0..W).filter(|i| active & (1 << i) != 0) {
+            let (at, x, y, row) = self.cell_at(gx.0[i], gy.0[i]);
+            for (c, k) in corners.iter_mut().zip(at) {
+                c.set(i, self.texels[k]);
+            }
+            (fx.0[i], fy.0[i], band.0[i]) = (x, y, self.bands[row]);
+        }
+        let pdf_uv = self.cell_pdf(cell_weight(corners, band));
+        (bilinear(corners, fx, fy), solid_angle_pdf(d, pdf_uv))
+    }
+
+    /// The density per unit (u, v) area of a cell of weight `weight`, for one value or lanes.
+    #[inline(always)]
+    fn cell_pdf<R: Real>(&self, weight: R) -> R {
+        let integral = self.distribution.integral();
+        if integral > 0.0 {
+            weight / R::splat(integral)
+        } else {
+            // A black map is sampled uniformly over the unit square.
+            R::splat(1.0)
+        }
     }
 
     /// Radiance arriving from world direction `w` (pointing into the environment).
@@ -211,14 +264,8 @@ impl EnvironmentMap {
         // than from the distribution's table (one lookup in memory instead of two; the same
         // number: the table holds the same weight of the same cell).
         let cell = self.texels_around(uv);
-        let integral = self.distribution.integral();
-        let pdf_uv = if integral > 0.0 {
-            cell_weight(cell.corners, self.bands[cell.row]) / integral
-        } else {
-            // A black map is sampled uniformly over the unit square.
-            1.0
-        };
-        (cell.radiance(), self.solid_angle_pdf(d, pdf_uv))
+        let pdf_uv = self.cell_pdf(cell_weight(cell.corners, self.bands[cell.row]));
+        (cell.radiance(), solid_angle_pdf(d, pdf_uv))
     }
 
     /// A world direction, its density per solid angle and the radiance from it.
@@ -263,19 +310,43 @@ impl EnvironmentMap {
     #[inline]
     fn pdf_local(&self, d: Vec3, uv: Vec2) -> f32 {
         let cell_uv = Vec2::new(wrap_u(uv.x - self.half_texel), uv.y);
-        self.solid_angle_pdf(d, self.distribution.pdf(cell_uv))
+        solid_angle_pdf(d, self.distribution.pdf(cell_uv))
     }
+}
 
-    /// The density per solid angle of local direction `d` whose density per unit (u, v)
-    /// area is `pdf_uv` (zero at the poles).
-    #[inline]
-    fn solid_angle_pdf(&self, d: Vec3, pdf_uv: f32) -> f32 {
-        let sin2 = d.x * d.x + d.z * d.z;
-        if sin2 <= 0.0 {
-            return 0.0;
-        }
-        pdf_uv / (2.0 * PI * PI * sin2.sqrt())
-    }
+/// The density per solid angle of local direction `d` whose density per unit (u, v) area is
+/// `pdf_uv` (zero at the poles), for one value or lanes.
+#[inline(always)]
+fn solid_angle_pdf<V: Vector3>(d: V, pdf_uv: V::R) -> V::R {
+    let sin2 = d.x() * d.x() + d.z() * d.z();
+    let zero = V::R::splat(0.0);
+    V::R::select(
+        sin2.le(zero),
+        zero,
+        pdf_uv / (V::R::splat(2.0 * PI * PI) * sin2.sqrt()),
+    )
+}
+
+/// The bilinear interpolation of a cell's corner radiances (x0, y0), (x1, y0), (x0, y0 + 1),
+/// (x1, y0 + 1) at (`fx`, `fy`) between its columns and rows, for one value or lanes.
+#[inline(always)]
+fn bilinear<V: Vector3>(c: [V; 4], fx: V::R, fy: V::R) -> V {
+    let one = V::R::splat(1.0);
+    let top = c[0].scale(one - fx) + c[1].scale(fx);
+    let bottom = c[2].scale(one - fx) + c[3].scale(fx);
+    top.scale(one - fy) + bottom.scale(fy)
+}
+
+/// The local direction of (u, v), and sin θ, written once for one value and for lanes: θ = πv
+/// and φ = 2πu, their sines and cosines by [`sin_cos_turns`] (v/2 and u turns; v/2 is exact).
+#[inline(always)]
+fn direction_of_uv<R: Real>(u: R, v: R) -> (R::V3, R) {
+    let (sin_t, cos_t) = sin_cos_turns(v * R::splat(0.5));
+    let (sin_p, cos_p) = sin_cos_turns(u);
+    (
+        R::V3::new(sin_p * sin_t, cos_t, -cos_p * sin_t),
+        sin_t.max(R::splat(0.0)),
+    )
 }
 
 /// A cell of the map's grid as a radiance lookup finds it ([`EnvironmentMap::texels_around`]).
@@ -293,10 +364,7 @@ impl TexelCell {
     /// The bilinear interpolation of the corners.
     #[inline]
     fn radiance(&self) -> Rgb {
-        let (c, fx, fy) = (&self.corners, self.fx, self.fy);
-        let top = c[0] * (1.0 - fx) + c[1] * fx;
-        let bottom = c[2] * (1.0 - fx) + c[3] * fx;
-        top * (1.0 - fy) + bottom * fy
+        bilinear(self.corners, self.fx, self.fy)
     }
 }
 
@@ -304,9 +372,17 @@ impl TexelCell {
 /// luminance of the four (which bounds the bilinear radiance inside the cell) times `band`,
 /// ∫ sin θ dθ over its row. Building the distribution and finding a direction's density both
 /// call it.
-#[inline]
-fn cell_weight(corners: [Rgb; 4], band: f32) -> f32 {
-    corners.into_iter().map(luminance).fold(0.0f32, f32::max) * band
+/// For one value or lanes.
+#[inline(always)]
+fn cell_weight<V: Vector3>(corners: [V; 4], band: V::R) -> V::R {
+    let [r, g, b] = LUMINANCE_WEIGHTS.map(|w| w as f32);
+    let weights = V::splat(Vec3::new(r, g, b));
+    // `luminance`'s sum, (r x + g y) + b z, is glam's dot product's.
+    corners
+        .into_iter()
+        .map(|c| weights.dot(c))
+        .fold(V::R::splat(0.0), V::R::max)
+        * band
 }
 
 /// `u - floor(u)` for `u` in [-1, 2), the range of every u coordinate this module wraps
@@ -314,15 +390,15 @@ fn cell_weight(corners: [Rgb; 4], band: f32) -> f32 {
 /// same whole number, chosen by comparisons rather than computed by `floor` (a library call
 /// on CPUs without SSE4.1). A -0 stays -0 (`floor` would give +0), which no caller tells
 /// apart: every one scales it or subtracts from it.
-#[inline]
-fn wrap_u(u: f32) -> f32 {
-    if u < 0.0 {
-        u + 1.0
-    } else if u >= 1.0 {
-        u - 1.0
-    } else {
-        u
-    }
+/// For one value or lanes.
+#[inline(always)]
+fn wrap_u<R: Real>(u: R) -> R {
+    let one = R::splat(1.0);
+    R::select(
+        u.lt(R::splat(0.0)),
+        u + one,
+        R::select(one.le(u), u - one, u),
+    )
 }
 
 #[cfg(test)]
@@ -449,6 +525,54 @@ mod tests {
                     m.eval(d).to_array().map(f32::to_bits)
                 );
                 assert_eq!(pdf.to_bits(), m.pdf(d).to_bits(), "direction {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn eight_lanes_look_up_what_one_direction_at_a_time_looks_up() {
+        let (w, h) = (12, 7);
+        let mut rng = pathlab_mc::rng::Pcg32::new(4, 8);
+        let bright: Vec<Rgb> = (0..w * h)
+            .map(|i| Vec3::new((i % 5) as f32, 1.0 + (i % 3) as f32, 0.5) * rng.uniform_f32())
+            .collect();
+        for texels in [bright, vec![Vec3::ZERO; w * h]] {
+            let m = EnvironmentMap::new(texels, w, h, Mat3::from_rotation_x(0.6), 2.0).unwrap();
+            // The poles, the seams, unnormalised and zero directions, then random ones.
+            let mut dirs = vec![Vec3::Y, -Vec3::Y, Vec3::X * 3.0, -Vec3::Z, Vec3::ZERO];
+            dirs.extend((0..w).map(|i| {
+                let phi = TAU * i as f32 / w as f32;
+                m.to_world * Vec3::new(phi.sin(), -0.2, -phi.cos())
+            }));
+            dirs.extend((0..8000).map(|_| {
+                pathlab_mc::warp::sample_uniform_sphere(Vec2::new(
+                    rng.uniform_f32(),
+                    rng.uniform_f32(),
+                )) * (0.5 + rng.uniform_f32())
+            }));
+            for (k, chunk) in dirs.chunks(W).enumerate() {
+                let mut ws = V8::default();
+                for (i, &d) in chunk.iter().enumerate() {
+                    ws.set(i, d);
+                }
+                // Every lane, then every other lane (the others give zeros).
+                let all = (1u32 << chunk.len()) - 1;
+                for active in [all, all & (0x55 << (k % 2))] {
+                    let (le, pdf) = m.eval_and_pdf_lanes(ws, active);
+                    for (i, &d) in chunk.iter().enumerate() {
+                        let (want_le, want_pdf) = if active & (1 << i) != 0 {
+                            m.eval_and_pdf(d)
+                        } else {
+                            (Vec3::ZERO, pdf.0[i])
+                        };
+                        assert_eq!(
+                            le.get(i).to_array().map(f32::to_bits),
+                            want_le.to_array().map(f32::to_bits),
+                            "{d}"
+                        );
+                        assert_eq!(pdf.0[i].to_bits(), want_pdf.to_bits(), "{d}");
+                    }
+                }
             }
         }
     }
