@@ -4,6 +4,7 @@
 
 use super::check_weights;
 use crate::error::{Error, Result};
+use crate::simd::lanes::{F8, W};
 use glam::Vec2;
 
 /// A continuous sample of a [`PiecewiseConstant1D`].
@@ -121,10 +122,14 @@ impl Pieces<'_> {
     /// The piece `o` with `cdf[o] <= u < cdf[o + 1]` (pieces of zero probability are skipped).
     #[inline]
     fn find_piece(&self, u: f32) -> usize {
-        // Number of CDF entries <= u, minus one, kept within 0..n.
-        self.cdf_entries_at_most(u)
-            .saturating_sub(1)
-            .min(self.len() - 1)
+        self.piece_of_count(self.cdf_entries_at_most(u))
+    }
+
+    /// The piece of a `u` that `count` CDF entries are at most: the count less one, kept
+    /// within 0..n.
+    #[inline]
+    fn piece_of_count(&self, count: usize) -> usize {
+        count.saturating_sub(1).min(self.len() - 1)
     }
 
     /// The number of CDF entries `<= u` (the CDF does not decrease, so they are its first
@@ -179,7 +184,15 @@ impl Pieces<'_> {
 
     #[inline]
     fn sample(&self, u: f32) -> PiecewiseSample {
-        let o = self.find_piece(u);
+        self.sample_counted(u, self.cdf_entries_at_most(u))
+    }
+
+    /// [`Pieces::sample`] of `u` given `count`, the number of CDF entries `<= u`
+    /// ([`Pieces::cdf_entries_at_most`]): the two halves of a sample, which the lanes' sampling
+    /// runs as two passes over the lanes.
+    #[inline]
+    fn sample_counted(&self, u: f32, count: usize) -> PiecewiseSample {
+        let o = self.piece_of_count(count);
         let (c0, c1) = (self.entries[o].cdf, self.entries[o + 1].cdf);
         let mut du = u - c0;
         if c1 - c0 > 0.0 {
@@ -504,6 +517,34 @@ impl PiecewiseConstant2D {
         (Vec2::new(col.x, row.x), col.pdf * row.pdf)
     }
 
+    /// [`PiecewiseConstant2D::sample`] of the lanes `active` of (`u[0]`, `u[1]`), each lane to
+    /// the bit as one sample at a time (the other lanes give zeros): the points' u and v and
+    /// their densities. The lanes are taken a step at a time: every lane's row, then every
+    /// lane's search of its row, then every lane's point.
+    pub fn sample_lanes(&self, u: [F8; 2], active: u32) -> ([F8; 2], F8) {
+        let lanes = || (0..W).filter(move |i| active & (1 << i) != 0);
+        let mut rows = [PiecewiseSample {
+            x: 0.0,
+            pdf: 0.0,
+            offset: 0,
+        }; W];
+        for i in lanes() {
+            rows[i] = self.marginal.sample(u[1].0[i]);
+        }
+        let mut counts = [0usize; W];
+        for i in lanes() {
+            counts[i] = self.row(rows[i].offset).cdf_entries_at_most(u[0].0[i]);
+        }
+        let (mut x, mut y, mut pdf) = (F8::splat(0.0), F8::splat(0.0), F8::splat(0.0));
+        for i in lanes() {
+            let col = self
+                .row(rows[i].offset)
+                .sample_counted(u[0].0[i], counts[i]);
+            (x.0[i], y.0[i], pdf.0[i]) = (col.x, rows[i].x, col.pdf * rows[i].pdf);
+        }
+        ([x, y], pdf)
+    }
+
     /// The density at `p` (0 outside the rectangle).
     pub fn pdf(&self, p: Vec2) -> f32 {
         if !(self.min.x..=self.max.x).contains(&p.x) || !(self.min.y..=self.max.y).contains(&p.y) {
@@ -611,6 +652,53 @@ mod tests {
                 let x = min.x + (max.x - min.x) * rng.uniform_f32();
                 assert_eq!(d.row(v).invert_sample(x), alone.invert_sample(x));
                 assert_eq!(d.row(v).piece_pdf(d.row(v).offset_of(x)), alone.pdf(x));
+            }
+        }
+    }
+
+    #[test]
+    fn eight_lanes_sample_what_one_sample_at_a_time_samples() {
+        let mut rng = Pcg32::new(2, 4);
+        let (nu, nv) = (33, 17);
+        let func: Vec<f32> = (0..nu * nv)
+            .map(|_| match rng.uniform_f32() {
+                x if x < 0.2 => 0.0,
+                x if x < 0.22 => 1e3 * x,
+                x => x,
+            })
+            .collect();
+        for (min, max) in [
+            (Vec2::ZERO, Vec2::ONE),
+            (Vec2::new(-1.0, 2.0), Vec2::new(3.0, 2.5)),
+        ] {
+            let d = PiecewiseConstant2D::new(&func, nu, nv, min, max).unwrap();
+            for k in 0..2000u32 {
+                let mut draw = || {
+                    F8(std::array::from_fn(|_| match rng.next_u32() % 50 {
+                        0 => 0.0,
+                        1 => 1.0f32.next_down(),
+                        _ => rng.uniform_f32(),
+                    }))
+                };
+                let u = [draw(), draw()];
+                let active = if k % 3 == 0 {
+                    0xff
+                } else {
+                    rng.next_u32() & 0xff
+                };
+                let ([x, y], pdf) = d.sample_lanes(u, active);
+                for i in 0..W {
+                    let want = if active & (1 << i) != 0 {
+                        d.sample(Vec2::new(u[0].0[i], u[1].0[i]))
+                    } else {
+                        (Vec2::ZERO, 0.0)
+                    };
+                    assert_eq!(
+                        [x.0[i], y.0[i], pdf.0[i]].map(f32::to_bits),
+                        [want.0.x, want.0.y, want.1].map(f32::to_bits),
+                        "lane {i} of {u:?}"
+                    );
+                }
             }
         }
     }

@@ -9,11 +9,14 @@
 //!
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
 //! for every lane and bounce, except where a lane's surface is Lambertian and its light an
-//! emitting triangle. There the lanes are shaded together in SIMD registers by the same
-//! functions the one-path code calls, instantiated on eight lanes (the [`Diffuse`] BSDF,
-//! [`TriangleEmitter::sample_li`], the shading [`Frame`], [`offset_ray_origin`],
+//! emitting triangle or an environment map. There the lanes are shaded together in SIMD
+//! registers by the same functions the one-path code calls, instantiated on eight lanes (the
+//! [`Diffuse`] BSDF, [`TriangleEmitter::sample_li`],
+//! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`], [`offset_ray_origin`],
 //! [`power_heuristic_weight`]; see `scatter_lanes`): this module holds only the scheduling
-//! and the masks that stand for the one-path code's early returns.
+//! and the masks that stand for the one-path code's early returns. The rays that leave the
+//! scene look the environment map up together too
+//! ([`EnvironmentMap::eval_and_pdf_lanes`]), and `arrive` takes what they found.
 //!
 //! Each lane computes exactly what [`PathIntegrator::li`] computes for its sample, to the bit
 //! (tested): the same random numbers in the same order, the same operations in the same
@@ -28,7 +31,7 @@ use crate::accel::RayLanes;
 use crate::bsdf::Diffuse;
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
-use crate::light::envmap::EnvironmentMap;
+use crate::light::envmap::{DirectionLanes, EnvironmentMap};
 use crate::light::{AreaShape, Light, TriangleEmitter};
 use crate::scene::{Scene, SurfaceInteraction};
 use crate::simd::lanes::{F8, M8, V8, W};
@@ -45,10 +48,15 @@ struct ScatterIn {
     wo: V8,
     diffuse: Diffuse<V8>,
     two_sided: M8,
-    /// Lanes whose light sample is a point on an emitting triangle (the others have no light
-    /// sample, or took theirs one lane at a time).
+    /// Lanes whose light sample is a point on an emitting triangle.
     light: M8,
     emitter: TriangleEmitter<V8>,
+    /// Lanes whose light sample is a direction of an environment map, and its direction and
+    /// density per solid angle (the lanes in neither mask have no light sample, or took theirs
+    /// one lane at a time).
+    environment: M8,
+    environment_wi: V8,
+    environment_pdf: F8,
     /// Probability of choosing the lane's light.
     light_pmf: F8,
     u_light: [F8; 2],
@@ -58,12 +66,18 @@ struct ScatterIn {
 /// What the lanes' scattering yields.
 #[derive(Clone, Copy, Default)]
 struct ScatterOut {
-    /// Lanes that trace a shadow ray towards their light point.
+    /// Lanes that trace a shadow ray towards their light point (or, for an environment map,
+    /// towards infinity along `shadow_d`).
     shadow: M8,
     shadow_o: V8,
     shadow_d: V8,
-    /// The light sample's contribution f Li |cos θi| w / p, before visibility and throughput.
+    /// The light sample's contribution f Li |cos θi| w / p, before visibility and throughput
+    /// (for an emitting triangle).
     ld: V8,
+    /// An environment map's sample's f |cos θi| and w / p, whose product with its radiance,
+    /// read once the shadow ray is known to be unblocked, is its contribution.
+    f: V8,
+    weight_over_pdf: F8,
     /// Lanes whose BSDF sample is a direction (the others' paths end).
     sampled: M8,
     wi: V8,
@@ -87,24 +101,30 @@ fn scatter_lanes(a: &ScatterIn, out: &mut ScatterOut) {
     let frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
     let wo_z = a.wo.dot(frame.n);
 
-    // Light sampling.
+    // Light sampling: a point on a triangle, or an environment map's direction.
+    let env = a.environment;
     let ls = a.emitter.sample_li(a.p, a.u_light[0], a.u_light[1]);
-    let wi_z = ls.wi.dot(frame.n);
-    let f = a.diffuse.f_z(wo_z, wi_z).scale(ls.wi.dot(frame.n).abs());
-    // `sample_light`'s early returns (`!(x <= 0)` lets NaN through, as there).
-    out.shadow = a.light
+    let wi = env.select3(a.environment_wi, ls.wi);
+    let wi_z = wi.dot(frame.n);
+    let f = a.diffuse.f_z(wo_z, wi_z).scale(wi.dot(frame.n).abs());
+    // `visible_light_sample`'s early returns (`!(x <= 0)` lets NaN through, as there).
+    let triangle = a.light
         & ls.dist2.not_equal(zero)
         & ls.abs_cos_light.not_equal(zero)
         & !ls.pdf.le(zero)
-        & !ls.li.max_element().le(zero)
-        & !f.max_element().le(zero);
-    let o = offset_ray_origin(a.p, a.ng, ls.p_light - a.p);
+        & !ls.li.max_element().le(zero);
+    let environment = env & !a.environment_pdf.le(zero);
+    out.shadow = (triangle | environment) & !f.max_element().le(zero);
+    // Towards the triangle's point (`spawn_ray_to`), or along the direction (`spawn_ray`).
+    let o = offset_ray_origin(a.p, a.ng, env.select3(wi, ls.p_light - a.p));
     let end = offset_ray_origin(ls.p_light, a.emitter.normal, o - ls.p_light);
     out.shadow_o = o;
-    out.shadow_d = end - o;
-    let pdf = a.light_pmf * ls.pdf;
+    out.shadow_d = env.select3(wi, end - o);
+    let pdf = a.light_pmf * env.select(a.environment_pdf, ls.pdf);
     let mis = power_heuristic_weight(pdf, a.diffuse.pdf_z(wo_z, wi_z));
     out.ld = f.mul_axes(ls.li).scale(mis / pdf);
+    out.f = f;
+    out.weight_over_pdf = mis / pdf;
 
     // BSDF sampling (and `Bsdf::sample_f`'s check of a finite value).
     let bs = a.diffuse.sample_z(wo_z, a.u_bsdf[0], a.u_bsdf[1]);
@@ -252,21 +272,48 @@ impl PathIntegrator {
             a.u_bsdf = [F8(u[4]), F8(u[5])];
             // From here on, the lanes with a hit are the Lambertian ones (the others' hits
             // were cleared above).
+            let mut environment = None;
+            let mut environment_lanes = 0u32;
             for i in 0..W {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
                     continue;
                 };
                 let u_light = Vec2::new(u[1][i], u[2][i]);
-                let triangle_light =
+                let light =
                     gather_light(scene, i, si, &mut lane.st, u[0][i], u_light, &mut a, stats);
-                a.light.set(i, triangle_light);
+                a.light.set(i, matches!(light, LaneLight::Triangle));
+                if let LaneLight::Environment(map) = light {
+                    environment = Some(map);
+                    environment_lanes |= 1 << i;
+                }
+            }
+            // The environment map's directions for every lane that chose it, together.
+            let directions = environment.map(|map| {
+                let d = sample_direction_lanes(map, [F8(u[1]), F8(u[2])], environment_lanes);
+                (map, d)
+            });
+            a.environment = M8::default();
+            if let Some((_, d)) = &directions {
+                for i in 0..W {
+                    a.environment.set(i, d.found & (1 << i) != 0);
+                }
+                (a.environment_wi, a.environment_pdf) = (d.wi, d.pdf);
             }
             scatter(&a, &mut b);
             for i in 0..W {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
                     continue;
                 };
-                let goes_on = self.finish_bounce(scene, i, &mut lane.st, si, &b, u[6][i], stats);
+                let goes_on = self.finish_bounce(
+                    scene,
+                    i,
+                    &mut lane.st,
+                    si,
+                    &b,
+                    directions.as_ref(),
+                    u[6][i],
+                    stats,
+                );
                 if !goes_on {
                     out(lane.tag, lane.st.l * lane.weight);
                     lanes[i] = None;
@@ -276,8 +323,9 @@ impl PathIntegrator {
     }
 
     /// The end of lane `i`'s bounce after the SIMD scattering: the shadow ray (adding the light
-    /// sample's contribution where it is unblocked), the throughput times the BSDF sample's
-    /// weight, Russian roulette with `u_rr`. Returns whether the path goes on.
+    /// sample's contribution where it is unblocked; an environment map's radiance, from
+    /// `directions`, is read then), the throughput times the BSDF sample's weight, Russian
+    /// roulette with `u_rr`. Returns whether the path goes on.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn finish_bounce(
@@ -287,19 +335,33 @@ impl PathIntegrator {
         st: &mut PathState,
         si: &SurfaceInteraction,
         b: &ScatterOut,
+        directions: Option<&(&EnvironmentMap, DirectionLanes)>,
         u_rr: f32,
         stats: &mut PathStats,
     ) -> bool {
         if b.shadow.get(i) {
             stats.rays += 1;
+            let environment = directions.filter(|(_, d)| d.found & (1 << i) != 0);
             let shadow = Ray {
                 o: b.shadow_o.get(i),
                 d: b.shadow_d.get(i),
                 t_min: 0.0,
-                t_max: SHADOW_RAY_END,
+                t_max: match environment {
+                    Some(_) => f32::INFINITY,
+                    None => SHADOW_RAY_END,
+                },
             };
             if !scene.occluded(&shadow) {
-                st.l += st.beta * b.ld.get(i);
+                match environment {
+                    Some((map, d)) => {
+                        // As `visible_light_sample` and `sample_light` finish.
+                        let li = map.radiance_at(Vec2::new(d.uv[0].0[i], d.uv[1].0[i]));
+                        if li.max_element() > 0.0 {
+                            st.l += st.beta * (b.f.get(i) * li * b.weight_over_pdf.0[i]);
+                        }
+                    }
+                    None => st.l += st.beta * b.ld.get(i),
+                }
             }
         }
         b.sampled.get(i) && {
@@ -416,6 +478,30 @@ fn look_up_escapes(
     Some(Escapes { active, le, pdf })
 }
 
+/// [`EnvironmentMap::sample_direction_lanes`] on the best vector unit this CPU has.
+fn sample_direction_lanes(map: &EnvironmentMap, u: [F8; 2], active: u32) -> DirectionLanes {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx2) = crate::simd::Avx2::detect() {
+        // SAFETY: `sample_direction_lanes_avx2` requires AVX2 and FMA, which `avx2` proves
+        // this CPU has. Its body is safe code.
+        return unsafe { sample_direction_lanes_avx2(avx2, map, u, active) };
+    }
+    map.sample_direction_lanes(u, active)
+}
+
+/// [`EnvironmentMap::sample_direction_lanes`] compiled for AVX2 (the same bits, as
+/// [`eval_and_pdf_lanes_avx2`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn sample_direction_lanes_avx2(
+    _: crate::simd::Avx2,
+    map: &EnvironmentMap,
+    u: [F8; 2],
+    active: u32,
+) -> DirectionLanes {
+    map.sample_direction_lanes(u, active)
+}
+
 /// [`EnvironmentMap::eval_and_pdf_lanes`] on the best vector unit this CPU has.
 fn eval_and_pdf_lanes(map: &EnvironmentMap, w: V8, active: u32) -> (V8, F8) {
     #[cfg(target_arch = "x86_64")]
@@ -440,13 +526,24 @@ fn eval_and_pdf_lanes_avx2(
     map.eval_and_pdf_lanes(w, active)
 }
 
+/// How a lane's light sample is taken.
+enum LaneLight<'a> {
+    /// A point on an emitting triangle, in the SIMD lanes.
+    Triangle,
+    /// A direction of this environment map, in the SIMD lanes.
+    Environment(&'a EnvironmentMap),
+    /// Already taken one lane at a time, or no light at all.
+    Taken,
+}
+
 /// Lane `i`'s light choice from `u_select`: an emitting triangle's data go to the lane of `a`
-/// (returns true) for the SIMD light sample; any other light is sampled here with the scalar
-/// code, its contribution added to `st.l`. No light: nothing (as the scalar code).
+/// for the SIMD light sample, as does the light's probability for an environment map; any
+/// other light is sampled here with the scalar code, its contribution added to `st.l`. No
+/// light: nothing (as the scalar code).
 #[allow(clippy::too_many_arguments)]
 #[inline]
-fn gather_light(
-    scene: &Scene,
+fn gather_light<'a>(
+    scene: &'a Scene,
     i: usize,
     si: &SurfaceInteraction,
     st: &mut PathState,
@@ -454,9 +551,9 @@ fn gather_light(
     u_light: Vec2,
     a: &mut ScatterIn,
     stats: &mut PathStats,
-) -> bool {
+) -> LaneLight<'a> {
     let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
-        return false;
+        return LaneLight::Taken;
     };
     match &scene.lights()[index] {
         Light::Area {
@@ -467,7 +564,11 @@ fn gather_light(
         } => {
             a.emitter.set_lane(i, t.emitter(*radiance, *two_sided));
             a.light_pmf.0[i] = pmf;
-            true
+            LaneLight::Triangle
+        }
+        Light::EnvironmentMap { map, .. } => {
+            a.light_pmf.0[i] = pmf;
+            LaneLight::Environment(map)
         }
         _ => {
             let wo = -st.ray.d;
@@ -475,7 +576,7 @@ fn gather_light(
             let ld = sample_light(scene, si, &bsdf, wo, u_select, u_light, 1, 1, stats);
             // (The scalar code divides by the one light sample: exact.)
             st.l += st.beta * ld;
-            false
+            LaneLight::Taken
         }
     }
 }

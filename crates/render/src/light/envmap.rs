@@ -290,7 +290,38 @@ impl EnvironmentMap {
             return None;
         }
         let pdf = pdf_uv / (2.0 * PI * PI * sin_t);
-        Some(((self.to_world * d).normalize(), pdf, uv))
+        Some((self.world_of(d), pdf, uv))
+    }
+
+    /// [`EnvironmentMap::sample_direction`] of the lanes `active` of (`u[0]`, `u[1]`), each
+    /// to the bit as one at a time: the lanes that have a direction, and in those lanes the
+    /// world direction, its density per solid angle and its (u, v).
+    pub fn sample_direction_lanes(&self, u: [F8; 2], active: u32) -> DirectionLanes {
+        let ([cell_u, v], pdf_uv) = self.distribution.sample_lanes(u, active);
+        let u = wrap_u(cell_u + F8::splat(self.half_texel));
+        let (d, sin_t) = direction_of_uv(u, v);
+        let zero = F8::splat(0.0);
+        let pdf = pdf_uv / (F8::splat(2.0 * PI * PI) * sin_t);
+        let found = !pdf_uv.le(zero) & !sin_t.le(zero);
+        let found = (0..W).fold(0, |m, i| m | (u32::from(found.get(i)) << i)) & active;
+        DirectionLanes {
+            found,
+            wi: self.world_of(d),
+            pdf,
+            uv: [u, v],
+        }
+    }
+
+    /// The world direction of local direction `d`, normalised: `to_world · d` in glam's order
+    /// of operations, times the reciprocal of its length, as glam's `normalize`; for one
+    /// value or lanes.
+    #[inline(always)]
+    fn world_of<V: Vector3>(&self, d: V) -> V {
+        let m = &self.to_world;
+        let w = V::splat(m.x_axis).scale(d.x())
+            + V::splat(m.y_axis).scale(d.y())
+            + V::splat(m.z_axis).scale(d.z());
+        w.scale(V::R::splat(1.0) / w.dot(w).sqrt())
     }
 
     /// Bilinear radiance at the map's (u, v), as [`EnvironmentMap::sample_direction`] gives
@@ -347,6 +378,19 @@ fn direction_of_uv<R: Real>(u: R, v: R) -> (R::V3, R) {
         R::V3::new(sin_p * sin_t, cos_t, -cos_p * sin_t),
         sin_t.max(R::splat(0.0)),
     )
+}
+
+/// Directions sampled in lanes ([`EnvironmentMap::sample_direction_lanes`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DirectionLanes {
+    /// The lanes that have a direction (the others' fields are meaningless).
+    pub found: u32,
+    /// World directions.
+    pub wi: V8,
+    /// Their densities per unit solid angle.
+    pub pdf: F8,
+    /// Their (u, v), where [`EnvironmentMap::radiance_at`] reads the radiance.
+    pub uv: [F8; 2],
 }
 
 /// A cell of the map's grid as a radiance lookup finds it ([`EnvironmentMap::texels_around`]).
@@ -572,6 +616,51 @@ mod tests {
                         );
                         assert_eq!(pdf.0[i].to_bits(), want_pdf.to_bits(), "{d}");
                     }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn eight_lanes_sample_the_directions_one_at_a_time_samples() {
+        let (w, h) = (16, 9);
+        let t: Vec<Rgb> = (0..w * h)
+            .map(|i| Vec3::splat(1.0 + (i % 7) as f32 + if i == 40 { 500.0 } else { 0.0 }))
+            .collect();
+        let m = EnvironmentMap::new(t, w, h, Mat3::from_rotation_y(0.7), 2.0).unwrap();
+        let mut rng = pathlab_mc::rng::Pcg32::new(6, 6);
+        for k in 0..4000u32 {
+            let mut draw = || {
+                F8(std::array::from_fn(|_| match rng.next_u32() % 40 {
+                    0 => 0.0,
+                    1 => 1.0f32.next_down(),
+                    _ => rng.uniform_f32(),
+                }))
+            };
+            let u = [draw(), draw()];
+            let active = if k % 2 == 0 {
+                0xff
+            } else {
+                rng.next_u32() & 0xff
+            };
+            let lanes = m.sample_direction_lanes(u, active);
+            for i in 0..W {
+                let one = (active & (1 << i) != 0)
+                    .then(|| m.sample_direction(Vec2::new(u[0].0[i], u[1].0[i])))
+                    .flatten();
+                assert_eq!(lanes.found & (1 << i) != 0, one.is_some(), "lane {i}");
+                if let Some((wi, pdf, uv)) = one {
+                    let got = (lanes.wi.get(i), lanes.pdf.0[i]);
+                    let got_uv = Vec2::new(lanes.uv[0].0[i], lanes.uv[1].0[i]);
+                    assert_eq!(
+                        got.0.to_array().map(f32::to_bits),
+                        wi.to_array().map(f32::to_bits)
+                    );
+                    assert_eq!(got.1.to_bits(), pdf.to_bits());
+                    assert_eq!(
+                        got_uv.to_array().map(f32::to_bits),
+                        uv.to_array().map(f32::to_bits)
+                    );
                 }
             }
         }
