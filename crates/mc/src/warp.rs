@@ -75,30 +75,7 @@ pub fn uniform_disk_concentric<T: Real>(u0: T, u1: T) -> (T, T) {
     (x, y)
 }
 
-/// (sin a, cos a) for a = π/4 · t with t in [-1, 1]: the angles of the concentric map, which
-/// need no range reduction. Taylor series to a⁹ and a¹⁰, whose truncation errors on
-/// |a| ≤ π/4 are below (π/4)¹¹/11! ≈ 2e-9 and (π/4)¹²/12! ≈ 1e-10, far under f32's rounding;
-/// the results are within two ulps of sin and cos of π/4 · t (1.95 and 1.64 at worst over
-/// every f32 in [0, 1], and symmetric for negative t; a test checks a grid). Plain arithmetic,
-/// for one value or for lanes.
-#[inline(always)]
-pub fn sin_cos_quarter_turn<T: Real>(t: T) -> (T, T) {
-    const S: [f32; 4] = [-1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362_880.0];
-    const C: [f32; 5] = [
-        -1.0 / 2.0,
-        1.0 / 24.0,
-        -1.0 / 720.0,
-        1.0 / 40_320.0,
-        -1.0 / 3_628_800.0,
-    ];
-    let k = |c: f32| T::splat(c);
-    let a = k(FRAC_PI_4) * t;
-    let a2 = a * a;
-    let sin = a + a * a2 * (k(S[0]) + a2 * (k(S[1]) + a2 * (k(S[2]) + a2 * k(S[3]))));
-    let cos =
-        k(1.0) + a2 * (k(C[0]) + a2 * (k(C[1]) + a2 * (k(C[2]) + a2 * (k(C[3]) + a2 * k(C[4])))));
-    (sin, cos)
-}
+pub use crate::simd::trig::sin_cos_quarter_turn;
 
 /// Density of a uniform point on the unit disk, per unit area: 1/π inside, 0 outside.
 #[inline]
