@@ -145,9 +145,10 @@ fn under_a_sky(mut desc: SceneDesc) -> SceneDesc {
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
-    // Lambertian surfaces lit by emitting triangles in SIMD lanes and everything else with
-    // the scalar code: every sample's radiance must be the scalar `li`'s to the bit, and the
-    // rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
+    // Lambertian surfaces lit by emitting triangles or an environment map in SIMD lanes (and
+    // the environment map's radiance towards the rays that leave the scene) and everything
+    // else with the scalar code: every sample's radiance must be the scalar `li`'s to the
+    // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these
     // rays do not meet), and no nodes are counted; with a hundred triangles more, the lanes

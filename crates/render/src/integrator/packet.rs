@@ -89,9 +89,11 @@ struct ScatterOut {
 /// The lanes' scattering at diffuse surfaces, composed of the functions the one-path code
 /// calls, on lanes: the shading frame ([`Frame::from_normal`], turned towards wo for a
 /// two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does), [`super::sample_light`] for
-/// a point on an emitting triangle up to the shadow ray ([`TriangleEmitter::sample_li`],
-/// [`Diffuse::f_z`], [`offset_ray_origin`], [`power_heuristic_weight`] against
-/// [`Diffuse::pdf_z`]), and [`crate::bsdf::Bsdf::sample_f`] for a Lambertian BSDF
+/// a point on an emitting triangle or an environment map's direction (drawn before, by
+/// [`EnvironmentMap::sample_direction_lanes`]) up to the shadow ray
+/// ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`offset_ray_origin`],
+/// [`power_heuristic_weight`] against [`Diffuse::pdf_z`]; the map's radiance is read after the
+/// shadow ray, as there), and [`crate::bsdf::Bsdf::sample_f`] for a Lambertian BSDF
 /// ([`Diffuse::sample_z`]). Only the control flow is the lanes' own: masks where the one-path
 /// code returns early.
 #[inline(always)]
