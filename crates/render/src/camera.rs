@@ -203,9 +203,7 @@ impl Camera {
         if self.orthographic {
             return (T::V3::splat(self.origin) + right + up, forward, one);
         }
-        // glam's `normalize`: times the reciprocal of the length.
-        let v = right + up + forward;
-        let d = v.scale(one / v.dot(v).sqrt());
+        let d = (right + up + forward).normalize();
         (T::V3::splat(self.origin), d, d.dot(forward))
     }
 

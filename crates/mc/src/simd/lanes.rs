@@ -396,6 +396,12 @@ pub trait Vector3:
     fn max_element(self) -> Self::R;
     /// `a` where `m`, else `b`, for each axis.
     fn select(m: <Self::R as Real>::Mask, a: Self, b: Self) -> Self;
+    /// glam's `normalize`: the vector times the reciprocal of its length (the same bits as
+    /// glam's for `Vec3`, without its debug check of a finite result).
+    #[inline(always)]
+    fn normalize(self) -> Self {
+        self.scale(Self::R::splat(1.0) / self.dot(self).sqrt())
+    }
 }
 
 impl Real for f32 {

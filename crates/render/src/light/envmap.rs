@@ -198,14 +198,11 @@ impl EnvironmentMap {
     }
 
     /// The local direction of world direction `w` and its (u, v), for one value or lanes:
-    /// `to_local · w` in glam's order of operations, normalised as glam's `normalize_or_zero`
-    /// does, u = atan2(x, -z) / 2π (mod 1) and v = acos y / π.
+    /// `to_local · w` ([`rotate`]), normalised as glam's `normalize_or_zero` does,
+    /// u = atan2(x, -z) / 2π (mod 1) and v = acos y / π.
     #[inline(always)]
     fn local_of<V: Vector3>(&self, w: V) -> (V, V::R, V::R) {
-        let m = &self.to_local;
-        let d = V::splat(m.x_axis).scale(w.x())
-            + V::splat(m.y_axis).scale(w.y())
-            + V::splat(m.z_axis).scale(w.z());
+        let d = rotate(&self.to_local, w);
         let zero = V::R::splat(0.0);
         let rcp = V::R::splat(1.0) / d.dot(d).sqrt();
         let d = V::select(
@@ -280,17 +277,22 @@ impl EnvironmentMap {
     /// reject the direction (the BSDF is zero there, a shadow ray is blocked) reads it after.
     pub fn sample_direction(&self, u: Vec2) -> Option<(Vec3, f32, Vec2)> {
         let (cell_uv, pdf_uv) = self.distribution.sample(u);
-        if pdf_uv <= 0.0 {
-            return None;
-        }
+        let (wi, pdf, u, found) = self.direction_of_cell(cell_uv.x, cell_uv.y, pdf_uv);
+        found.then(|| (wi, pdf, Vec2::new(u, cell_uv.y)))
+    }
+
+    /// The world direction of the distribution's point (`cell_u`, `v`) of density `pdf_uv`
+    /// per unit (u, v) area, its density per solid angle and its u, and whether it is a
+    /// direction (a density above zero, off the poles); for one value or lanes.
+    #[inline(always)]
+    fn direction_of_cell<R: Real>(&self, cell_u: R, v: R, pdf_uv: R) -> (R::V3, R, R, R::Mask) {
         // Cells start at grid column 0, half a texel into u.
-        let uv = Vec2::new(wrap_u(cell_uv.x + self.half_texel), cell_uv.y);
-        let (d, sin_t) = Self::uv_to_direction(uv);
-        if sin_t <= 0.0 {
-            return None;
-        }
-        let pdf = pdf_uv / (2.0 * PI * PI * sin_t);
-        Some((self.world_of(d), pdf, uv))
+        let u = wrap_u(cell_u + R::splat(self.half_texel));
+        let (d, sin_t) = direction_of_uv(u, v);
+        let zero = R::splat(0.0);
+        let pdf = pdf_uv / (R::splat(2.0 * PI * PI) * sin_t);
+        let found = !pdf_uv.le(zero) & !sin_t.le(zero);
+        (rotate(&self.to_world, d).normalize(), pdf, u, found)
     }
 
     /// [`EnvironmentMap::sample_direction`] of the lanes `active` of (`u[0]`, `u[1]`), each
@@ -298,30 +300,14 @@ impl EnvironmentMap {
     /// world direction, its density per solid angle and its (u, v).
     pub fn sample_direction_lanes(&self, u: [F8; 2], active: u32) -> DirectionLanes {
         let ([cell_u, v], pdf_uv) = self.distribution.sample_lanes(u, active);
-        let u = wrap_u(cell_u + F8::splat(self.half_texel));
-        let (d, sin_t) = direction_of_uv(u, v);
-        let zero = F8::splat(0.0);
-        let pdf = pdf_uv / (F8::splat(2.0 * PI * PI) * sin_t);
-        let found = !pdf_uv.le(zero) & !sin_t.le(zero);
+        let (wi, pdf, u, found) = self.direction_of_cell(cell_u, v, pdf_uv);
         let found = (0..W).fold(0, |m, i| m | (u32::from(found.get(i)) << i)) & active;
         DirectionLanes {
             found,
-            wi: self.world_of(d),
+            wi,
             pdf,
             uv: [u, v],
         }
-    }
-
-    /// The world direction of local direction `d`, normalised: `to_world · d` in glam's order
-    /// of operations, times the reciprocal of its length, as glam's `normalize`; for one
-    /// value or lanes.
-    #[inline(always)]
-    fn world_of<V: Vector3>(&self, d: V) -> V {
-        let m = &self.to_world;
-        let w = V::splat(m.x_axis).scale(d.x())
-            + V::splat(m.y_axis).scale(d.y())
-            + V::splat(m.z_axis).scale(d.z());
-        w.scale(V::R::splat(1.0) / w.dot(w).sqrt())
     }
 
     /// Bilinear radiance at the map's (u, v), as [`EnvironmentMap::sample_direction`] gives
@@ -343,6 +329,15 @@ impl EnvironmentMap {
         let cell_uv = Vec2::new(wrap_u(uv.x - self.half_texel), uv.y);
         solid_angle_pdf(d, self.distribution.pdf(cell_uv))
     }
+}
+
+/// `m · v` in glam's order of operations (its columns times v's axes, summed from x to z),
+/// for one vector or lanes.
+#[inline(always)]
+fn rotate<V: Vector3>(m: &Mat3, v: V) -> V {
+    V::splat(m.x_axis).scale(v.x())
+        + V::splat(m.y_axis).scale(v.y())
+        + V::splat(m.z_axis).scale(v.z())
 }
 
 /// The density per solid angle of local direction `d` whose density per unit (u, v) area is
