@@ -296,10 +296,7 @@ impl PathIntegrator {
             });
             a.environment = M8::default();
             if let Some((_, d)) = &directions {
-                for i in 0..W {
-                    a.environment.set(i, d.found & (1 << i) != 0);
-                }
-                (a.environment_wi, a.environment_pdf) = (d.wi, d.pdf);
+                (a.environment, a.environment_wi, a.environment_pdf) = (d.found, d.wi, d.pdf);
             }
             scatter(&a, &mut b);
             for i in 0..W {
@@ -343,7 +340,7 @@ impl PathIntegrator {
     ) -> bool {
         if b.shadow.get(i) {
             stats.rays += 1;
-            let environment = directions.filter(|(_, d)| d.found & (1 << i) != 0);
+            let environment = directions.filter(|(_, d)| d.found.get(i));
             let shadow = Ray {
                 o: b.shadow_o.get(i),
                 d: b.shadow_d.get(i),

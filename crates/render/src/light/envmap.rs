@@ -16,7 +16,7 @@ use crate::color::{luminance, LUMINANCE_WEIGHTS};
 use crate::desc::Rgb;
 use glam::{Mat3, Vec2, Vec3};
 use pathlab_mc::distribution::PiecewiseConstant2D;
-use pathlab_mc::simd::lanes::{Real, Vector3, F8, V8, W};
+use pathlab_mc::simd::lanes::{Real, Vector3, F8, M8, V8, W};
 use pathlab_mc::simd::trig::{acos, atan2, sin_cos_turns};
 use std::f32::consts::{PI, TAU};
 
@@ -300,8 +300,8 @@ impl EnvironmentMap {
     /// world direction, its density per solid angle and its (u, v).
     pub fn sample_direction_lanes(&self, u: [F8; 2], active: u32) -> DirectionLanes {
         let ([cell_u, v], pdf_uv) = self.distribution.sample_lanes(u, active);
+        // The lanes outside `active` have no direction: their density is zero.
         let (wi, pdf, u, found) = self.direction_of_cell(cell_u, v, pdf_uv);
-        let found = (0..W).fold(0, |m, i| m | (u32::from(found.get(i)) << i)) & active;
         DirectionLanes {
             found,
             wi,
@@ -379,7 +379,7 @@ fn direction_of_uv<R: Real>(u: R, v: R) -> (R::V3, R) {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct DirectionLanes {
     /// The lanes that have a direction (the others' fields are meaningless).
-    pub found: u32,
+    pub found: M8,
     /// World directions.
     pub wi: V8,
     /// Their densities per unit solid angle.
@@ -643,7 +643,7 @@ mod tests {
                 let one = (active & (1 << i) != 0)
                     .then(|| m.sample_direction(Vec2::new(u[0].0[i], u[1].0[i])))
                     .flatten();
-                assert_eq!(lanes.found & (1 << i) != 0, one.is_some(), "lane {i}");
+                assert_eq!(lanes.found.get(i), one.is_some(), "lane {i}");
                 if let Some((wi, pdf, uv)) = one {
                     let got = (lanes.wi.get(i), lanes.pdf.0[i]);
                     let got_uv = Vec2::new(lanes.uv[0].0[i], lanes.uv[1].0[i]);
