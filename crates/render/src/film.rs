@@ -2,7 +2,7 @@
 
 use crate::desc::Rgb;
 use glam::{DVec3, Vec3};
-use pathlab_mc::exact::{add_fixed, from_fixed, ExactStats};
+use pathlab_mc::exact::{add_fixed, add_fixed_with_squares, from_fixed, ExactStats};
 
 /// Statistics of one pixel's samples: their count, and exact sums of each channel and of
 /// luminance and of their squares ([`pathlab_mc::exact`]): the same for any order in which
@@ -11,10 +11,8 @@ use pathlab_mc::exact::{add_fixed, from_fixed, ExactStats};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PixelStats {
     n: u64,
-    /// Σ of R, G, B and luminance, fixed point.
-    sums: [i128; 4],
-    /// Σ of their squares, fixed point.
-    squares: [i128; 4],
+    /// Σ of R, G, B and luminance, then Σ of their squares, in fixed point.
+    sums: [i128; 8],
 }
 
 /// Bytes of one pixel in [`PixelStats::to_bytes`].
@@ -26,17 +24,13 @@ impl PixelStats {
     pub fn add(&mut self, l: Rgb) {
         self.n += 1;
         let lum = crate::color::luminance(l);
-        for (c, v) in [l.x, l.y, l.z, lum].into_iter().enumerate() {
-            let v = v as f64;
-            self.sums[c] = add_fixed(self.sums[c], v);
-            self.squares[c] = add_fixed(self.squares[c], v * v);
-        }
+        add_fixed_with_squares(&mut self.sums, [l.x, l.y, l.z, lum]);
     }
 
     /// Statistics of channel `c` (0, 1, 2: R, G, B; 3: luminance).
     #[inline]
     fn channel(&self, c: usize) -> ExactStats {
-        ExactStats::from_raw(self.n, self.sums[c], self.squares[c])
+        ExactStats::from_raw(self.n, self.sums[c], self.sums[4 + c])
     }
 
     /// Statistics of the samples' luminance (the "illuminance" of the course's adaptive
@@ -48,9 +42,8 @@ impl PixelStats {
     /// Combines with another set of samples of the same pixel (exactly).
     pub fn merge(&mut self, o: &PixelStats) {
         self.n += o.n;
-        for c in 0..4 {
-            self.sums[c] = self.sums[c].saturating_add(o.sums[c]);
-            self.squares[c] = self.squares[c].saturating_add(o.squares[c]);
+        for (s, o) in self.sums.iter_mut().zip(&o.sums) {
+            *s = s.saturating_add(*o);
         }
     }
 
@@ -90,7 +83,7 @@ impl PixelStats {
     /// The exact state, little-endian: count, then the sums, then the sums of squares.
     pub fn to_bytes(&self, out: &mut Vec<u8>) {
         out.extend(self.n.to_le_bytes());
-        for v in self.sums.iter().chain(&self.squares) {
+        for v in &self.sums {
             out.extend(v.to_le_bytes());
         }
     }
@@ -105,11 +98,7 @@ impl PixelStats {
         for (k, chunk) in b[8..].chunks_exact(16).enumerate() {
             v[k] = i128::from_le_bytes(chunk.try_into().ok()?);
         }
-        Some(PixelStats {
-            n,
-            sums: [v[0], v[1], v[2], v[3]],
-            squares: [v[4], v[5], v[6], v[7]],
-        })
+        Some(PixelStats { n, sums: v })
     }
 }
 

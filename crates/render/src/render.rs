@@ -183,11 +183,30 @@ pub fn pixel_sample_values(
     values
 }
 
+/// `l` read one 4-byte component at a time. A sample's radiance arrives in the memory where
+/// the integrator has just stored it, component by component; a wider load spanning two of
+/// those stores cannot take its value from them and waits until they reach the cache, which
+/// the film's additions were measured to pay on every sample (the compiler otherwise reads
+/// y and z as one 8-byte load).
+#[inline(always)]
+fn component_by_component(l: &crate::desc::Rgb) -> crate::desc::Rgb {
+    // SAFETY: each pointer comes from a reference to an initialised, aligned `f32`; a
+    // volatile read of it is an ordinary read that the compiler may not merge with another.
+    unsafe {
+        crate::desc::Rgb::new(
+            std::ptr::read_volatile(&l.x),
+            std::ptr::read_volatile(&l.y),
+            std::ptr::read_volatile(&l.z),
+        )
+    }
+}
+
 /// Adds radiance `l` to `px` when it is finite (counting it in `ok`); a NaN or infinite
 /// sample is added as black and counted in `bad` (as pbrt does), so that a pixel's count is
 /// always the number of its sample indices done.
 #[inline]
 fn add_sample(px: &mut PixelStats, l: crate::desc::Rgb, ok: &mut u64, bad: &mut u64) {
+    let l = component_by_component(&l);
     if l.is_finite() {
         px.add(l);
         *ok += 1;
