@@ -11,7 +11,11 @@ one machine (bench/run.sh scenes starts it with a venv holding `mitsuba`):
    over --reps images on each side (pathlab's with seeds 1, 2, ...); also net of the
    reference's own noise (its standard-error image), which adds the same to both errors; and
    the ratio of the root mean squared errors over the images (net, at the budget) with its
-   standard error
+   standard error;
+3. the same equal-time error with pathlab's own default sampler, Sobol (`--sampler sobol`, at
+   the spp its rate with Sobol allows), which it takes where a scene file names no sampler:
+   these files name `independent`, which pathlab honours, so (2) compares the same estimator
+   with the same kind of samples, and (3) what pathlab's sampler gains on top
 
 Mitsuba's variant is llvm_ad_rgb (JIT-compiled, as wide as the CPU's vectors: 16 lanes with
 AVX-512); its first render of each configuration compiles kernels and is not timed. Each
@@ -59,7 +63,8 @@ print(f"{cpu_line()}; Mitsuba 3 {mi.__version__} {variant}; {pathlab_build(args.
       f" rates are medians of {args.reps} runs taken in turns")
 print(f"{'scene':<18} {'Mitsuba S/s':>12} {'pathlab S/s':>12} {'ratio':>6}   {'Mitsuba RMSE':>12}"
       f" {'pathlab spp':>11} {'time used':>9} {'pathlab RMSE':>12} {'RMSE ratio':>10} {'at budget':>9}"
-      f" {'net of ref':>10} {'net, budget':>11} {'mean sq., net, budget':>21}")
+      f" {'net of ref':>10} {'net, budget':>11} {'mean sq., net, budget':>21}"
+      f" {'Sobol spp':>9} {'Sobol: mean sq., net, budget':>28}")
 results = {"cpu": cpu_line(), "variant": variant, "spp": args.spp, "cases": {}}
 os.makedirs(args.work, exist_ok=True)
 for name, folder, depth, ref_depth in CASES:
@@ -78,6 +83,23 @@ for name, folder, depth, ref_depth in CASES:
         lambda rep: mitsuba_render(scene, mitsuba_depth, args.spp, rep),
         lambda flags, kind: pathlab_render(scene, depth, flags, f"{kind}-{tag}"),
         ref_var=ref_var)
+    # Equal time with Sobol samples: the same budget (Mitsuba's median time), the spp
+    # pathlab's rate with Sobol allows, probed as `compare` probes.
+    sobol = ["--sampler", "sobol"]
+    probe, _ = pathlab_render(scene, depth, ["-s", str(args.spp)] + sobol, f"probe-sobol-{tag}")
+    spp_s = max(1, int(c["mitsuba_seconds"] * probe["samples_per_second"] / pixels))
+    errs_s, secs_s = [], []
+    for rep in range(args.reps):
+        stats, img = pathlab_render(scene, depth, ["-s", str(spp_s), "--seed", str(rep + 1)] + sobol,
+                                    f"equal-time-sobol-{tag}")
+        errs_s.append(mitsuba_runs.rmse(img, ref))
+        secs_s.append(stats["seconds"])
+    budget_s = (float(np.median(secs_s)) / c["mitsuba_seconds"]) ** 0.5
+    ratio_s, se_s = mitsuba_runs.mean_square_ratio(errs_s, c["mitsuba_rmses"], ref_var or 0.0)
+    c["sobol_spp"] = spp_s
+    c["sobol_rmses"] = errs_s
+    c["sobol_rmse_ratio_mean_net_at_budget"] = ratio_s * budget_s if ratio_s is not None else None
+    c["sobol_rmse_ratio_mean_net_at_budget_se"] = se_s * budget_s if se_s is not None else None
     results["cases"][name] = c
     print(f"{name:<18} {c['mitsuba_rate']:12.3e} {c['pathlab_rate']:12.3e} {c['ratio']:6.2f}"
           f"   {c['mitsuba_rmse']:12.5f} {c['pathlab_spp']:11d}"
@@ -85,6 +107,8 @@ for name, folder, depth, ref_depth in CASES:
           f" {c['rmse_ratio']:10.2f} {c['rmse_ratio_at_budget']:9.2f}"
           f" {mitsuba_runs.fmt(c['rmse_ratio_net'], 10)}"
           f" {mitsuba_runs.fmt(c['rmse_ratio_net_at_budget'], 11)}"
-          f" {mitsuba_runs.fmt_se(c['rmse_ratio_mean_net_at_budget'], c['rmse_ratio_mean_net_at_budget_se'], 21)}",
+          f" {mitsuba_runs.fmt_se(c['rmse_ratio_mean_net_at_budget'], c['rmse_ratio_mean_net_at_budget_se'], 21)}"
+          f" {spp_s:9d}"
+          f" {mitsuba_runs.fmt_se(c['sobol_rmse_ratio_mean_net_at_budget'], c['sobol_rmse_ratio_mean_net_at_budget_se'], 28)}",
           flush=True)
 json.dump(results, open(f"{args.work}/scenes.json", "w"), indent=1)

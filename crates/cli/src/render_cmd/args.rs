@@ -146,8 +146,9 @@ pub struct RenderArgs {
     /// Where the uniform numbers come from: sobol (Owen-scrambled, padded per dimension),
     /// stratified or independent. Per-pixel variances (--aov variance) are exact estimates only
     /// for independent samples; for the others they overstate the error.
-    /// Default: sobol, or independent with --target-error/--time (whose error estimate is
-    /// exact only for independent samples).
+    /// Default: the one the scene file names (Mitsuba's `<sampler type=...>`, pbrt's
+    /// `Sampler`), else sobol, or independent with --target-error/--time (whose error estimate
+    /// is exact only for independent samples).
     #[arg(long)]
     pub sampler: Option<SamplerKind>,
     /// Render in passes until the estimated relative RMSE of the image is at most E, spending
