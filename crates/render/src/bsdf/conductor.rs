@@ -1,7 +1,7 @@
 //! Conductors: smooth (a delta lobe) or rough (a microfacet model), with the Fresnel
 //! reflectance of a complex index of refraction.
 
-use super::fresnel::fresnel_conductor;
+use super::fresnel::fresnel_conductor_rgb;
 use super::microfacet::Microfacet;
 use super::mirror::specular_reflection;
 use super::scattering::reflect;
@@ -28,12 +28,7 @@ impl Conductor {
     /// Fresnel reflectance per channel at cos θ.
     #[inline]
     fn fresnel(&self, cos: f32) -> Rgb {
-        self.specular
-            * Rgb::new(
-                fresnel_conductor(cos, self.eta.x, self.k.x),
-                fresnel_conductor(cos, self.eta.y, self.k.y),
-                fresnel_conductor(cos, self.eta.z, self.k.z),
-            )
+        self.specular * fresnel_conductor_rgb(cos, self.eta, self.k)
     }
 
     /// f(wo, wi) (zero for a smooth conductor: a delta lobe).

@@ -2,6 +2,9 @@
 //! refraction), Schlick's approximation as the course's option, and the hemispherical
 //! average of the dielectric reflectance that coated materials need.
 
+use crate::simd::lanes::{Real, F8};
+use glam::Vec3;
+
 /// Fresnel reflectance of a smooth dielectric for light arriving at cos θi (positive: from the
 /// outside, the side the normal points to) with relative index `eta` = n_inside / n_outside.
 pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
@@ -44,68 +47,92 @@ pub fn fresnel_schlick(cos_theta_i: f32, eta: f32) -> f32 {
     r0 + (1.0 - r0) * (1.0 - cos).powi(5)
 }
 
-/// A complex number, only as much as the conductor Fresnel equations need.
+/// A complex number over a [`Real`] (one value or lanes), only as much as the conductor
+/// Fresnel equations need.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Complex {
-    re: f32,
-    im: f32,
+struct Complex<R> {
+    re: R,
+    im: R,
 }
 
-impl Complex {
-    const fn new(re: f32, im: f32) -> Self {
+impl<R: Real> Complex<R> {
+    fn new(re: R, im: R) -> Self {
         Complex { re, im }
     }
-    fn add(self, o: Complex) -> Complex {
+    fn real(re: R) -> Self {
+        Complex::new(re, R::splat(0.0))
+    }
+    fn add(self, o: Self) -> Self {
         Complex::new(self.re + o.re, self.im + o.im)
     }
-    fn sub(self, o: Complex) -> Complex {
+    fn sub(self, o: Self) -> Self {
         Complex::new(self.re - o.re, self.im - o.im)
     }
-    fn mul(self, o: Complex) -> Complex {
+    fn mul(self, o: Self) -> Self {
         Complex::new(
             self.re * o.re - self.im * o.im,
             self.re * o.im + self.im * o.re,
         )
     }
-    fn scale(self, s: f32) -> Complex {
+    fn scale(self, s: R) -> Self {
         Complex::new(self.re * s, self.im * s)
     }
-    fn norm2(self) -> f32 {
+    fn norm2(self) -> R {
         self.re * self.re + self.im * self.im
     }
-    fn div(self, o: Complex) -> Complex {
+    fn div(self, o: Self) -> Self {
         let d = o.norm2();
         Complex::new(
             (self.re * o.re + self.im * o.im) / d,
             (self.im * o.re - self.re * o.im) / d,
         )
     }
-    /// The principal square root (non-negative real part).
-    fn sqrt(self) -> Complex {
+    /// The principal square root (non-negative real part; zero at zero).
+    fn sqrt(self) -> Self {
+        let zero = R::splat(0.0);
         let r = self.norm2().sqrt();
-        if r == 0.0 {
-            return Complex::new(0.0, 0.0);
-        }
-        let re = (0.5 * (r + self.re)).max(0.0).sqrt();
-        let im = (0.5 * (r - self.re)).max(0.0).sqrt();
-        Complex::new(re, if self.im < 0.0 { -im } else { im })
+        let re = (R::splat(0.5) * (r + self.re)).max(zero).sqrt();
+        let im = (R::splat(0.5) * (r - self.re)).max(zero).sqrt();
+        let at_zero = r.equals(zero);
+        Complex::new(
+            R::select(at_zero, zero, re),
+            R::select(at_zero, zero, R::select(self.im.lt(zero), -im, im)),
+        )
     }
 }
 
 /// Fresnel reflectance (unpolarised) of a conductor with complex relative index η + i k, for
 /// light arriving at cos θi ∈ [0, 1] from the outside.
 pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
-    let cos_i = cos_theta_i.clamp(0.0, 1.0);
-    let sin2_i = 1.0 - cos_i * cos_i;
+    fresnel_conductor_real(cos_theta_i, eta, k)
+}
+
+/// [`fresnel_conductor`] of the three channels' indices at once, in the lanes of one [`F8`]:
+/// each channel to the bit as [`fresnel_conductor`] gives it.
+pub fn fresnel_conductor_rgb(cos_theta_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
+    // The five spare lanes repeat the first channel (any finite index would do).
+    let lanes = |v: Vec3| F8([v.x, v.y, v.z, v.x, v.x, v.x, v.x, v.x]);
+    let f = fresnel_conductor_real(F8::splat(cos_theta_i), lanes(eta), lanes(k));
+    Vec3::new(f.0[0], f.0[1], f.0[2])
+}
+
+/// [`fresnel_conductor`] written once for one value and for lanes.
+#[inline(always)]
+fn fresnel_conductor_real<R: Real>(cos_theta_i: R, eta: R, k: R) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    // `clamp(0, 1)` (NaN stays NaN).
+    let cos_i = R::select(cos_theta_i.lt(zero), zero, cos_theta_i);
+    let cos_i = R::select(cos_i.gt(one), one, cos_i);
+    let sin2_i = one - cos_i * cos_i;
     let n = Complex::new(eta, k);
-    let sin2_t = Complex::new(sin2_i, 0.0).div(n.mul(n));
-    let cos_t = Complex::new(1.0, 0.0).sub(sin2_t).sqrt();
+    let sin2_t = Complex::real(sin2_i).div(n.mul(n));
+    let cos_t = Complex::real(one).sub(sin2_t).sqrt();
     let n_cos_i = n.scale(cos_i);
     let r_parl = n_cos_i.sub(cos_t).div(n_cos_i.add(cos_t));
-    let ci = Complex::new(cos_i, 0.0);
+    let ci = Complex::real(cos_i);
     let n_cos_t = n.mul(cos_t);
     let r_perp = ci.sub(n_cos_t).div(ci.add(n_cos_t));
-    0.5 * (r_parl.norm2() + r_perp.norm2())
+    R::splat(0.5) * (r_parl.norm2() + r_perp.norm2())
 }
 
 /// Hemispherical average 2 ∫ F(μ) μ dμ of the dielectric Fresnel reflectance for light
@@ -140,6 +167,40 @@ mod tests {
         let brewster = 1.5f32.atan();
         let f = fresnel_dielectric(brewster.cos(), 1.5);
         assert!(f > 0.0 && f < 0.1);
+    }
+
+    #[test]
+    fn three_channels_at_once_are_each_channel_alone() {
+        // Every channel of the lanes' Fresnel is the one-value Fresnel's, to the bit, over
+        // angles from grazing to normal (and outside [0, 1], and NaN) and indices of metals,
+        // a dielectric (k = 0) and an index of one.
+        let mut rng = pathlab_mc::rng::Pcg32::new(11, 3);
+        let mut cosines = vec![0.0f32, 1.0, -0.5, 1.5, 1e-7, f32::NAN];
+        cosines.extend((0..200).map(|_| rng.uniform_f32()));
+        let indices = [
+            (
+                Vec3::new(0.143, 0.374, 1.442),
+                Vec3::new(3.983, 2.385, 1.603),
+            ),
+            (Vec3::new(1.5, 1.0, 0.2), Vec3::new(0.0, 0.0, 3.9)),
+            (Vec3::new(2.8, 0.05, 1.0), Vec3::new(1e-3, 5.0, 0.0)),
+        ];
+        for (eta, k) in indices {
+            for &c in &cosines {
+                let f = fresnel_conductor_rgb(c, eta, k);
+                for (got, (e, kk)) in f
+                    .to_array()
+                    .into_iter()
+                    .zip(eta.to_array().into_iter().zip(k.to_array()))
+                {
+                    let want = fresnel_conductor(c, e, kk);
+                    assert!(
+                        got.to_bits() == want.to_bits(),
+                        "cos {c}, eta {e}, k {kk}: {got} vs {want}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
