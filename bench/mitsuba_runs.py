@@ -121,15 +121,8 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None, ref
         rates_p.append(stats["samples_per_second"])
     rate_m, rate_p = float(np.median(rates_m)), float(np.median(rates_p))
     t_m, e_m = float(np.median(times_m)), float(np.median(errs_m))
-    probe, _ = pathlab(["-s", str(spp)], "probe")
-    spp_p = max(1, int(t_m * probe["samples_per_second"] / pixels))
-    errs_p, secs_p = [], []
-    for rep in range(reps):
-        stats, img = pathlab(["-s", str(spp_p), "--seed", str(rep + 1)], "equal-time")
-        errs_p.append(rmse(img, ref))
-        secs_p.append(stats["seconds"])
+    spp_p, errs_p, secs = equal_time(reps, spp, pixels, ref, t_m, pathlab)
     e_p = float(np.median(errs_p))
-    secs = float(np.median(secs_p))
     ratio = e_p / e_m if e_m > 0 else None
     net = None
     if ref_var is not None and e_m * e_m > ref_var:
@@ -157,6 +150,22 @@ def compare(reps, spp, pixels, ref, mitsuba, pathlab, mitsuba_settings=None, ref
         "rmse_ratio_mean_net_at_budget_se": mean_se * budget
         if mean_se is not None and budget is not None else None,
     }
+
+
+def equal_time(reps, spp, pixels, ref, budget, pathlab, flags=(), kind=""):
+    """pathlab's equal-time renders, as `compare` makes them: its rate with `flags` probed by a
+    render at `spp`, then `reps` renders (seeds 1, 2, ...) at the spp that rate allows in
+    `budget` seconds (`kind` tells their files apart). Returns that spp, the renders' RMSEs
+    against `ref` and their median time."""
+    flags = list(flags)
+    probe, _ = pathlab(["-s", str(spp)] + flags, "probe" + kind)
+    spp_p = max(1, int(budget * probe["samples_per_second"] / pixels))
+    errs, secs = [], []
+    for rep in range(reps):
+        stats, img = pathlab(["-s", str(spp_p), "--seed", str(rep + 1)] + flags, "equal-time" + kind)
+        errs.append(rmse(img, ref))
+        secs.append(stats["seconds"])
+    return spp_p, errs, float(np.median(secs))
 
 
 def mean_square_ratio(errs_p, errs_m, ref_var):

@@ -78,23 +78,18 @@ for name, folder, depth, ref_depth in CASES:
     pixels = ref.shape[0] * ref.shape[1]
     mitsuba_depth = -1 if depth == "inf" else int(depth) + 1
     tag = folder + ("" if depth == "inf" else f"-m{depth}")
+    def pathlab(flags, kind):
+        return pathlab_render(scene, depth, flags, f"{kind}-{tag}")
     c = mitsuba_runs.compare(
         args.reps, args.spp, pixels, ref,
         lambda rep: mitsuba_render(scene, mitsuba_depth, args.spp, rep),
-        lambda flags, kind: pathlab_render(scene, depth, flags, f"{kind}-{tag}"),
-        ref_var=ref_var)
+        pathlab, ref_var=ref_var)
     # Equal time with Sobol samples: the same budget (Mitsuba's median time), the spp
-    # pathlab's rate with Sobol allows, probed as `compare` probes.
-    sobol = ["--sampler", "sobol"]
-    probe, _ = pathlab_render(scene, depth, ["-s", str(args.spp)] + sobol, f"probe-sobol-{tag}")
-    spp_s = max(1, int(c["mitsuba_seconds"] * probe["samples_per_second"] / pixels))
-    errs_s, secs_s = [], []
-    for rep in range(args.reps):
-        stats, img = pathlab_render(scene, depth, ["-s", str(spp_s), "--seed", str(rep + 1)] + sobol,
-                                    f"equal-time-sobol-{tag}")
-        errs_s.append(mitsuba_runs.rmse(img, ref))
-        secs_s.append(stats["seconds"])
-    budget_s = (float(np.median(secs_s)) / c["mitsuba_seconds"]) ** 0.5
+    # pathlab's rate with Sobol allows.
+    spp_s, errs_s, secs_s = mitsuba_runs.equal_time(
+        args.reps, args.spp, pixels, ref, c["mitsuba_seconds"], pathlab,
+        ["--sampler", "sobol"], "-sobol")
+    budget_s = (secs_s / c["mitsuba_seconds"]) ** 0.5
     ratio_s, se_s = mitsuba_runs.mean_square_ratio(errs_s, c["mitsuba_rmses"], ref_var or 0.0)
     c["sobol_spp"] = spp_s
     c["sobol_rmses"] = errs_s
