@@ -11,6 +11,7 @@ use pathlab_render::accel::{Bvh, Bvh4, BvhParams, TriBlock};
 use pathlab_render::bsdf::{Bxdf, Conductor, Microfacet, NormalDistribution, RoughDielectric};
 use pathlab_render::geometry::Ray;
 use pathlab_render::shape::Triangle;
+use pathlab_render::simd::lanes::F8;
 
 /// A bumpy sphere of about `n` triangles.
 fn mesh(n: usize) -> Vec<Triangle> {
@@ -193,6 +194,16 @@ fn environment_map(c: &mut Criterion) {
         .collect();
     c.bench_function("environment map sample, 1024 draws", |b| {
         b.iter(|| us.iter().filter_map(|&u| map.sample(black_box(u))).count())
+    });
+    c.bench_function("environment map sample in lanes, 1024 draws", |b| {
+        b.iter(|| {
+            us.chunks_exact(8)
+                .map(|u| {
+                    let lanes = [0, 1].map(|k| F8(std::array::from_fn(|i| u[i][k])));
+                    map.sample_direction_lanes(black_box(lanes), 0xff).pdf.0[3]
+                })
+                .sum::<f32>()
+        })
     });
     let ws: Vec<Vec3> = us
         .iter()

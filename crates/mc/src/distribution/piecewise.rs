@@ -4,7 +4,7 @@
 
 use super::check_weights;
 use crate::error::{Error, Result};
-use crate::simd::lanes::{F8, W};
+use crate::simd::lanes::{Real, F8, M8, W};
 use glam::Vec2;
 
 /// A continuous sample of a [`PiecewiseConstant1D`].
@@ -152,14 +152,36 @@ impl Pieces<'_> {
         lo + count_cdf_at_most(&self.entries[lo..hi], u)
     }
 
+    /// [`Pieces::cdf_entries_at_most`] without a branch on the length of `u`'s bucket where it
+    /// holds at most `WINDOW` entries, as most do: the count is then over a fixed window of
+    /// `WINDOW` entries that holds them. A window start `s` before the bucket's first entry
+    /// `lo` is no harm: the entries from `s` to `lo` are ≤ u and counted, those from the
+    /// bucket's end on are not. For searches one after another that the branch on the
+    /// bucket's length would mispredict (the lanes' searches); a long bucket or a short table
+    /// is counted as there.
+    #[inline(always)]
+    fn cdf_entries_at_most_windowed(&self, u: f32) -> usize {
+        const WINDOW: usize = 16;
+        let buckets = self.guide.len() - 2;
+        let t = u * buckets as f32;
+        let len = self.entries.len();
+        if !t.is_nan() && t >= 0.0 && len >= WINDOW {
+            let k = (t as usize).min(buckets);
+            let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+            let start = lo.min(len - WINDOW);
+            if let (true, Some(window)) =
+                (hi - lo <= WINDOW, self.entries.get(start..start + WINDOW))
+            {
+                return start + count_cdf_at_most(window, u);
+            }
+        }
+        self.cdf_entries_at_most(u)
+    }
+
     /// Density of piece `o` with respect to x.
     #[inline]
     fn piece_pdf(&self, o: usize) -> f32 {
-        if self.func_int > 0.0 {
-            self.entries[o].func / self.func_int
-        } else {
-            1.0 / (self.max - self.min)
-        }
+        density_of_piece(self.entries[o].func, self.func_int, self.min, self.max)
     }
 
     /// Whether the domain is [0, 1], where the maps between x and the fraction of the domain
@@ -189,25 +211,45 @@ impl Pieces<'_> {
 
     /// [`Pieces::sample`] of `u` given `count`, the number of CDF entries `<= u`
     /// ([`Pieces::cdf_entries_at_most`]): the two halves of a sample, which the lanes' sampling
-    /// runs as two passes over the lanes.
+    /// runs as passes over the lanes.
     #[inline]
     fn sample_counted(&self, u: f32, count: usize) -> PiecewiseSample {
         let o = self.piece_of_count(count);
-        let (c0, c1) = (self.entries[o].cdf, self.entries[o + 1].cdf);
-        let mut du = u - c0;
-        if c1 - c0 > 0.0 {
-            du /= c1 - c0;
+        let piece = self.piece(o);
+        let x = point_in_piece(u, o as f32, piece, self.len(), self.min, self.max);
+        PiecewiseSample {
+            x: self.settle_in_piece(x, o),
+            pdf: density_of_piece(piece.func, self.func_int, self.min, self.max),
+            offset: o,
         }
-        let t = (divide_by_count(o as f32 + du.clamp(0.0, 1.0), self.len())).min(1.0);
-        // On [0, 1], 0 + t · 1 is t itself (t ≥ +0: o + du is never -0).
-        let x = if self.unit_domain() {
-            t
+    }
+
+    /// Piece `o`'s CDF at its two ends and its value.
+    #[inline(always)]
+    fn piece(&self, o: usize) -> Piece<f32> {
+        let (e0, e1) = (self.entries[o], self.entries[o + 1]);
+        Piece {
+            c0: e0.cdf,
+            c1: e1.cdf,
+            func: e0.func,
+        }
+    }
+
+    /// `x`, a point [`point_in_piece`] put in piece `o`, or the nearest float inside piece `o`
+    /// where rounding put it at the edge of a neighbouring piece, whose density differs (or
+    /// is zero).
+    #[inline(always)]
+    fn settle_in_piece(&self, x: f32, o: usize) -> f32 {
+        if self.offset_of(x) == o {
+            x
         } else {
-            self.min + t * (self.max - self.min)
-        };
-        let mut x = x.min(self.max.next_down());
-        // Rounding can put a point at a piece's edge into the neighbouring piece, whose density
-        // differs (or is zero); step to the nearest float inside piece `o`.
+            self.step_into_piece(x, o)
+        }
+    }
+
+    /// [`Pieces::settle_in_piece`] of a point outside piece `o`.
+    #[inline(never)]
+    fn step_into_piece(&self, mut x: f32, o: usize) -> f32 {
         for _ in 0..8 {
             match self.offset_of(x).cmp(&o) {
                 std::cmp::Ordering::Less => x = x.next_up(),
@@ -215,11 +257,7 @@ impl Pieces<'_> {
                 std::cmp::Ordering::Equal => break,
             }
         }
-        PiecewiseSample {
-            x,
-            pdf: self.piece_pdf(o),
-            offset: o,
-        }
+        x
     }
 
     fn invert_sample(&self, x: f32) -> f32 {
@@ -232,16 +270,61 @@ impl Pieces<'_> {
     }
 }
 
+/// A piece of a tabulated distribution as sampling reads it, for one value or lanes: the CDF
+/// at its start and end and its value.
+#[derive(Clone, Copy, Debug, Default)]
+struct Piece<R> {
+    c0: R,
+    c1: R,
+    func: R,
+}
+
+/// The point that `u` maps to in piece `o` (as a number) of `n` equal pieces over
+/// `[min, max]`: the CDF inverted linearly inside the piece, kept below `max`; before
+/// [`Pieces::settle_in_piece`]. Written once for one value and for lanes (the `f32` minimum
+/// and clamp as selects with their NaN rules: a NaN `du` stays NaN, a NaN `t` or `x` takes the
+/// bound).
+#[inline(always)]
+fn point_in_piece<R: Real>(u: R, o: R, piece: Piece<R>, n: usize, min: f32, max: f32) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let width = piece.c1 - piece.c0;
+    let du = u - piece.c0;
+    let du = R::select(width.gt(zero), du / width, du);
+    let du = R::select(du.lt(zero), zero, R::select(du.gt(one), one, du));
+    let t = divide_by_count(o + du, n);
+    let t = R::select(t.lt(one), t, one);
+    // On [0, 1], 0 + t · 1 is t itself (t ≥ +0: o + du is never -0).
+    let x = if min == 0.0 && max == 1.0 {
+        t
+    } else {
+        R::splat(min) + t * R::splat(max - min)
+    };
+    let top = R::splat(max.next_down());
+    R::select(x.lt(top), x, top)
+}
+
+/// The density with respect to x of a piece of value `func` in a distribution over
+/// `[min, max]` whose values integrate to `func_int` (uniform where they are all zero), for
+/// one value or lanes.
+#[inline(always)]
+fn density_of_piece<R: Real>(func: R, func_int: R, min: f32, max: f32) -> R {
+    R::select(
+        func_int.gt(R::splat(0.0)),
+        func / func_int,
+        R::splat(1.0 / (max - min)),
+    )
+}
+
 /// `a / n`, by a product with 1/n where `n` is a power of two: 1/n is then exact, and `a · 1/n`
 /// and `a / n` are both the correctly rounded value of the same real number, so they are the
 /// same float (subnormal results included); a division where it is not.
-#[inline]
-fn divide_by_count(a: f32, n: usize) -> f32 {
+#[inline(always)]
+fn divide_by_count<R: Real>(a: R, n: usize) -> R {
     if n.is_power_of_two() {
         // 2^-k from its exponent bits (k < 64 < 127: a normal float).
-        a * f32::from_bits((127 - n.trailing_zeros()) << 23)
+        a * R::splat(f32::from_bits((127 - n.trailing_zeros()) << 23))
     } else {
-        a / n as f32
+        a / R::splat(n as f32)
     }
 }
 
@@ -420,6 +503,40 @@ impl PiecewiseConstant1D {
     }
 }
 
+/// The pieces that eight searches found, one per lane, as the lanes' inversion reads them.
+#[derive(Default)]
+struct PieceLanes {
+    /// Each lane's piece.
+    o: [usize; W],
+    /// Its index as a number, its CDF at both ends and its value.
+    index: F8,
+    piece: Piece<F8>,
+}
+
+impl PieceLanes {
+    /// Lane `i`'s piece: the one of `pieces` that `count` CDF entries are at most.
+    #[inline(always)]
+    fn set(&mut self, i: usize, pieces: &Pieces<'_>, count: usize) {
+        let o = pieces.piece_of_count(count);
+        let p = pieces.piece(o);
+        self.o[i] = o;
+        self.index.0[i] = o as f32;
+        (self.piece.c0.0[i], self.piece.c1.0[i], self.piece.func.0[i]) = (p.c0, p.c1, p.func);
+    }
+
+    /// The lanes' points for `u` in their pieces, before [`Pieces::settle_in_piece`], and
+    /// their densities, where the pieces are of distributions with the number of pieces and
+    /// the domain of `like` and the integrals `func_int`.
+    #[inline(always)]
+    fn points(&self, like: &Pieces<'_>, u: F8, func_int: F8) -> (F8, F8) {
+        let (n, min, max) = (like.len(), like.min, like.max);
+        (
+            point_in_piece(u, self.index, self.piece, n, min, max),
+            density_of_piece(self.piece.func, func_int, min, max),
+        )
+    }
+}
+
 /// A piecewise-constant density on a rectangle: `nu × nv` cells with values `f[v][u]`.
 ///
 /// Sampled by the marginal-conditional method: first a row `v` from the marginal density
@@ -519,30 +636,44 @@ impl PiecewiseConstant2D {
 
     /// [`PiecewiseConstant2D::sample`] of the lanes `active` of (`u[0]`, `u[1]`), each lane to
     /// the bit as one sample at a time (the other lanes give zeros): the points' u and v and
-    /// their densities. The lanes are taken a step at a time: every lane's row, then every
-    /// lane's search of its row, then every lane's point.
+    /// their densities. The searches go lane by lane (each lane reads its own row), the
+    /// inversions inside the pieces on all lanes at once ([`point_in_piece`],
+    /// [`density_of_piece`]): first the rows, from the marginal, then the points in the rows.
     pub fn sample_lanes(&self, u: [F8; 2], active: u32) -> ([F8; 2], F8) {
         let lanes = || (0..W).filter(move |i| active & (1 << i) != 0);
-        let mut rows = [PiecewiseSample {
-            x: 0.0,
-            pdf: 0.0,
-            offset: 0,
-        }; W];
+        let marginal = self.marginal.pieces();
+        let mut rows = PieceLanes::default();
         for i in lanes() {
-            rows[i] = self.marginal.sample(u[1].0[i]);
+            let u = u[1].0[i];
+            rows.set(i, &marginal, marginal.cdf_entries_at_most_windowed(u));
         }
+        let (y, pdf_v) = rows.points(&marginal, u[1], F8::splat(marginal.func_int));
         let mut counts = [0usize; W];
         for i in lanes() {
-            counts[i] = self.row(rows[i].offset).cdf_entries_at_most(u[0].0[i]);
+            counts[i] = self.row(rows.o[i]).cdf_entries_at_most_windowed(u[0].0[i]);
         }
-        let (mut x, mut y, mut pdf) = (F8::splat(0.0), F8::splat(0.0), F8::splat(0.0));
+        let mut cols = PieceLanes::default();
+        let mut row_integrals = F8::splat(0.0);
         for i in lanes() {
-            let col = self
-                .row(rows[i].offset)
-                .sample_counted(u[0].0[i], counts[i]);
-            (x.0[i], y.0[i], pdf.0[i]) = (col.x, rows[i].x, col.pdf * rows[i].pdf);
+            let row = self.row(rows.o[i]);
+            cols.set(i, &row, counts[i]);
+            row_integrals.0[i] = row.func_int;
         }
-        ([x, y], pdf)
+        let (x, pdf_u) = cols.points(&self.row(0), u[0], row_integrals);
+        let mut on = M8::default();
+        for i in lanes() {
+            on.set(i, true);
+        }
+        let mut point = [x, y];
+        for i in lanes() {
+            point[0].0[i] = self.row(rows.o[i]).settle_in_piece(x.0[i], cols.o[i]);
+            point[1].0[i] = marginal.settle_in_piece(y.0[i], rows.o[i]);
+        }
+        let zero = F8::splat(0.0);
+        (
+            point.map(|c| on.select(c, zero)),
+            on.select(pdf_u * pdf_v, zero),
+        )
     }
 
     /// The density at `p` (0 outside the rectangle).
@@ -594,10 +725,12 @@ mod tests {
             }
             us.extend((0..2000).map(|_| rng.uniform_f32()));
             for u in us {
+                let want = cdf.partition_point(|&c| c <= u);
+                assert_eq!(d.pieces().cdf_entries_at_most(u), want, "n = {n}, u = {u}");
                 assert_eq!(
-                    d.pieces().cdf_entries_at_most(u),
-                    cdf.partition_point(|&c| c <= u),
-                    "n = {n}, u = {u}"
+                    d.pieces().cdf_entries_at_most_windowed(u),
+                    want,
+                    "windowed, n = {n}, u = {u}"
                 );
             }
         }
