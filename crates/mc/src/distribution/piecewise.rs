@@ -138,18 +138,26 @@ impl Pieces<'_> {
     /// whole CDF.
     #[inline]
     fn cdf_entries_at_most(&self, u: f32) -> usize {
+        match self.bucket(u) {
+            Some((lo, hi)) => lo + count_cdf_at_most(&self.entries[lo..hi], u),
+            None => 0,
+        }
+    }
+
+    /// The entries `lo..hi` of `u`'s bucket of the guide table: entries before `lo` are
+    /// ≤ k/K ≤ u, entries from `hi` on exceed (k + 1)/K > u (bucket K, u ≥ 1, runs to the
+    /// end). None where `u` is NaN or negative: every CDF entry is ≥ 0, and none compares
+    /// ≤ NaN.
+    #[inline(always)]
+    fn bucket(&self, u: f32) -> Option<(usize, usize)> {
         let buckets = self.guide.len() - 2;
         // K is a power of two, so t is exactly u·K and k/K ≤ u < (k + 1)/K.
         let t = u * buckets as f32;
         if t.is_nan() || t < 0.0 {
-            // Every CDF entry is ≥ 0, and none compares ≤ NaN.
-            return 0;
+            return None;
         }
         let k = (t as usize).min(buckets);
-        // Entries before `lo` are ≤ k/K ≤ u; entries from `hi` on exceed (k + 1)/K > u
-        // (bucket K, u ≥ 1, runs to the end).
-        let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
-        lo + count_cdf_at_most(&self.entries[lo..hi], u)
+        Some((self.guide[k] as usize, self.guide[k + 1] as usize))
     }
 
     /// [`Pieces::cdf_entries_at_most`] without a branch on the length of `u`'s bucket where it
@@ -162,20 +170,17 @@ impl Pieces<'_> {
     #[inline(always)]
     fn cdf_entries_at_most_windowed(&self, u: f32) -> usize {
         const WINDOW: usize = 16;
-        let buckets = self.guide.len() - 2;
-        let t = u * buckets as f32;
+        let Some((lo, hi)) = self.bucket(u) else {
+            return 0;
+        };
         let len = self.entries.len();
-        if !t.is_nan() && t >= 0.0 && len >= WINDOW {
-            let k = (t as usize).min(buckets);
-            let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+        if len >= WINDOW && hi - lo <= WINDOW {
             let start = lo.min(len - WINDOW);
-            if let (true, Some(window)) =
-                (hi - lo <= WINDOW, self.entries.get(start..start + WINDOW))
-            {
+            if let Some(window) = self.entries.get(start..start + WINDOW) {
                 return start + count_cdf_at_most(window, u);
             }
         }
-        self.cdf_entries_at_most(u)
+        lo + count_cdf_at_most(&self.entries[lo..hi], u)
     }
 
     /// Density of piece `o` with respect to x.
@@ -184,11 +189,10 @@ impl Pieces<'_> {
         density_of_piece(self.entries[o].func, self.func_int, self.min, self.max)
     }
 
-    /// Whether the domain is [0, 1], where the maps between x and the fraction of the domain
-    /// before it are the identity.
+    /// Whether the domain is [0, 1] ([`is_unit_domain`]).
     #[inline]
     fn unit_domain(&self) -> bool {
-        self.min == 0.0 && self.max == 1.0
+        is_unit_domain(self.min, self.max)
     }
 
     /// The index of the piece containing `x` (clamped to the domain).
@@ -294,13 +298,20 @@ fn point_in_piece<R: Real>(u: R, o: R, piece: Piece<R>, n: usize, min: f32, max:
     let t = divide_by_count(o + du, n);
     let t = R::select(t.lt(one), t, one);
     // On [0, 1], 0 + t · 1 is t itself (t ≥ +0: o + du is never -0).
-    let x = if min == 0.0 && max == 1.0 {
+    let x = if is_unit_domain(min, max) {
         t
     } else {
         R::splat(min) + t * R::splat(max - min)
     };
     let top = R::splat(max.next_down());
     R::select(x.lt(top), x, top)
+}
+
+/// Whether `[min, max]` is [0, 1], where the maps between x and the fraction of the domain
+/// before it are the identity.
+#[inline(always)]
+fn is_unit_domain(min: f32, max: f32) -> bool {
+    min == 0.0 && max == 1.0
 }
 
 /// The density with respect to x of a piece of value `func` in a distribution over
