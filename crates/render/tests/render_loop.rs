@@ -7,7 +7,10 @@ mod common;
 use common::*;
 use glam::{DVec3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
-use pathlab_render::desc::{EnvironmentMapDesc, MeshDesc, SceneDesc};
+use pathlab_render::desc::{
+    EnvironmentMapDesc, MaterialDesc, MeshDesc, NormalDistribution, SceneDesc, SphereDesc,
+    TextureDesc,
+};
 use pathlab_render::film::Film;
 use pathlab_render::integrator::{BdptIntegrator, IntegratorKind};
 use pathlab_render::render::{render, RenderSettings};
@@ -142,12 +145,45 @@ fn under_a_sky(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with rough conductors: GGX of one roughness on the wall and the mirror sphere (the
+/// lanes shade those together), and two the lanes leave to the scalar code, a Beckmann sphere
+/// and an anisotropic GGX one.
+fn with_metals(mut desc: SceneDesc) -> SceneDesc {
+    let gold = |alpha: f32, distribution| MaterialDesc::Conductor {
+        alpha,
+        eta: Vec3::new(0.143, 0.374, 1.442),
+        k: Vec3::new(3.983, 2.385, 1.603),
+        distribution,
+    };
+    desc.materials[1] = gold(0.08, NormalDistribution::Ggx);
+    desc.materials[2] = gold(0.3, NormalDistribution::Ggx);
+    desc.materials.push(gold(0.2, NormalDistribution::Beckmann));
+    desc.materials.push(MaterialDesc::RoughConductor {
+        alpha_u: TextureDesc::Constant(Vec3::splat(0.1)),
+        alpha_v: TextureDesc::Constant(Vec3::splat(0.4)),
+        eta: Vec3::new(0.2, 0.9, 1.1),
+        k: Vec3::new(3.9, 2.4, 2.2),
+        specular: TextureDesc::Constant(Vec3::ONE),
+        distribution: NormalDistribution::Ggx,
+    });
+    for (x, material) in [(-0.1, 3), (0.7, 4)] {
+        desc.spheres.push(SphereDesc {
+            center: Vec3::new(x, 0.12, 0.5),
+            radius: 0.12,
+            material,
+            ..Default::default()
+        });
+    }
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
     // Lambertian surfaces lit by emitting triangles or an environment map in SIMD lanes (and
     // the environment map's radiance towards the rays that leave the scene) and everything
-    // else with the scalar code: every sample's radiance must be the scalar `li`'s to the
+    // else with the scalar code (rough GGX conductors of one roughness too, in the scenes
+    // `with_metals`): every sample's radiance must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these
@@ -159,6 +195,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         (big_light(), false),
         (under_a_sky(mixed_scene()), false),
         (crowded(under_a_sky(mixed_scene())), true),
+        (with_metals(mixed_scene()), false),
+        (crowded(under_a_sky(with_metals(mixed_scene()))), true),
     ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);

@@ -154,6 +154,12 @@ impl M8 {
     pub fn set(&mut self, i: usize, on: bool) {
         self.0[i] = if on { !0 } else { 0 };
     }
+
+    /// Whether any lane is set.
+    #[inline(always)]
+    pub fn any(self) -> bool {
+        self.0.iter().fold(0, |a, &m| a | m) != 0
+    }
 }
 
 macro_rules! lane_op {
@@ -396,6 +402,15 @@ pub trait Vector3:
     fn max_element(self) -> Self::R;
     /// `a` where `m`, else `b`, for each axis.
     fn select(m: <Self::R as Real>::Mask, a: Self, b: Self) -> Self;
+    /// glam's `cross`: (y z' - y' z, z x' - z' x, x y' - x' y).
+    #[inline(always)]
+    fn cross(self, o: Self) -> Self {
+        Self::new(
+            self.y() * o.z() - o.y() * self.z(),
+            self.z() * o.x() - o.z() * self.x(),
+            self.x() * o.y() - o.x() * self.y(),
+        )
+    }
     /// glam's `normalize`: the vector times the reciprocal of its length (the same bits as
     /// glam's for `Vec3`, without its debug check of a finite result).
     #[inline(always)]
@@ -664,6 +679,12 @@ mod tests {
             let u = V8 { x: b, y: a, z: b };
             assert!(same(v.dot(u).0[i], v.get(i).dot(u.get(i))));
             assert!(same(v.max_element().0[i], v.get(i).max_element()));
+            let (c, g) = (Vector3::cross(v, u).get(i), v.get(i).cross(u.get(i)));
+            assert!(
+                same(c.x, g.x) && same(c.y, g.y) && same(c.z, g.z),
+                "{c} vs {g}"
+            );
+            assert_eq!(a.lt(b).any(), (0..W).any(|j| a.0[j] < b.0[j]));
         }
     }
 }

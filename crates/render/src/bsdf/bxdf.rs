@@ -4,6 +4,34 @@
 use super::*;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
+use pathlab_mc::simd::lanes::{Real, Vector3};
+
+/// A non-delta lobe's sample in the local frame, for one direction (`V = Vec3`) or for eight
+/// lanes ([`crate::simd::lanes::V8`]): it exists where `valid`.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectionSample<V: Vector3> {
+    /// The sampled direction, local.
+    pub wi: V,
+    /// Its density per unit solid angle.
+    pub pdf: V::R,
+    /// f there.
+    pub f: V,
+    /// Where the sample exists.
+    pub valid: <V::R as Real>::Mask,
+}
+
+impl DirectionSample<Vec3> {
+    /// The sample where it exists.
+    #[inline]
+    pub fn local(self) -> Option<LocalSample> {
+        self.valid.then_some(LocalSample {
+            f: self.f,
+            wi: self.wi,
+            pdf: self.pdf,
+            delta: false,
+        })
+    }
+}
 
 /// A sampled direction in the local frame.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,13 +1,15 @@
 //! Conductors: smooth (a delta lobe) or rough (a microfacet model), with the Fresnel
 //! reflectance of a complex index of refraction.
 
-use super::fresnel::fresnel_conductor_rgb;
-use super::microfacet::Microfacet;
+use super::bxdf::DirectionSample;
+use super::fresnel::{fresnel_conductor_rgb, ConductorFresnel};
+use super::microfacet::{Distribution, IsotropicGgx, Microfacet, NormalDistribution};
 use super::mirror::specular_reflection;
 use super::scattering::reflect;
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
+use pathlab_mc::simd::lanes::{Real, F8, V8};
 
 /// A conductor with complex index η + i k per channel. Smooth without a distribution;
 /// otherwise f = D(wm) G(wo, wi, wm) F(wo·wm) / (4 cos θo cos θi) with wm the half vector
@@ -31,57 +33,206 @@ impl Conductor {
         self.specular * fresnel_conductor_rgb(cos, self.eta, self.k)
     }
 
+    /// The rough lobe (`None` when smooth).
+    #[inline]
+    fn rough(&self) -> Option<RoughConductor<Rgb, Microfacet>> {
+        self.distribution.map(|distribution| RoughConductor {
+            eta: self.eta,
+            k: self.k,
+            specular: self.specular,
+            distribution,
+        })
+    }
+
+    /// The rough lobe where its distribution is GGX of one roughness in every direction: the
+    /// model the path tracer's lanes shade together, with the same functions.
+    #[inline]
+    pub fn as_isotropic_ggx(&self) -> Option<RoughConductor<Rgb, IsotropicGgx<f32>>> {
+        let m = self.distribution?;
+        (m.kind == NormalDistribution::Ggx && m.is_isotropic()).then_some(RoughConductor {
+            eta: self.eta,
+            k: self.k,
+            specular: self.specular,
+            distribution: IsotropicGgx { alpha: m.alpha },
+        })
+    }
+
     /// f(wo, wi) (zero for a smooth conductor: a delta lobe).
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        let Some(m) = self.distribution else {
-            return Rgb::ZERO;
-        };
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let wm = wo + wi;
-        if wm.length_squared() == 0.0 {
-            return Rgb::ZERO;
-        }
-        let wm = wm.normalize();
-        let dg = m.d(wm) * m.g(wo, wi, wm);
-        self.fresnel(wo.dot(wm)) * (dg / (4.0 * wo.z * wi.z))
+        self.rough().map_or(Rgb::ZERO, |r| r.f(wo, wi))
     }
 
     /// A sample: the mirror direction when smooth, otherwise the reflection of `wo` about a
     /// sampled microfacet normal.
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
-        let Some(m) = self.distribution else {
+        let Some(r) = self.rough() else {
             return specular_reflection(wo, self.fresnel(wo.z.abs()), 1.0);
         };
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let wm = m.sample_wm(wo, u);
-        let wi = reflect(wo, wm);
-        if wi.z <= 0.0 {
-            return None;
-        }
-        LocalSample::evaluated(wi, self.pdf(wo, wi), || self.f(wo, wi))
+        r.sample(wo, u.x, u.y).local()
     }
 
-    /// Density of [`Conductor::sample`]: pdf(wm) / (4 wo·wm).
+    /// Density of [`Conductor::sample`].
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let Some(m) = self.distribution else {
-            return 0.0;
-        };
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        let wm = wo + wi;
-        if wm.length_squared() == 0.0 {
-            return 0.0;
-        }
-        let wm = wm.normalize();
+        self.rough().map_or(0.0, |r| r.pdf(wo, wi))
+    }
+}
+
+/// A rough conductor's lobe, written once for one direction (`V = Rgb`, with `Microfacet`
+/// or [`IsotropicGgx`]) and for eight lanes (`V = V8`, with `IsotropicGgx<F8>`): f = D(wm)
+/// G(wo, wi, wm) F(wo·wm) / (4 cos θo cos θi) with wm the half vector, sampled by reflecting
+/// `wo` about a normal from the distribution, of density pdf(wm) / (4 wo·wm).
+///
+/// [`V8`]: crate::simd::lanes::V8
+/// [`F8`]: crate::simd::lanes::F8
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RoughConductor<V, M> {
+    /// Real part of the index, per channel.
+    pub eta: V,
+    /// Imaginary part, per channel.
+    pub k: V,
+    /// Scale of the reflection.
+    pub specular: V,
+    /// The microfacet distribution.
+    pub distribution: M,
+}
+
+impl<V: ConductorFresnel, M: Distribution<V::R>> RoughConductor<V, M> {
+    /// f(wo, wi) and its density as a sample from `wo`, from one half vector (zero where
+    /// either direction is below the surface or they are opposite).
+    #[inline(always)]
+    pub fn f_and_pdf(&self, wo: V, wi: V) -> (V, V::R) {
+        let (zero, four) = (V::R::splat(0.0), V::R::splat(4.0));
+        let sum = wo + wi;
+        let wm = sum.normalize();
+        let m = &self.distribution;
+        let dg = m.d(wm) * m.g(wo, wi, wm);
         let cos_om = wo.dot(wm);
-        if cos_om <= 0.0 {
-            return 0.0;
+        let fresnel = self
+            .specular
+            .mul_axes(V::fresnel_conductor(cos_om, self.eta, self.k));
+        let f = fresnel.scale(dg / (four * wo.z() * wi.z()));
+        let pdf = m.pdf_wm(wo, wm) / (four * cos_om);
+        // Both below or opposite: nothing (`!(z > 0)` lets NaN through, as `z <= 0`).
+        let none = wo.z().le(zero) | wi.z().le(zero) | sum.dot(sum).equals(zero);
+        (
+            V::select(none, V::splat(Vec3::ZERO), f),
+            V::R::select(none | cos_om.le(zero), zero, pdf),
+        )
+    }
+
+    /// f(wo, wi).
+    #[inline(always)]
+    pub fn f(&self, wo: V, wi: V) -> V {
+        self.f_and_pdf(wo, wi).0
+    }
+
+    /// Density of [`RoughConductor::sample`] choosing `wi`.
+    #[inline(always)]
+    pub fn pdf(&self, wo: V, wi: V) -> V::R {
+        self.f_and_pdf(wo, wi).1
+    }
+
+    /// The reflection of `wo` about a normal drawn from (`u0`, `u1`): it exists where `wo`
+    /// and it are above the surface and its density is positive.
+    #[inline(always)]
+    pub fn sample(&self, wo: V, u0: V::R, u1: V::R) -> DirectionSample<V> {
+        let zero = V::R::splat(0.0);
+        let wm = self.distribution.sample_wm(wo, u0, u1);
+        let wi = reflect(wo, wm);
+        let (f, pdf) = self.f_and_pdf(wo, wi);
+        DirectionSample {
+            wi,
+            pdf,
+            f,
+            valid: !wo.z().le(zero) & !wi.z().le(zero) & pdf.gt(zero),
         }
-        m.pdf_wm(wo, wm) / (4.0 * cos_om)
+    }
+}
+
+impl RoughConductor<V8, IsotropicGgx<F8>> {
+    /// Sets lane `i` to `c`. Every field is taken apart here: a field added to
+    /// [`RoughConductor`] or [`IsotropicGgx`] fails to compile until its lanes are set too.
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, c: RoughConductor<Rgb, IsotropicGgx<f32>>) {
+        let RoughConductor {
+            eta,
+            k,
+            specular,
+            distribution: IsotropicGgx { alpha },
+        } = c;
+        self.eta.set(i, eta);
+        self.k.set(i, k);
+        self.specular.set(i, specular);
+        self.distribution.alpha.0[i] = alpha;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pathlab_mc::rng::Pcg32;
+
+    /// Eight lanes of the rough conductor compute, lane by lane, what the one-direction
+    /// [`Conductor`] computes (through [`Microfacet`]), to the bit: f, pdf and the sample,
+    /// for directions above, below and on the horizon, opposite pairs and equal ones.
+    #[test]
+    fn lanes_compute_what_the_one_direction_conductor_computes() {
+        let mut rng = Pcg32::new(7, 11);
+        let direction = |rng: &mut Pcg32| {
+            let z = 2.0 * rng.uniform_f32() - 1.0;
+            let phi = std::f32::consts::TAU * rng.uniform_f32();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        };
+        let (mut valid, mut lanes_seen) = (0, 0);
+        for round in 0..400 {
+            let mut lanes = RoughConductor::<V8, IsotropicGgx<F8>>::default();
+            let (mut wo, mut wi) = (V8::default(), V8::default());
+            let (mut u0, mut u1) = (F8::default(), F8::default());
+            let mut scalar = Vec::new();
+            for i in 0..8 {
+                let alpha = [1e-4, 0.01, 0.1, 0.3, 0.7, 1.0, 2.0, 0.05][(round + i) % 8];
+                let c = Conductor {
+                    eta: Vec3::new(0.2, 0.9, 1.4) + rng.uniform_f32(),
+                    k: Vec3::new(3.9, 2.4, 1.6) * rng.uniform_f32(),
+                    specular: Vec3::new(1.0, 0.8, rng.uniform_f32()),
+                    distribution: Some(Microfacet::new(NormalDistribution::Ggx, alpha)),
+                };
+                lanes.set_lane(i, c.as_isotropic_ggx().expect("isotropic GGX"));
+                let (o, mut w) = (direction(&mut rng), direction(&mut rng));
+                match round % 5 {
+                    0 => w = -o,
+                    1 => w = o,
+                    2 => w.z = 0.0,
+                    _ => {}
+                }
+                wo.set(i, o);
+                wi.set(i, w);
+                (u0.0[i], u1.0[i]) = (rng.uniform_f32(), rng.uniform_f32());
+                scalar.push(c);
+            }
+            let (f, pdf) = lanes.f_and_pdf(wo, wi);
+            let s = lanes.sample(wo, u0, u1);
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            for (i, c) in scalar.iter().enumerate() {
+                let (o, w) = (wo.get(i), wi.get(i));
+                assert_eq!(bits(f.get(i)), bits(c.f(o, w)), "f, lane {i}: {o} {w}");
+                assert_eq!(pdf.0[i].to_bits(), c.pdf(o, w).to_bits(), "pdf, lane {i}");
+                let one = c.sample(o, Vec2::new(u0.0[i], u1.0[i]));
+                assert_eq!(s.valid.get(i), one.is_some(), "sample, lane {i}: {o}");
+                if let Some(one) = one {
+                    assert_eq!(bits(s.wi.get(i)), bits(one.wi));
+                    assert_eq!(bits(s.f.get(i)), bits(one.f));
+                    assert_eq!(s.pdf.0[i].to_bits(), one.pdf.to_bits());
+                    valid += 1;
+                }
+                lanes_seen += 1;
+            }
+        }
+        // A guard that most samples are compared, not only the empty ones.
+        assert!(
+            valid * 3 > lanes_seen,
+            "{valid} of {lanes_seen} samples valid"
+        );
     }
 }

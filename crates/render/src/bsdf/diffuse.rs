@@ -1,6 +1,7 @@
 //! Lambertian reflection, written once for one direction and for eight lanes (see
 //! [`pathlab_mc::simd::lanes`]): the path tracer's lanes shade with these same functions.
 
+use super::bxdf::DirectionSample;
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
@@ -14,19 +15,6 @@ use std::f32::consts::FRAC_1_PI;
 pub struct Diffuse<V = Rgb> {
     /// Albedo.
     pub reflectance: V,
-}
-
-/// A cosine-weighted sample of a [`Diffuse`] (one, or eight lanes'): it exists where `valid`.
-#[derive(Clone, Copy, Debug)]
-pub struct DiffuseSample<V: Vector3> {
-    /// The sampled direction, local.
-    pub wi: V,
-    /// Its density per unit solid angle.
-    pub pdf: V::R,
-    /// f there.
-    pub f: V,
-    /// Where the sample exists (wo above the surface, positive density).
-    pub valid: <V::R as Real>::Mask,
 }
 
 #[cfg(test)]
@@ -70,11 +58,11 @@ impl<V: Vector3> Diffuse<V> {
 
     /// A cosine-weighted direction from `u`, seen from a direction of local z `wo_z`.
     #[inline(always)]
-    pub fn sample_z(&self, wo_z: V::R, u0: V::R, u1: V::R) -> DiffuseSample<V> {
+    pub fn sample_z(&self, wo_z: V::R, u0: V::R, u1: V::R) -> DirectionSample<V> {
         let zero = V::R::splat(0.0);
         let wi: V = cosine_hemisphere(u0, u1);
         let pdf = cosine_hemisphere_pdf(wi.z());
-        DiffuseSample {
+        DirectionSample {
             wi,
             pdf,
             f: self.value(),
@@ -94,13 +82,7 @@ impl Diffuse {
     /// A cosine-weighted direction.
     #[inline]
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
-        let s = self.sample_z(wo.z, u.x, u.y);
-        s.valid.then_some(LocalSample {
-            f: s.f,
-            wi: s.wi,
-            pdf: s.pdf,
-            delta: false,
-        })
+        self.sample_z(wo.z, u.x, u.y).local()
     }
 
     /// Density of [`Diffuse::sample`].

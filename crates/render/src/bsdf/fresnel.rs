@@ -2,7 +2,7 @@
 //! refraction), Schlick's approximation as the course's option, and the hemispherical
 //! average of the dielectric reflectance that coated materials need.
 
-use crate::simd::lanes::{Real, F8};
+use crate::simd::lanes::{Real, Vector3, F8, V8};
 use glam::Vec3;
 
 /// Fresnel reflectance of a smooth dielectric for light arriving at cos θi (positive: from the
@@ -114,6 +114,32 @@ pub fn fresnel_conductor_rgb(cos_theta_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
     let lanes = |v: Vec3| F8([v.x, v.y, v.z, v.x, v.x, v.x, v.x, v.x]);
     let f = fresnel_conductor_real(F8::splat(cos_theta_i), lanes(eta), lanes(k));
     Vec3::new(f.0[0], f.0[1], f.0[2])
+}
+
+/// [`fresnel_conductor`] of each channel of a colour: one colour (`Vec3`, by
+/// [`fresnel_conductor_rgb`]) or eight lanes' ([`V8`], a channel at a time), to the bit the
+/// same.
+pub trait ConductorFresnel: Vector3 {
+    /// The reflectance per channel at cos θi with index `eta` + i `k` per channel.
+    fn fresnel_conductor(cos_theta_i: Self::R, eta: Self, k: Self) -> Self;
+}
+
+impl ConductorFresnel for Vec3 {
+    #[inline(always)]
+    fn fresnel_conductor(cos_theta_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
+        fresnel_conductor_rgb(cos_theta_i, eta, k)
+    }
+}
+
+impl ConductorFresnel for V8 {
+    #[inline(always)]
+    fn fresnel_conductor(cos_theta_i: F8, eta: V8, k: V8) -> V8 {
+        V8 {
+            x: fresnel_conductor_real(cos_theta_i, eta.x, k.x),
+            y: fresnel_conductor_real(cos_theta_i, eta.y, k.y),
+            z: fresnel_conductor_real(cos_theta_i, eta.z, k.z),
+        }
+    }
 }
 
 /// [`fresnel_conductor`] written once for one value and for lanes.

@@ -278,6 +278,15 @@ impl LobeList {
     }
 }
 
+/// A lobe the path tracer's lanes shade together ([`Material::lane_bxdf`]).
+#[derive(Clone, Copy, Debug)]
+pub enum LaneBxdf {
+    /// Lambertian.
+    Diffuse(Diffuse),
+    /// A rough conductor of GGX normals of one roughness.
+    Conductor(RoughConductor<Rgb, IsotropicGgx<f32>>),
+}
+
 impl Material {
     /// A material of one model without textures.
     pub fn new(bxdf: Bxdf, two_sided: bool) -> Self {
@@ -287,16 +296,24 @@ impl Material {
         })
     }
 
-    /// The reflectance and sidedness of a plain (untextured) Lambertian material.
+    /// The lobe and sidedness of a plain (untextured) material of one lobe that the path
+    /// tracer's lanes shade together: Lambertian, or a rough conductor of GGX normals of one
+    /// roughness.
     #[inline]
-    pub fn as_lambertian(&self) -> Option<(Diffuse, bool)> {
-        match self {
-            Material::Leaf(Leaf {
-                model: Model::Fixed(Bxdf::Diffuse(d)),
-                two_sided,
-            }) => Some((*d, *two_sided)),
-            _ => None,
-        }
+    pub fn lane_bxdf(&self) -> Option<(LaneBxdf, bool)> {
+        let Material::Leaf(Leaf {
+            model: Model::Fixed(bxdf),
+            two_sided,
+        }) = self
+        else {
+            return None;
+        };
+        let lobe = match bxdf {
+            Bxdf::Diffuse(d) => LaneBxdf::Diffuse(*d),
+            Bxdf::Conductor(c) => LaneBxdf::Conductor(c.as_isotropic_ggx()?),
+            _ => return None,
+        };
+        Some((lobe, *two_sided))
     }
 
     /// Whether evaluating the material may read a texture at the surface's (u, v): every

@@ -8,8 +8,15 @@
 //! distribution; GGX samples the distribution of visible normals (Heitz 2018), Beckmann the
 //! distribution of normals D(wm) cos θm.
 
+//!
+//! The GGX pieces that the rough conductor's lanes use (D and Λ of one roughness, the
+//! density and sampling of visible normals, Smith's G1) are written once over
+//! [`Real`] (see [`pathlab_mc::simd::lanes`]): [`Microfacet`] calls their `f32` instance, and
+//! [`IsotropicGgx`] is the same distribution for one direction or for eight lanes.
+
 use glam::{Vec2, Vec3};
-use pathlab_mc::warp::sample_uniform_disk_concentric;
+use pathlab_mc::simd::lanes::{Real, Vector3};
+use pathlab_mc::warp::uniform_disk_concentric;
 use std::f32::consts::{PI, TAU};
 
 /// Which distribution of microfacet normals.
@@ -47,10 +54,149 @@ pub fn erf(x: f32) -> f32 {
     sign * (1.0 - poly * (-x * x).exp()) as f32
 }
 
-#[inline]
-fn tan2_theta(w: Vec3) -> f32 {
-    let cos2 = w.z * w.z;
-    (1.0 - cos2).max(0.0) / cos2
+/// tan²θ of a local direction (infinite or NaN at the horizon).
+#[inline(always)]
+fn tan2_theta<R: Real>(w: R::V3) -> R {
+    let cos2 = w.z() * w.z();
+    (R::splat(1.0) - cos2).max(R::splat(0.0)) / cos2
+}
+
+/// A distribution of microfacet normals as the microfacet models use it, for one direction
+/// (`R = f32`: [`Microfacet`], every kind) or for lanes ([`IsotropicGgx`]).
+pub trait Distribution<R: Real> {
+    /// The density of normals D(wm).
+    fn d(&self, wm: R::V3) -> R;
+    /// Smith's Λ(w).
+    fn lambda(&self, w: R::V3) -> R;
+    /// Density per solid angle of [`Distribution::sample_wm`] producing `wm`.
+    fn pdf_wm(&self, wo: R::V3, wm: R::V3) -> R;
+    /// A microfacet normal for light leaving towards `wo`, from (`u0`, `u1`).
+    fn sample_wm(&self, wo: R::V3, u0: R, u1: R) -> R::V3;
+    /// Masking-shadowing G1(wo, wm) G1(wi, wm).
+    #[inline(always)]
+    fn g(&self, wo: R::V3, wi: R::V3, wm: R::V3) -> R {
+        smith_g1(wo, wm, self.lambda(wo)) * smith_g1(wi, wm, self.lambda(wi))
+    }
+}
+
+/// Smith's masking 1 / (1 + Λ(w)) of a facet with normal `wm` seen from `w`, where Λ(w) is
+/// `lambda`: zero when the facet faces away from `w` or `w` is on the other side of the macro
+/// surface than the facet sees.
+#[inline(always)]
+fn smith_g1<R: Real>(w: R::V3, wm: R::V3, lambda: R) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    R::select((w.dot(wm) * w.z()).le(zero), zero, one / (one + lambda))
+}
+
+/// GGX's D(wm) of roughness `alpha` in every direction.
+#[inline(always)]
+fn ggx_d_isotropic<R: Real>(alpha: R, wm: R::V3) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let a2 = alpha * alpha;
+    let cos2 = wm.z() * wm.z();
+    let t = cos2 * (a2 - one) + one;
+    R::select(wm.z().le(zero), zero, a2 / (R::splat(PI) * t * t))
+}
+
+/// GGX's Λ(w), `alpha` the roughness seen along the azimuth of `w`: infinite at the horizon,
+/// zero along the normal.
+#[inline(always)]
+fn ggx_lambda<R: Real>(alpha: R, w: R::V3) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let tan2 = tan2_theta::<R>(w);
+    let lambda = R::splat(0.5) * (R::splat(-1.0) + (one + alpha * alpha * tan2).sqrt());
+    R::select(
+        !tan2.is_finite(),
+        R::splat(f32::INFINITY),
+        R::select(tan2.equals(zero), zero, lambda),
+    )
+}
+
+/// The density of visible normals D_wo(wm) = G1(wo) max(0, wo·wm) D(wm) / cos θo, with wo
+/// taken on the upper side (zero for wo on the horizon).
+#[inline(always)]
+fn visible_normal_pdf<R: Real, M: Distribution<R>>(m: &M, wo: R::V3, wm: R::V3) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let up = <R::V3 as Vector3>::select(wo.z().lt(zero), -wo, wo);
+    let cos_om = up.dot(wm);
+    let pdf = m.d(wm) * cos_om / ((one + m.lambda(up)) * up.z());
+    R::select(wo.z().equals(zero) | cos_om.le(zero), zero, pdf)
+}
+
+/// Heitz's sampling of GGX visible normals (roughness `ax` along x, `ay` along y): a point on
+/// the projected hemisphere of the stretched configuration, warped back.
+#[inline(always)]
+fn sample_visible_ggx<R: Real>(ax: R, ay: R, wo: R::V3, u0: R, u1: R) -> R::V3 {
+    type V<R> = <R as Real>::V3;
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let wh = V::<R>::new(ax * wo.x(), ay * wo.y(), wo.z()).normalize();
+    let wh = V::<R>::select(wh.z().lt(zero), -wh, wh);
+    let t1 = V::<R>::select(
+        wh.z().lt(R::splat(0.99999)),
+        V::<R>::splat(Vec3::Z).cross(wh).normalize(),
+        V::<R>::splat(Vec3::X),
+    );
+    let t2 = wh.cross(t1);
+    let (px, py) = uniform_disk_concentric(u0, u1);
+    // Squeeze the disk onto the visible part of the projected hemisphere.
+    let h = (one - px * px).max(zero).sqrt();
+    let s = R::splat(0.5) * (one + wh.z());
+    let py = (one - s) * h + s * py;
+    let pz = (one - (px * px + py * py)).max(zero).sqrt();
+    let nh = t1.scale(px) + t2.scale(py) + wh.scale(pz);
+    V::<R>::new(ax * nh.x(), ay * nh.y(), nh.z().max(R::splat(1e-6))).normalize()
+}
+
+/// GGX of one roughness in every direction, for one direction (`R = f32`) or for lanes: the
+/// same functions as [`Microfacet`]'s for such a distribution, to the bit.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IsotropicGgx<R> {
+    /// Roughness α.
+    pub alpha: R,
+}
+
+impl<R: Real> Distribution<R> for IsotropicGgx<R> {
+    #[inline(always)]
+    fn d(&self, wm: R::V3) -> R {
+        ggx_d_isotropic(self.alpha, wm)
+    }
+
+    #[inline(always)]
+    fn lambda(&self, w: R::V3) -> R {
+        ggx_lambda(self.alpha, w)
+    }
+
+    #[inline(always)]
+    fn pdf_wm(&self, wo: R::V3, wm: R::V3) -> R {
+        visible_normal_pdf(self, wo, wm)
+    }
+
+    #[inline(always)]
+    fn sample_wm(&self, wo: R::V3, u0: R, u1: R) -> R::V3 {
+        sample_visible_ggx(self.alpha, self.alpha, wo, u0, u1)
+    }
+}
+
+impl Distribution<f32> for Microfacet {
+    #[inline]
+    fn d(&self, wm: Vec3) -> f32 {
+        Microfacet::d(self, wm)
+    }
+
+    #[inline]
+    fn lambda(&self, w: Vec3) -> f32 {
+        Microfacet::lambda(self, w)
+    }
+
+    #[inline]
+    fn pdf_wm(&self, wo: Vec3, wm: Vec3) -> f32 {
+        Microfacet::pdf_wm(self, wo, wm)
+    }
+
+    #[inline]
+    fn sample_wm(&self, wo: Vec3, u0: f32, u1: f32) -> Vec3 {
+        Microfacet::sample_wm(self, wo, Vec2::new(u0, u1))
+    }
 }
 
 impl Microfacet {
@@ -120,49 +266,42 @@ impl Microfacet {
                 }
             };
         }
-        let a2 = self.alpha * self.alpha;
-        let cos2 = wm.z * wm.z;
         match self.kind {
             NormalDistribution::Beckmann => {
+                let a2 = self.alpha * self.alpha;
+                let cos2 = wm.z * wm.z;
                 let tan2 = (1.0 - cos2).max(0.0) / cos2;
                 (-tan2 / a2).exp() / (PI * a2 * cos2 * cos2)
             }
-            NormalDistribution::Ggx => {
-                let t = cos2 * (a2 - 1.0) + 1.0;
-                a2 / (PI * t * t)
-            }
+            NormalDistribution::Ggx => ggx_d_isotropic(self.alpha, wm),
         }
     }
 
     /// Smith's Λ(w): the masked projected area per visible projected area.
     pub fn lambda(&self, w: Vec3) -> f32 {
-        let tan2 = tan2_theta(w);
+        let alpha = self.projected_alpha(w);
+        if self.kind == NormalDistribution::Ggx {
+            return ggx_lambda(alpha, w);
+        }
+        let tan2 = tan2_theta::<f32>(w);
         if !tan2.is_finite() {
             return f32::INFINITY;
         }
         if tan2 == 0.0 {
             return 0.0;
         }
-        let alpha = self.projected_alpha(w);
-        match self.kind {
-            NormalDistribution::Ggx => 0.5 * (-1.0 + (1.0 + alpha * alpha * tan2).sqrt()),
-            NormalDistribution::Beckmann => {
-                let a = 1.0 / (alpha * tan2.sqrt());
-                if a >= 6.0 {
-                    return 0.0;
-                }
-                0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * PI.sqrt())
-            }
+        // Beckmann.
+        let a = 1.0 / (alpha * tan2.sqrt());
+        if a >= 6.0 {
+            return 0.0;
         }
+        0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * PI.sqrt())
     }
 
     /// Smith's masking of a facet with normal `wm` seen from `w` (zero when the facet faces
     /// away from `w` or `w` is on the other side of the macro surface than the facet sees).
     pub fn g1(&self, w: Vec3, wm: Vec3) -> f32 {
-        if w.dot(wm) * w.z <= 0.0 {
-            return 0.0;
-        }
-        1.0 / (1.0 + self.lambda(w))
+        smith_g1(w, wm, self.lambda(w))
     }
 
     /// Masking-shadowing G1(wo, wm) G1(wi, wm).
@@ -174,7 +313,7 @@ impl Microfacet {
     /// visible normal for GGX, a normal from D(wm) cos θm for Beckmann.
     pub fn sample_wm(&self, wo: Vec3, u: Vec2) -> Vec3 {
         match self.kind {
-            NormalDistribution::Ggx => self.sample_visible_ggx(wo, u),
+            NormalDistribution::Ggx => sample_visible_ggx(self.alpha, self.alpha_y, wo, u.x, u.y),
             NormalDistribution::Beckmann if !self.is_isotropic() => {
                 // D(wm) cos θm for elliptical slopes: the azimuth from the ellipse, then
                 // tan²θ = -ln(1 - u) / (cos²φ/αx² + sin²φ/αy²).
@@ -203,44 +342,9 @@ impl Microfacet {
     /// Density per solid angle of [`Microfacet::sample_wm`] producing `wm`.
     pub fn pdf_wm(&self, wo: Vec3, wm: Vec3) -> f32 {
         match self.kind {
-            NormalDistribution::Ggx => {
-                if wo.z == 0.0 {
-                    return 0.0;
-                }
-                // D_wo(wm) = G1(wo) max(0, wo·wm) D(wm) / cos θo, with wo on the upper side.
-                let wo = if wo.z < 0.0 { -wo } else { wo };
-                let cos_om = wo.dot(wm);
-                if cos_om <= 0.0 {
-                    return 0.0;
-                }
-                self.d(wm) * cos_om / ((1.0 + self.lambda(wo)) * wo.z)
-            }
+            NormalDistribution::Ggx => visible_normal_pdf(self, wo, wm),
             NormalDistribution::Beckmann => self.d(wm) * wm.z.max(0.0),
         }
-    }
-
-    /// Heitz's sampling of GGX visible normals: a point on the projected hemisphere of the
-    /// stretched configuration, warped back.
-    fn sample_visible_ggx(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        let (a, ay) = (self.alpha, self.alpha_y);
-        let mut wh = Vec3::new(a * wo.x, ay * wo.y, wo.z).normalize();
-        if wh.z < 0.0 {
-            wh = -wh;
-        }
-        let t1 = if wh.z < 0.99999 {
-            Vec3::Z.cross(wh).normalize()
-        } else {
-            Vec3::X
-        };
-        let t2 = wh.cross(t1);
-        let mut p = sample_uniform_disk_concentric(u);
-        // Squeeze the disk onto the visible part of the projected hemisphere.
-        let h = (1.0 - p.x * p.x).max(0.0).sqrt();
-        let s = 0.5 * (1.0 + wh.z);
-        p.y = (1.0 - s) * h + s * p.y;
-        let pz = (1.0 - p.length_squared()).max(0.0).sqrt();
-        let nh = p.x * t1 + p.y * t2 + pz * wh;
-        Vec3::new(a * nh.x, ay * nh.y, nh.z.max(1e-6)).normalize()
     }
 }
 

@@ -33,14 +33,14 @@ pub mod scattering;
 pub mod thin_dielectric;
 
 pub use bxdf::{Bxdf, Lobes, LocalSample};
-pub use conductor::Conductor;
+pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::{FresnelModel, SmoothDielectric};
 pub use diffuse::Diffuse;
 pub use diffuse_transmission::DiffuseTransmission;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 pub use layered::{Base, Coat, LayerMedium, LayerStack, Layered};
-pub use material::{Leaf, Material, Model, ShadingPoint};
-pub use microfacet::{Microfacet, NormalDistribution};
+pub use material::{LaneBxdf, Leaf, Material, Model, ShadingPoint};
+pub use microfacet::{Distribution, IsotropicGgx, Microfacet, NormalDistribution};
 pub use mirror::Mirror;
 pub use mixture::{Bsdf, BsdfSample, Guard, Lobe, MAX_LOBES};
 pub use plastic::Plastic;

@@ -2,11 +2,12 @@
 //! frame's normal (z) or a facet's normal. (Their weights are [`super::fresnel`]'s.)
 
 use glam::Vec3;
+use pathlab_mc::simd::lanes::{Real, Vector3};
 
-/// Mirror reflection of `w` about the unit normal `n`.
-#[inline]
-pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
-    2.0 * w.dot(n) * n - w
+/// Mirror reflection of `w` about the unit normal `n` (one direction, or lanes).
+#[inline(always)]
+pub fn reflect<V: Vector3>(w: V, n: V) -> V {
+    n.scale(V::R::splat(2.0) * w.dot(n)) - w
 }
 
 /// Refraction of `w` (pointing away from the interface) through a facet with unit normal `n`

@@ -8,10 +8,11 @@
 //! numbers for all lanes at once.
 //!
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
-//! for every lane and bounce, except where a lane's surface is Lambertian and its light an
-//! emitting triangle or an environment map. There the lanes are shaded together in SIMD
-//! registers by the same functions the one-path code calls, instantiated on eight lanes (the
-//! [`Diffuse`] BSDF, [`TriangleEmitter::sample_li`],
+//! for every lane and bounce, except where a lane's surface is Lambertian or a rough GGX
+//! conductor ([`Material::lane_bxdf`]) and its light an emitting triangle or an environment
+//! map. There the lanes are shaded together in SIMD registers by the same functions the
+//! one-path code calls, instantiated on eight lanes (the [`Diffuse`] and [`RoughConductor`]
+//! BSDFs, [`TriangleEmitter::sample_li`],
 //! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`], [`offset_ray_origin`],
 //! [`power_heuristic_weight`]; see `scatter_lanes`): this module holds only the scheduling
 //! and the masks that stand for the one-path code's early returns. The rays that leave the
@@ -28,7 +29,7 @@ use super::{
     camera_sample, power_heuristic_weight, sample_light, CameraSample, PathStats, SampleRef,
 };
 use crate::accel::RayLanes;
-use crate::bsdf::Diffuse;
+use crate::bsdf::{Diffuse, IsotropicGgx, LaneBxdf, Material, RoughConductor};
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
 use crate::light::envmap::{DirectionLanes, EnvironmentMap};
@@ -46,7 +47,10 @@ struct ScatterIn {
     ng: V8,
     ns: V8,
     wo: V8,
+    /// Lanes at a rough conductor, whose lobe is `metal`; the others' is `diffuse`.
+    conductor: M8,
     diffuse: Diffuse<V8>,
+    metal: RoughConductor<V8, IsotropicGgx<F8>>,
     two_sided: M8,
     /// Lanes whose light sample is a point on an emitting triangle.
     light: M8,
@@ -86,29 +90,40 @@ struct ScatterOut {
     weight: V8,
 }
 
-/// The lanes' scattering at diffuse surfaces, composed of the functions the one-path code
-/// calls, on lanes: the shading frame ([`Frame::from_normal`], turned towards wo for a
-/// two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does), [`super::sample_light`] for
-/// a point on an emitting triangle or an environment map's direction (drawn before, by
-/// [`EnvironmentMap::sample_direction_lanes`]) up to the shadow ray
-/// ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`offset_ray_origin`],
-/// [`power_heuristic_weight`] against [`Diffuse::pdf_z`]; the map's radiance is read after the
-/// shadow ray, as there), and [`crate::bsdf::Bsdf::sample_f`] for a Lambertian BSDF
-/// ([`Diffuse::sample_z`]). Only the control flow is the lanes' own: masks where the one-path
-/// code returns early.
+/// The lanes' scattering at diffuse surfaces and rough conductors, composed of the functions
+/// the one-path code calls, on lanes: the shading frame ([`Frame::from_normal`], turned
+/// towards wo for a two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does),
+/// [`super::sample_light`] for a point on an emitting triangle or an environment map's
+/// direction (drawn before, by [`EnvironmentMap::sample_direction_lanes`]) up to the shadow
+/// ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`] or [`RoughConductor::f_and_pdf`],
+/// [`offset_ray_origin`], [`power_heuristic_weight`] against [`Diffuse::pdf_z`] or the
+/// conductor's density; the map's radiance is read after the shadow ray, as there), and
+/// [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe ([`Diffuse::sample_z`],
+/// [`RoughConductor::sample`]). Only the control flow is the lanes' own: masks where the
+/// one-path code returns early, and the conductor's functions skipped where no lane is at a
+/// conductor.
 #[inline(always)]
 fn scatter_lanes(a: &ScatterIn, out: &mut ScatterOut) {
     let zero = F8::splat(0.0);
     let flip = a.two_sided & a.wo.dot(a.ns).lt(zero);
     let frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
     let wo_z = a.wo.dot(frame.n);
+    let metal = a.conductor;
+    let any_metal = metal.any();
 
     // Light sampling: a point on a triangle, or an environment map's direction.
     let env = a.environment;
     let ls = a.emitter.sample_li(a.p, a.u_light[0], a.u_light[1]);
     let wi = env.select3(a.environment_wi, ls.wi);
     let wi_z = wi.dot(frame.n);
-    let f = a.diffuse.f_z(wo_z, wi_z).scale(wi.dot(frame.n).abs());
+    let (f, bsdf_pdf) = (a.diffuse.f_z(wo_z, wi_z), a.diffuse.pdf_z(wo_z, wi_z));
+    let (f, bsdf_pdf) = if any_metal {
+        let (f_metal, pdf_metal) = a.metal.f_and_pdf(frame.to_local(a.wo), frame.to_local(wi));
+        (metal.select3(f_metal, f), metal.select(pdf_metal, bsdf_pdf))
+    } else {
+        (f, bsdf_pdf)
+    };
+    let f = f.scale(wi.dot(frame.n).abs());
     // `visible_light_sample`'s early returns (`!(x <= 0)` lets NaN through, as there).
     let triangle = a.light
         & ls.dist2.not_equal(zero)
@@ -123,13 +138,22 @@ fn scatter_lanes(a: &ScatterIn, out: &mut ScatterOut) {
     out.shadow_o = o;
     out.shadow_d = env.select3(wi, end - o);
     let pdf = a.light_pmf * env.select(a.environment_pdf, ls.pdf);
-    let mis = power_heuristic_weight(pdf, a.diffuse.pdf_z(wo_z, wi_z));
+    let mis = power_heuristic_weight(pdf, bsdf_pdf);
     out.ld = f.mul_axes(ls.li).scale(mis / pdf);
     out.f = f;
     out.weight_over_pdf = mis / pdf;
 
     // BSDF sampling (and `Bsdf::sample_f`'s check of a finite value).
-    let bs = a.diffuse.sample_z(wo_z, a.u_bsdf[0], a.u_bsdf[1]);
+    let mut bs = a.diffuse.sample_z(wo_z, a.u_bsdf[0], a.u_bsdf[1]);
+    if any_metal {
+        let m = a
+            .metal
+            .sample(frame.to_local(a.wo), a.u_bsdf[0], a.u_bsdf[1]);
+        bs.wi = metal.select3(m.wi, bs.wi);
+        bs.pdf = metal.select(m.pdf, bs.pdf);
+        bs.f = metal.select3(m.f, bs.f);
+        bs.valid = (metal & m.valid) | (!metal & bs.valid);
+    }
     let wi = frame.to_world(bs.wi);
     let finite = bs.f.x.is_finite() & bs.f.y.is_finite() & bs.f.z.is_finite();
     out.sampled = bs.valid & finite;
@@ -226,9 +250,10 @@ impl PathIntegrator {
                 }
             }
             let escapes = look_up_escapes(scene, &lanes, &hits);
-            // Arrive; scatter the lanes at other materials than Lambertian ones now, and
-            // gather the Lambertian ones' inputs.
-            let mut lambert_lanes = 0u32;
+            // Arrive; scatter the lanes at materials the lanes do not shade together now, and
+            // gather the others' inputs.
+            let mut shaded = 0u32;
+            a.conductor = M8::default();
             for i in 0..W {
                 let Some(lane) = &mut lanes[i] else { continue };
                 let smp = &mut samplers[i];
@@ -245,7 +270,8 @@ impl PathIntegrator {
                 }
                 // `arrive` goes on only at a surface.
                 let Some(si) = &hits[i] else { continue };
-                let Some((diffuse, two_sided)) = scene.material(si.material).as_lambertian() else {
+                let material: &Material = scene.material(si.material);
+                let Some((lobe, two_sided)) = material.lane_bxdf() else {
                     if !self.scatter(scene, st, si, smp, stats) {
                         out(lane.tag, st.l * lane.weight);
                         lanes[i] = None;
@@ -253,27 +279,36 @@ impl PathIntegrator {
                     hits[i] = None;
                     continue;
                 };
-                stats.random_vertices += u64::from(diffuse.reflectance.max_element() > 0.0);
+                match lobe {
+                    LaneBxdf::Diffuse(diffuse) => {
+                        stats.random_vertices += u64::from(diffuse.reflectance.max_element() > 0.0);
+                        a.diffuse.set_lane(i, diffuse);
+                    }
+                    LaneBxdf::Conductor(metal) => {
+                        stats.random_vertices += 1;
+                        a.metal.set_lane(i, metal);
+                        a.conductor.set(i, true);
+                    }
+                }
                 let wo = -st.ray.d;
                 a.p.set(i, si.p);
                 a.ng.set(i, si.ng);
                 a.ns.set(i, si.ns);
                 a.wo.set(i, wo);
-                a.diffuse.set_lane(i, diffuse);
                 a.two_sided.set(i, two_sided);
-                lambert_lanes |= 1 << i;
+                shaded |= 1 << i;
             }
-            if lambert_lanes == 0 {
+            if shaded == 0 {
                 continue;
             }
-            // The scalar code's random numbers, in its order, for all Lambertian lanes at
-            // once: light choice (1D), light point (2D), lobe choice (1D, unused: a Lambertian
-            // BSDF has one), direction (2D), Russian roulette (1D).
-            AnySampler::next_lanes(&mut samplers, lambert_lanes, &[1, 2, 1, 2, 1], &mut u);
+            // The scalar code's random numbers, in its order, for all these lanes at once:
+            // light choice (1D), light point (2D), lobe choice (1D, unused: their BSDFs have
+            // one lobe), direction (2D), Russian roulette (1D).
+            AnySampler::next_lanes(&mut samplers, shaded, &[1, 2, 1, 2, 1], &mut u);
             a.u_light = [F8(u[1]), F8(u[2])];
             a.u_bsdf = [F8(u[4]), F8(u[5])];
-            // From here on, the lanes with a hit are the Lambertian ones (the others' hits
-            // were cleared above).
+            // From here on, the lanes with a hit are the ones shaded together (the others'
+            // hits were cleared above).
             let mut environment = None;
             let mut environment_lanes = 0u32;
             for i in 0..W {
