@@ -8,8 +8,8 @@ use common::*;
 use glam::{DVec3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::desc::{
-    EnvironmentMapDesc, MaterialDesc, MeshDesc, NormalDistribution, SceneDesc, SphereDesc,
-    TextureDesc,
+    EnvironmentMapDesc, FresnelModel, MaterialDesc, MeshDesc, NormalDistribution, SceneDesc,
+    SphereDesc, TextureDesc,
 };
 use pathlab_render::film::Film;
 use pathlab_render::integrator::{BdptIntegrator, IntegratorKind};
@@ -177,13 +177,58 @@ fn with_metals(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with smooth lobes: a mirror, a smooth conductor, glass (exact Fresnel reflectance,
+/// shaded in the lanes; and Schlick's, left to the scalar code), each on a sphere, the glass
+/// ones large enough to be entered and left.
+fn with_smooth_lobes(mut desc: SceneDesc) -> SceneDesc {
+    let glass = |fresnel| MaterialDesc::Glass {
+        reflectance: Vec3::ONE,
+        transmittance: Vec3::new(0.9, 1.0, 0.95),
+        roughness: 0.0,
+        ior: 1.5,
+        distribution: NormalDistribution::Ggx,
+        fresnel,
+    };
+    let first = desc.materials.len();
+    desc.materials.extend([
+        MaterialDesc::Mirror {
+            reflectance: Vec3::new(0.9, 0.8, 0.7),
+        },
+        MaterialDesc::Conductor {
+            alpha: 0.0,
+            eta: Vec3::new(0.2, 0.9, 1.1),
+            k: Vec3::new(3.9, 2.4, 2.2),
+            distribution: NormalDistribution::Beckmann,
+        },
+        glass(FresnelModel::Exact),
+        glass(FresnelModel::Schlick),
+    ]);
+    for (k, (x, z, r)) in [
+        (-0.6, -0.4, 0.1),
+        (0.6, -0.5, 0.12),
+        (-0.2, 0.3, 0.25),
+        (0.3, 0.6, 0.2),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        desc.spheres.push(SphereDesc {
+            center: Vec3::new(x, r, z),
+            radius: r,
+            material: first + k,
+            ..Default::default()
+        });
+    }
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
     // Lambertian surfaces lit by emitting triangles or an environment map in SIMD lanes (and
     // the environment map's radiance towards the rays that leave the scene) and everything
-    // else with the scalar code (rough GGX conductors of one roughness too, in the scenes
-    // `with_metals`): every sample's radiance must be the scalar `li`'s to the
+    // else with the scalar code (rough GGX conductors of one roughness, mirrors, smooth
+    // conductors and glass too, in the scenes `with_metals` and `with_smooth_lobes`): every sample's radiance must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these
@@ -197,6 +242,11 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         (crowded(under_a_sky(mixed_scene())), true),
         (with_metals(mixed_scene()), false),
         (crowded(under_a_sky(with_metals(mixed_scene()))), true),
+        (with_smooth_lobes(mixed_scene()), false),
+        (
+            under_a_sky(with_smooth_lobes(with_metals(mixed_scene()))),
+            false,
+        ),
     ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);

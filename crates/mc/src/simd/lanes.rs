@@ -79,6 +79,12 @@ impl F8 {
         zip(self, o, f32::max)
     }
 
+    /// Lane-wise `f32::min` (NaN gives the other operand; of two zeros, either).
+    #[inline(always)]
+    pub fn min(self, o: F8) -> F8 {
+        zip(self, o, f32::min)
+    }
+
     /// Lane-wise `1.0f32.copysign(self)`: ±1 with each lane's sign.
     #[inline(always)]
     pub fn sign_one(self) -> F8 {
@@ -351,6 +357,8 @@ pub trait Real:
     fn abs(self) -> Self;
     /// `f32::max`.
     fn max(self, o: Self) -> Self;
+    /// `f32::min`.
+    fn min(self, o: Self) -> Self;
     /// `1.0f32.copysign(self)`.
     fn sign_one(self) -> Self;
     /// `self < o`.
@@ -437,6 +445,10 @@ impl Real for f32 {
     #[inline(always)]
     fn max(self, o: f32) -> f32 {
         f32::max(self, o)
+    }
+    #[inline(always)]
+    fn min(self, o: f32) -> f32 {
+        f32::min(self, o)
     }
     #[inline(always)]
     fn sign_one(self) -> f32 {
@@ -556,6 +568,10 @@ impl Real for F8 {
         F8::max(self, o)
     }
     #[inline(always)]
+    fn min(self, o: F8) -> F8 {
+        F8::min(self, o)
+    }
+    #[inline(always)]
     fn sign_one(self) -> F8 {
         F8::sign_one(self)
     }
@@ -662,6 +678,7 @@ mod tests {
             // IEEE leaves open which zero the maximum of +0 and -0 is, and scalar and vector
             // code pick differently; the value is the same.
             assert!(same(a.max(b).0[i], x.max(y)) || (x == 0.0 && y == 0.0));
+            assert!(same(a.min(b).0[i], x.min(y)) || (x == 0.0 && y == 0.0));
             assert!(same(a.sign_one().0[i], 1.0f32.copysign(x)));
             assert!(same(a.abs().sqrt().0[i], x.abs().sqrt()));
             assert_eq!(a.lt(b).get(i), x < y);

@@ -4,7 +4,7 @@
 use super::*;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
-use pathlab_mc::simd::lanes::{Real, Vector3};
+use pathlab_mc::simd::lanes::{Real, Vector3, M8, V8};
 
 /// A non-delta lobe's sample in the local frame, for one direction (`V = Vec3`) or for eight
 /// lanes ([`crate::simd::lanes::V8`]): it exists where `valid`.
@@ -30,6 +30,30 @@ impl DirectionSample<Vec3> {
             pdf: self.pdf,
             delta: false,
         })
+    }
+
+    /// The sample of a delta lobe where it exists.
+    #[inline]
+    pub fn delta(self) -> Option<LocalSample> {
+        self.valid.then_some(LocalSample {
+            f: self.f,
+            wi: self.wi,
+            pdf: self.pdf,
+            delta: true,
+        })
+    }
+}
+
+impl DirectionSample<V8> {
+    /// `a` in the lanes `m`, `b` in the others.
+    #[inline(always)]
+    pub fn select(m: M8, a: Self, b: Self) -> Self {
+        DirectionSample {
+            wi: m.select3(a.wi, b.wi),
+            pdf: m.select(a.pdf, b.pdf),
+            f: m.select3(a.f, b.f),
+            valid: (m & a.valid) | (!m & b.valid),
+        }
     }
 }
 

@@ -2,9 +2,9 @@
 //! reflectance of a complex index of refraction.
 
 use super::bxdf::DirectionSample;
-use super::fresnel::{fresnel_conductor_rgb, ConductorFresnel};
+use super::fresnel::ConductorFresnel;
 use super::microfacet::{Distribution, IsotropicGgx, Microfacet, NormalDistribution};
-use super::mirror::specular_reflection;
+use super::mirror::specular_reflection_real;
 use super::scattering::reflect;
 use super::LocalSample;
 use crate::desc::Rgb;
@@ -27,10 +27,15 @@ pub struct Conductor {
 }
 
 impl Conductor {
-    /// Fresnel reflectance per channel at cos θ.
+    /// The smooth lobe (`None` when rough): the model the path tracer's lanes shade together
+    /// with the same function.
     #[inline]
-    fn fresnel(&self, cos: f32) -> Rgb {
-        self.specular * fresnel_conductor_rgb(cos, self.eta, self.k)
+    pub fn as_smooth(&self) -> Option<SmoothConductor<Rgb>> {
+        self.distribution.is_none().then_some(SmoothConductor {
+            eta: self.eta,
+            k: self.k,
+            specular: self.specular,
+        })
     }
 
     /// The rough lobe (`None` when smooth).
@@ -66,7 +71,12 @@ impl Conductor {
     /// sampled microfacet normal.
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
         let Some(r) = self.rough() else {
-            return specular_reflection(wo, self.fresnel(wo.z.abs()), 1.0);
+            let smooth = SmoothConductor {
+                eta: self.eta,
+                k: self.k,
+                specular: self.specular,
+            };
+            return smooth.sample(wo).delta();
         };
         r.sample(wo, u.x, u.y).local()
     }
@@ -74,6 +84,40 @@ impl Conductor {
     /// Density of [`Conductor::sample`].
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         self.rough().map_or(0.0, |r| r.pdf(wo, wi))
+    }
+}
+
+/// A smooth conductor's lobe, written once for one direction (`V = Rgb`) and for eight lanes
+/// (`V = V8`): the mirror direction, weighted by the Fresnel reflectance at |cos θo| (a delta
+/// lobe).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SmoothConductor<V> {
+    /// Real part of the index, per channel.
+    pub eta: V,
+    /// Imaginary part, per channel.
+    pub k: V,
+    /// Scale of the reflection.
+    pub specular: V,
+}
+
+impl<V: ConductorFresnel> SmoothConductor<V> {
+    /// The mirror direction of `wo` (where `wo` is off the surface).
+    #[inline(always)]
+    pub fn sample(&self, wo: V) -> DirectionSample<V> {
+        let fresnel = V::fresnel_conductor(wo.z().abs(), self.eta, self.k);
+        specular_reflection_real(wo, self.specular.mul_axes(fresnel), V::R::splat(1.0))
+    }
+}
+
+impl SmoothConductor<V8> {
+    /// Sets lane `i` to `c`. Every field is taken apart here: a field added to
+    /// [`SmoothConductor`] fails to compile until its lanes are set too.
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, c: SmoothConductor<Rgb>) {
+        let SmoothConductor { eta, k, specular } = c;
+        self.eta.set(i, eta);
+        self.k.set(i, k);
+        self.specular.set(i, specular);
     }
 }
 
@@ -170,6 +214,7 @@ impl RoughConductor<V8, IsotropicGgx<F8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::Mirror;
     use pathlab_mc::rng::Pcg32;
 
     /// Eight lanes of the rough conductor compute, lane by lane, what the one-direction
@@ -234,5 +279,53 @@ mod tests {
             valid * 3 > lanes_seen,
             "{valid} of {lanes_seen} samples valid"
         );
+    }
+
+    /// Eight lanes of the smooth conductor and of the mirror sample, lane by lane, what the
+    /// one-direction models sample, to the bit (from both sides and on the surface).
+    #[test]
+    fn smooth_lanes_sample_what_one_direction_samples() {
+        let mut rng = Pcg32::new(9, 2);
+        for round in 0..200 {
+            let mut metal = SmoothConductor::<V8>::default();
+            let mut mirror = Mirror::<V8>::default();
+            let mut wo = V8::default();
+            let mut one = Vec::new();
+            for i in 0..8 {
+                let c = Conductor {
+                    eta: Vec3::new(0.2, 0.9, 1.4) * rng.uniform_f32(),
+                    k: Vec3::new(3.9, 2.4, 1.6) + rng.uniform_f32(),
+                    specular: Vec3::new(1.0, 0.8, rng.uniform_f32()),
+                    distribution: None,
+                };
+                let m = Mirror {
+                    reflectance: Vec3::new(rng.uniform_f32(), 0.5, 1.0),
+                };
+                metal.set_lane(i, c.as_smooth().expect("smooth"));
+                mirror.set_lane(i, m);
+                let z = if round % 5 == 0 {
+                    0.0
+                } else {
+                    2.0 * rng.uniform_f32() - 1.0
+                };
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                wo.set(i, Vec3::new(r * 0.6, r * 0.8, z));
+                one.push((c, m));
+            }
+            let (s_metal, s_mirror) = (metal.sample(wo), mirror.sample_real(wo));
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            for (i, (c, m)) in one.iter().enumerate() {
+                let o = wo.get(i);
+                for (s, scalar) in [(s_metal, c.sample(o, Vec2::ZERO)), (s_mirror, m.sample(o))] {
+                    assert_eq!(s.valid.get(i), scalar.is_some(), "lane {i}: {o}");
+                    if let Some(scalar) = scalar {
+                        assert!(scalar.delta);
+                        assert_eq!(bits(s.wi.get(i)), bits(scalar.wi));
+                        assert_eq!(bits(s.f.get(i)), bits(scalar.f));
+                        assert_eq!(s.pdf.0[i].to_bits(), scalar.pdf.to_bits());
+                    }
+                }
+            }
+        }
     }
 }

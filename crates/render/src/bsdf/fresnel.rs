@@ -8,20 +8,27 @@ use glam::Vec3;
 /// Fresnel reflectance of a smooth dielectric for light arriving at cos θi (positive: from the
 /// outside, the side the normal points to) with relative index `eta` = n_inside / n_outside.
 pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
-    let (cos_i, eta) = if cos_theta_i < 0.0 {
-        (-cos_theta_i, 1.0 / eta)
-    } else {
-        (cos_theta_i, eta)
-    };
-    let cos_i = cos_i.min(1.0);
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return 1.0; // total internal reflection
-    }
-    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    fresnel_dielectric_real(cos_theta_i, eta)
+}
+
+/// [`fresnel_dielectric`] written once for one value and for lanes.
+#[inline(always)]
+pub fn fresnel_dielectric_real<R: Real>(cos_theta_i: R, eta: R) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    // From inside: the angle's cosine on the inside and the index seen from there.
+    let inside = cos_theta_i.lt(zero);
+    let cos_i = R::select(inside, -cos_theta_i, cos_theta_i).min(one);
+    let eta = R::select(inside, one / eta, eta);
+    let sin2_t = (one - cos_i * cos_i) / (eta * eta);
+    let cos_t = (one - sin2_t).max(zero).sqrt();
     let r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (r_parl * r_parl + r_perp * r_perp)
+    // Total internal reflection where sin²θt >= 1.
+    R::select(
+        one.le(sin2_t),
+        one,
+        R::splat(0.5) * (r_parl * r_parl + r_perp * r_perp),
+    )
 }
 
 /// Schlick's approximation R0 + (1 - R0)(1 - cos θ)^5 of [`fresnel_dielectric`], with

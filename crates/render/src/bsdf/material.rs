@@ -285,6 +285,12 @@ pub enum LaneBxdf {
     Diffuse(Diffuse),
     /// A rough conductor of GGX normals of one roughness.
     Conductor(RoughConductor<Rgb, IsotropicGgx<f32>>),
+    /// A perfect mirror.
+    Mirror(Mirror),
+    /// A smooth conductor.
+    SmoothConductor(SmoothConductor<Rgb>),
+    /// Smooth glass of exact Fresnel reflectance.
+    Dielectric(SmoothDielectric),
 }
 
 impl Material {
@@ -297,8 +303,8 @@ impl Material {
     }
 
     /// The lobe and sidedness of a plain (untextured) material of one lobe that the path
-    /// tracer's lanes shade together: Lambertian, or a rough conductor of GGX normals of one
-    /// roughness.
+    /// tracer's lanes shade together: Lambertian, a rough conductor of GGX normals of one
+    /// roughness, a mirror, a smooth conductor, or smooth glass of exact Fresnel reflectance.
     #[inline]
     pub fn lane_bxdf(&self) -> Option<(LaneBxdf, bool)> {
         let Material::Leaf(Leaf {
@@ -310,7 +316,12 @@ impl Material {
         };
         let lobe = match bxdf {
             Bxdf::Diffuse(d) => LaneBxdf::Diffuse(*d),
-            Bxdf::Conductor(c) => LaneBxdf::Conductor(c.as_isotropic_ggx()?),
+            Bxdf::Conductor(c) => match c.as_smooth() {
+                Some(smooth) => LaneBxdf::SmoothConductor(smooth),
+                None => LaneBxdf::Conductor(c.as_isotropic_ggx()?),
+            },
+            Bxdf::Mirror(m) => LaneBxdf::Mirror(*m),
+            Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(*d),
             _ => return None,
         };
         Some((lobe, *two_sided))

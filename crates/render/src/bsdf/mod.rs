@@ -33,8 +33,8 @@ pub mod scattering;
 pub mod thin_dielectric;
 
 pub use bxdf::{Bxdf, Lobes, LocalSample};
-pub use conductor::{Conductor, RoughConductor};
-pub use dielectric::{FresnelModel, SmoothDielectric};
+pub use conductor::{Conductor, RoughConductor, SmoothConductor};
+pub use dielectric::{DielectricLanes, FresnelModel, SmoothDielectric};
 pub use diffuse::Diffuse;
 pub use diffuse_transmission::DiffuseTransmission;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};

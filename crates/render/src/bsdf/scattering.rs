@@ -31,34 +31,38 @@ pub fn refract_about(w: Vec3, n: Vec3, eta: f32) -> Option<(Vec3, f32)> {
 
 /// The relative index η' of a pair of directions (local frame) across an interface of
 /// relative index `eta` (inside / outside): η from outside in, 1/η from inside out, one when
-/// both lie on the same side (or either on the interface).
-#[inline]
-pub fn relative_eta(wo: Vec3, wi: Vec3, eta: f32) -> f32 {
-    if wo.z * wi.z >= 0.0 {
-        1.0
-    } else if wo.z > 0.0 {
-        eta
-    } else {
-        1.0 / eta
-    }
+/// both lie on the same side (or either on the interface). For one pair or lanes.
+#[inline(always)]
+pub fn relative_eta<V: Vector3>(wo: V, wi: V, eta: V::R) -> V::R {
+    let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
+    V::R::select(
+        zero.le(wo.z() * wi.z()),
+        one,
+        V::R::select(wo.z().gt(zero), eta, one / eta),
+    )
 }
 
 /// Refracts `wo` (local frame, z = normal) through an interface of relative index `eta`
 /// (inside / outside); `None` under total internal reflection. Returns wi and the relative
 /// index η' along the path (η for entering, 1/η for leaving).
 pub fn refract(wo: Vec3, eta: f32) -> Option<(Vec3, f32)> {
-    let (cos_o, etap, sign) = if wo.z > 0.0 {
-        (wo.z, eta, 1.0)
-    } else {
-        (-wo.z, 1.0 / eta, -1.0)
-    };
-    let sin2_t = (1.0 - cos_o * cos_o).max(0.0) / (etap * etap);
-    if sin2_t >= 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let wi = Vec3::new(-wo.x / etap, -wo.y / etap, -sign * cos_t);
-    Some((wi.normalize(), etap))
+    let (wi, etap, ok) = refract_real(wo, eta);
+    ok.then_some((wi, etap))
+}
+
+/// [`refract`] written once for one direction and for lanes: wi, η', and where it exists
+/// (not total internal reflection).
+#[inline(always)]
+pub fn refract_real<V: Vector3>(wo: V, eta: V::R) -> (V, V::R, <V::R as Real>::Mask) {
+    let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
+    let above = wo.z().gt(zero);
+    let cos_o = V::R::select(above, wo.z(), -wo.z());
+    let etap = V::R::select(above, eta, one / eta);
+    let sign = V::R::select(above, one, -one);
+    let sin2_t = (one - cos_o * cos_o).max(zero) / (etap * etap);
+    let cos_t = (one - sin2_t).sqrt();
+    let wi = V::new(-wo.x() / etap, -wo.y() / etap, -sign * cos_t);
+    (wi.normalize(), etap, !one.le(sin2_t))
 }
 
 #[cfg(test)]

@@ -29,7 +29,11 @@ use super::{
     camera_sample, power_heuristic_weight, sample_light, CameraSample, PathStats, SampleRef,
 };
 use crate::accel::RayLanes;
-use crate::bsdf::{Diffuse, IsotropicGgx, LaneBxdf, Material, RoughConductor};
+use crate::bsdf::bxdf::DirectionSample;
+use crate::bsdf::{
+    DielectricLanes, Diffuse, IsotropicGgx, LaneBxdf, Material, Mirror, RoughConductor,
+    SmoothConductor,
+};
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
 use crate::light::envmap::{DirectionLanes, EnvironmentMap};
@@ -47,10 +51,14 @@ struct ScatterIn {
     ng: V8,
     ns: V8,
     wo: V8,
-    /// Lanes at a rough conductor, whose lobe is `metal`; the others' is `diffuse`.
-    conductor: M8,
+    /// Which lanes have which lobe: `metal`, a rough conductor; `mirror`; `smooth_metal`, a
+    /// smooth conductor; `glass`; the others' is `diffuse`.
+    lobes: LobeLanes,
     diffuse: Diffuse<V8>,
     metal: RoughConductor<V8, IsotropicGgx<F8>>,
+    mirror: Mirror<V8>,
+    smooth_metal: SmoothConductor<V8>,
+    glass: DielectricLanes,
     two_sided: M8,
     /// Lanes whose light sample is a point on an emitting triangle.
     light: M8,
@@ -64,7 +72,20 @@ struct ScatterIn {
     /// Probability of choosing the lane's light.
     light_pmf: F8,
     u_light: [F8; 2],
+    /// The lobe choice's number (glass's choice between reflection and refraction).
+    u_lobe: F8,
     u_bsdf: [F8; 2],
+}
+
+/// Which lanes have which lobe (the rest: Lambertian).
+#[derive(Clone, Copy, Default)]
+struct LobeLanes {
+    conductor: M8,
+    mirror: M8,
+    smooth_metal: M8,
+    glass: M8,
+    /// The three delta lobes together: no light sample.
+    delta: M8,
 }
 
 /// What the lanes' scattering yields.
@@ -86,12 +107,16 @@ struct ScatterOut {
     sampled: M8,
     wi: V8,
     pdf: F8,
+    /// Whether it comes from a delta lobe, and the relative index η' it crossed (one where it
+    /// did not refract).
+    delta: M8,
+    eta: F8,
     /// f |cos θi| / p of the BSDF sample, the throughput's factor.
     weight: V8,
 }
 
-/// The lanes' scattering at diffuse surfaces and rough conductors, composed of the functions
-/// the one-path code calls, on lanes: the shading frame ([`Frame::from_normal`], turned
+/// The lanes' scattering at diffuse surfaces, rough conductors and smooth lobes, composed of
+/// the functions the one-path code calls, on lanes: the shading frame ([`Frame::from_normal`], turned
 /// towards wo for a two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does),
 /// [`super::sample_light`] for a point on an emitting triangle or an environment map's
 /// direction (drawn before, by [`EnvironmentMap::sample_direction_lanes`]) up to the shadow
@@ -99,17 +124,19 @@ struct ScatterOut {
 /// [`offset_ray_origin`], [`power_heuristic_weight`] against [`Diffuse::pdf_z`] or the
 /// conductor's density; the map's radiance is read after the shadow ray, as there), and
 /// [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe ([`Diffuse::sample_z`],
-/// [`RoughConductor::sample`]). Only the control flow is the lanes' own: masks where the
-/// one-path code returns early, and the conductor's functions skipped where no lane is at a
-/// conductor.
+/// [`RoughConductor::sample`], [`Mirror::sample_real`], [`SmoothConductor::sample`],
+/// [`DielectricLanes::sample`]; smooth lobes have no light sample). Only the control flow is
+/// the lanes' own: masks where the one-path code returns early, and each lobe's functions
+/// skipped where no lane has it (all but the Lambertian ones without `OTHER_LOBES`: a
+/// separate, smaller instance for passes of Lambertian lanes alone).
 #[inline(always)]
-fn scatter_lanes(a: &ScatterIn, out: &mut ScatterOut) {
+fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let zero = F8::splat(0.0);
     let flip = a.two_sided & a.wo.dot(a.ns).lt(zero);
     let frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
     let wo_z = a.wo.dot(frame.n);
-    let metal = a.conductor;
-    let any_metal = metal.any();
+    let metal = a.lobes.conductor;
+    let any_metal = OTHER_LOBES && metal.any();
 
     // Light sampling: a point on a triangle, or an environment map's direction.
     let env = a.environment;
@@ -143,20 +170,34 @@ fn scatter_lanes(a: &ScatterIn, out: &mut ScatterOut) {
     out.f = f;
     out.weight_over_pdf = mis / pdf;
 
-    // BSDF sampling (and `Bsdf::sample_f`'s check of a finite value).
+    // BSDF sampling (and `Bsdf::sample_f`'s checks of a positive density and a finite value).
     let mut bs = a.diffuse.sample_z(wo_z, a.u_bsdf[0], a.u_bsdf[1]);
     if any_metal {
         let m = a
             .metal
             .sample(frame.to_local(a.wo), a.u_bsdf[0], a.u_bsdf[1]);
-        bs.wi = metal.select3(m.wi, bs.wi);
-        bs.pdf = metal.select(m.pdf, bs.pdf);
-        bs.f = metal.select3(m.f, bs.f);
-        bs.valid = (metal & m.valid) | (!metal & bs.valid);
+        bs = DirectionSample::select(metal, m, bs);
     }
+    let mut eta = F8::splat(1.0);
+    let lobes = &a.lobes;
+    if OTHER_LOBES && lobes.delta.any() {
+        let wo = frame.to_local(a.wo);
+        let mut d = a.mirror.sample_real(wo);
+        if lobes.smooth_metal.any() {
+            d = DirectionSample::select(lobes.smooth_metal, a.smooth_metal.sample(wo), d);
+        }
+        if lobes.glass.any() {
+            let (g, g_eta) = a.glass.sample(wo, a.u_lobe);
+            d = DirectionSample::select(lobes.glass, g, d);
+            eta = lobes.glass.select(g_eta, eta);
+        }
+        bs = DirectionSample::select(lobes.delta, d, bs);
+    }
+    out.delta = lobes.delta;
+    out.eta = eta;
     let wi = frame.to_world(bs.wi);
     let finite = bs.f.x.is_finite() & bs.f.y.is_finite() & bs.f.z.is_finite();
-    out.sampled = bs.valid & finite;
+    out.sampled = bs.valid & bs.pdf.gt(zero) & finite;
     out.wi = wi;
     out.pdf = bs.pdf;
     out.weight = bs.f.scale(wi.dot(frame.n).abs() / bs.pdf);
@@ -165,19 +206,33 @@ fn scatter_lanes(a: &ScatterIn, out: &mut ScatterOut) {
 /// [`scatter_lanes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn scatter_avx2(_: crate::simd::Avx2, a: &ScatterIn, out: &mut ScatterOut) {
-    scatter_lanes(a, out)
+fn scatter_avx2<const OTHER_LOBES: bool>(
+    _: crate::simd::Avx2,
+    a: &ScatterIn,
+    out: &mut ScatterOut,
+) {
+    scatter_lanes::<OTHER_LOBES>(a, out)
 }
 
-/// [`scatter_lanes`] on the best vector unit this CPU has.
+/// [`scatter_lanes`] on the best vector unit this CPU has, its Lambertian instance where no
+/// lane has another lobe.
 fn scatter(a: &ScatterIn, out: &mut ScatterOut) {
+    let other = (a.lobes.conductor | a.lobes.delta).any();
     #[cfg(target_arch = "x86_64")]
     if let Some(avx2) = crate::simd::Avx2::detect() {
         // SAFETY: `scatter_avx2` requires AVX2 and FMA, which `avx2` proves this CPU has. Its
         // body is safe code.
-        return unsafe { scatter_avx2(avx2, a, out) };
+        return unsafe {
+            match other {
+                true => scatter_avx2::<true>(avx2, a, out),
+                false => scatter_avx2::<false>(avx2, a, out),
+            }
+        };
     }
-    scatter_lanes(a, out)
+    match other {
+        true => scatter_lanes::<true>(a, out),
+        false => scatter_lanes::<false>(a, out),
+    }
 }
 
 /// One lane's path: its sample's tag and where the path stands.
@@ -253,7 +308,7 @@ impl PathIntegrator {
             // Arrive; scatter the lanes at materials the lanes do not shade together now, and
             // gather the others' inputs.
             let mut shaded = 0u32;
-            a.conductor = M8::default();
+            a.lobes = LobeLanes::default();
             for i in 0..W {
                 let Some(lane) = &mut lanes[i] else { continue };
                 let smp = &mut samplers[i];
@@ -287,7 +342,25 @@ impl PathIntegrator {
                     LaneBxdf::Conductor(metal) => {
                         stats.random_vertices += 1;
                         a.metal.set_lane(i, metal);
-                        a.conductor.set(i, true);
+                        a.lobes.conductor.set(i, true);
+                    }
+                    LaneBxdf::Mirror(mirror) => {
+                        stats.random_vertices += 1;
+                        a.mirror.set_lane(i, mirror);
+                        a.lobes.mirror.set(i, true);
+                        a.lobes.delta.set(i, true);
+                    }
+                    LaneBxdf::SmoothConductor(metal) => {
+                        stats.random_vertices += 1;
+                        a.smooth_metal.set_lane(i, metal);
+                        a.lobes.smooth_metal.set(i, true);
+                        a.lobes.delta.set(i, true);
+                    }
+                    LaneBxdf::Dielectric(glass) => {
+                        stats.random_vertices += 1;
+                        a.glass.set_lane(i, glass);
+                        a.lobes.glass.set(i, true);
+                        a.lobes.delta.set(i, true);
                     }
                 }
                 let wo = -st.ray.d;
@@ -306,6 +379,7 @@ impl PathIntegrator {
             // one lobe), direction (2D), Russian roulette (1D).
             AnySampler::next_lanes(&mut samplers, shaded, &[1, 2, 1, 2, 1], &mut u);
             a.u_light = [F8(u[1]), F8(u[2])];
+            a.u_lobe = F8(u[3]);
             a.u_bsdf = [F8(u[4]), F8(u[5])];
             // From here on, the lanes with a hit are the ones shaded together (the others'
             // hits were cleared above).
@@ -315,6 +389,11 @@ impl PathIntegrator {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
                     continue;
                 };
+                // Smooth lobes take no light sample (their numbers are drawn all the same).
+                if a.lobes.delta.get(i) {
+                    a.light.set(i, false);
+                    continue;
+                }
                 let u_light = Vec2::new(u[1][i], u[2][i]);
                 let light =
                     gather_light(scene, i, si, &mut lane.st, u[0][i], u_light, &mut a, stats);
@@ -358,8 +437,8 @@ impl PathIntegrator {
 
     /// The end of lane `i`'s bounce after the SIMD scattering: the shadow ray (adding the light
     /// sample's contribution where it is unblocked; an environment map's radiance, from
-    /// `directions`, is read then), the throughput times the BSDF sample's weight, Russian
-    /// roulette with `u_rr`. Returns whether the path goes on.
+    /// `directions`, is read then), the throughput times the BSDF sample's weight (and the
+    /// radiance scale by the relative index it crossed), Russian roulette with `u_rr`. Returns whether the path goes on.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn finish_bounce(
@@ -400,9 +479,11 @@ impl PathIntegrator {
         }
         b.sampled.get(i) && {
             st.beta *= b.weight.get(i);
+            let eta = b.eta.0[i];
+            st.eta_scale *= eta * eta;
             st.beta.max_element() > 0.0
                 && st.beta.is_finite()
-                && self.survive(st, si, b.wi.get(i), b.pdf.0[i], false, u_rr)
+                && self.survive(st, si, b.wi.get(i), b.pdf.0[i], b.delta.get(i), u_rr)
         }
     }
 }
