@@ -147,7 +147,7 @@ fn under_a_sky(mut desc: SceneDesc) -> SceneDesc {
 
 /// `desc` with rough conductors: GGX of one roughness on the wall and the mirror sphere (the
 /// lanes shade those together), and two the lanes leave to the scalar code, a Beckmann sphere
-/// and an anisotropic GGX one.
+/// and an anisotropic GGX one; and rough glass spheres, GGX (the lanes') and Beckmann.
 fn with_metals(mut desc: SceneDesc) -> SceneDesc {
     let gold = |alpha: f32, distribution| MaterialDesc::Conductor {
         alpha,
@@ -166,10 +166,26 @@ fn with_metals(mut desc: SceneDesc) -> SceneDesc {
         specular: TextureDesc::Constant(Vec3::ONE),
         distribution: NormalDistribution::Ggx,
     });
-    for (x, material) in [(-0.1, 3), (0.7, 4)] {
+    let rough_glass = |distribution| MaterialDesc::Glass {
+        reflectance: Vec3::ONE,
+        transmittance: Vec3::new(0.95, 1.0, 0.9),
+        roughness: 0.2,
+        ior: 1.5,
+        distribution,
+        fresnel: FresnelModel::Exact,
+    };
+    desc.materials.push(rough_glass(NormalDistribution::Ggx));
+    desc.materials
+        .push(rough_glass(NormalDistribution::Beckmann));
+    for (x, z, r, material) in [
+        (-0.1, 0.5, 0.12, 3),
+        (0.7, 0.5, 0.12, 4),
+        (-0.6, 0.0, 0.2, 5),
+        (0.1, -0.5, 0.15, 6),
+    ] {
         desc.spheres.push(SphereDesc {
-            center: Vec3::new(x, 0.12, 0.5),
-            radius: 0.12,
+            center: Vec3::new(x, r, z),
+            radius: r,
             material,
             ..Default::default()
         });
@@ -227,8 +243,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
     // Lambertian surfaces lit by emitting triangles or an environment map in SIMD lanes (and
     // the environment map's radiance towards the rays that leave the scene) and everything
-    // else with the scalar code (rough GGX conductors of one roughness, mirrors, smooth
-    // conductors and glass too, in the scenes `with_metals` and `with_smooth_lobes`): every sample's radiance must be the scalar `li`'s to the
+    // else with the scalar code (rough GGX conductors and glass of one roughness, mirrors,
+    // smooth conductors and glass too, in the scenes `with_metals` and `with_smooth_lobes`): every sample's radiance must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these

@@ -101,12 +101,22 @@ impl Lobes {
     /// `r` and `t = 1 - r`: the restricted lobe's share set to zero, the rest renormalised
     /// (exactly `(r, t)` for [`Lobes::All`]). `None` when nothing is left.
     pub(crate) fn choose(self, r: f32, t: f32) -> Option<(f32, f32)> {
+        let (r, t, left) = self.choose_real(r, t);
+        left.then_some((r, t))
+    }
+
+    /// [`Lobes::choose`] for one value or lanes: the probabilities, and where anything is
+    /// left.
+    #[inline(always)]
+    pub(crate) fn choose_real<R: Real>(self, r: R, t: R) -> (R, R, R::Mask) {
+        let zero = R::splat(0.0);
         let (r, t) = match self {
-            Lobes::All => return Some((r, t)),
-            Lobes::Reflection => (r, 0.0),
-            Lobes::Transmission => (0.0, t),
+            // (0 == 0: every lane.)
+            Lobes::All => return (r, t, zero.equals(zero)),
+            Lobes::Reflection => (r, zero),
+            Lobes::Transmission => (zero, t),
         };
-        (r + t > 0.0).then(|| (r / (r + t), t / (r + t)))
+        (r / (r + t), t / (r + t), (r + t).gt(zero))
     }
 }
 

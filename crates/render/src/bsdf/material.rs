@@ -285,6 +285,8 @@ pub enum LaneBxdf {
     Diffuse(Diffuse),
     /// A rough conductor of GGX normals of one roughness.
     Conductor(RoughConductor<Rgb, IsotropicGgx<f32>>),
+    /// Rough glass of GGX normals of one roughness.
+    RoughDielectric(RoughDielectric<f32, Rgb, IsotropicGgx<f32>>),
     /// A perfect mirror.
     Mirror(Mirror),
     /// A smooth conductor.
@@ -303,8 +305,9 @@ impl Material {
     }
 
     /// The lobe and sidedness of a plain (untextured) material of one lobe that the path
-    /// tracer's lanes shade together: Lambertian, a rough conductor of GGX normals of one
-    /// roughness, a mirror, a smooth conductor, or smooth glass of exact Fresnel reflectance.
+    /// tracer's lanes shade together: Lambertian, a rough conductor or rough glass of GGX
+    /// normals of one roughness, a mirror, a smooth conductor, or smooth glass of exact
+    /// Fresnel reflectance.
     #[inline]
     pub fn lane_bxdf(&self) -> Option<(LaneBxdf, bool)> {
         let Material::Leaf(Leaf {
@@ -320,6 +323,7 @@ impl Material {
                 Some(smooth) => LaneBxdf::SmoothConductor(smooth),
                 None => LaneBxdf::Conductor(c.as_isotropic_ggx()?),
             },
+            Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(d.as_isotropic_ggx()?),
             Bxdf::Mirror(m) => LaneBxdf::Mirror(*m),
             Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(*d),
             _ => return None,

@@ -14,19 +14,25 @@ pub fn reflect<V: Vector3>(w: V, n: V) -> V {
 /// and relative index `eta` = n_below / n_above. `None` under total internal reflection;
 /// otherwise the refracted direction and the relative index η' along the path.
 pub fn refract_about(w: Vec3, n: Vec3, eta: f32) -> Option<(Vec3, f32)> {
-    let (mut cos_i, mut n, mut etap) = (w.dot(n), n, eta);
-    if cos_i < 0.0 {
-        etap = 1.0 / eta;
-        cos_i = -cos_i;
-        n = -n;
-    }
-    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (etap * etap);
-    if sin2_t >= 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let wt = -w / etap + (cos_i / etap - cos_t) * n;
-    Some((wt.normalize(), etap))
+    let (wt, etap, ok) = refract_about_real(w, n, eta);
+    ok.then_some((wt, etap))
+}
+
+/// [`refract_about`] written once for one direction and for lanes: the refracted direction,
+/// η', and where it exists (not total internal reflection).
+#[inline(always)]
+pub fn refract_about_real<V: Vector3>(w: V, n: V, eta: V::R) -> (V, V::R, <V::R as Real>::Mask) {
+    let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
+    let cos = w.dot(n);
+    // From below: the index seen from there, and the normal on w's side.
+    let below = cos.lt(zero);
+    let etap = V::R::select(below, one / eta, eta);
+    let cos_i = V::R::select(below, -cos, cos);
+    let n = V::select(below, -n, n);
+    let sin2_t = (one - cos_i * cos_i).max(zero) / (etap * etap);
+    let cos_t = (one - sin2_t).sqrt();
+    let wt = (-w).div_by(etap) + n.scale(cos_i / etap - cos_t);
+    (wt.normalize(), etap, !one.le(sin2_t))
 }
 
 /// The relative index η' of a pair of directions (local frame) across an interface of
