@@ -193,6 +193,44 @@ fn with_metals(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with textured materials: a diffuse checkerboard (the lanes'), a rough GGX conductor
+/// whose roughness is a checkerboard (the lanes'), and one whose roughness differs along u and
+/// v (left to the scalar code), on the floor and two spheres.
+fn with_textures(mut desc: SceneDesc) -> SceneDesc {
+    let checks = |a: Vec3, b: Vec3| TextureDesc::Checkerboard {
+        color0: a,
+        color1: b,
+        to_uv: glam::Affine2::from_scale(glam::Vec2::splat(6.0)),
+    };
+    let metal = |alpha_v| MaterialDesc::RoughConductor {
+        alpha_u: checks(Vec3::splat(0.05), Vec3::splat(0.4)),
+        alpha_v,
+        eta: Vec3::new(0.2, 0.9, 1.1),
+        k: Vec3::new(3.9, 2.4, 2.2),
+        specular: TextureDesc::Constant(Vec3::ONE),
+        distribution: NormalDistribution::Ggx,
+    };
+    desc.materials[0] = MaterialDesc::TexturedDiffuse {
+        texture: checks(Vec3::new(0.8, 0.2, 0.1), Vec3::new(0.1, 0.6, 0.7)),
+        scale: Vec3::ONE,
+        two_sided: false,
+    };
+    let first = desc.materials.len();
+    desc.materials
+        .push(metal(checks(Vec3::splat(0.05), Vec3::splat(0.4))));
+    desc.materials
+        .push(metal(TextureDesc::Constant(Vec3::splat(0.2))));
+    for (k, (x, z)) in [(-0.4, 0.4), (0.4, -0.3)].into_iter().enumerate() {
+        desc.spheres.push(SphereDesc {
+            center: Vec3::new(x, 0.2, z),
+            radius: 0.2,
+            material: first + k,
+            ..Default::default()
+        });
+    }
+    desc
+}
+
 /// `desc` with smooth lobes: a mirror, a smooth conductor, glass (exact Fresnel reflectance,
 /// shaded in the lanes; and Schlick's, left to the scalar code), each on a sphere, the glass
 /// ones large enough to be entered and left.
@@ -244,7 +282,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // Lambertian surfaces lit by emitting triangles or an environment map in SIMD lanes (and
     // the environment map's radiance towards the rays that leave the scene) and everything
     // else with the scalar code (rough GGX conductors and glass of one roughness, mirrors,
-    // smooth conductors and glass too, in the scenes `with_metals` and `with_smooth_lobes`): every sample's radiance must be the scalar `li`'s to the
+    // smooth conductors and glass too, textured or not, in the scenes `with_metals`,
+    // `with_smooth_lobes` and `with_textures`): every sample's radiance must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these
@@ -263,6 +302,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
             under_a_sky(with_smooth_lobes(with_metals(mixed_scene()))),
             false,
         ),
+        (with_textures(mixed_scene()), false),
+        (under_a_sky(with_textures(mixed_scene())), false),
     ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);

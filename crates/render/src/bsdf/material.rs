@@ -304,28 +304,45 @@ impl Material {
         })
     }
 
-    /// The lobe and sidedness of a plain (untextured) material of one lobe that the path
-    /// tracer's lanes shade together: Lambertian, a rough conductor or rough glass of GGX
-    /// normals of one roughness, a mirror, a smooth conductor, or smooth glass of exact
-    /// Fresnel reflectance.
+    /// The lobe and sidedness of a material of one lobe that the path tracer's lanes shade
+    /// together, its textures read at `tex`: Lambertian, a rough conductor or rough glass of
+    /// GGX normals of one roughness, a mirror, a smooth conductor, or smooth glass of exact
+    /// Fresnel reflectance. Textured models are evaluated (as [`Material::bsdf`] evaluates
+    /// them) only where they may give one of those: diffuse, and GGX conductors and glass of
+    /// the same roughness along u and v.
     #[inline]
-    pub fn lane_bxdf(&self) -> Option<(LaneBxdf, bool)> {
-        let Material::Leaf(Leaf {
-            model: Model::Fixed(bxdf),
-            two_sided,
-        }) = self
-        else {
+    pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<(LaneBxdf, bool)> {
+        let Material::Leaf(Leaf { model, two_sided }) = self else {
             return None;
         };
+        let bxdf = match model {
+            Model::Fixed(bxdf) => *bxdf,
+            Model::Diffuse { .. }
+            | Model::Conductor {
+                kind: NormalDistribution::Ggx,
+                ..
+            }
+            | Model::Dielectric {
+                kind: NormalDistribution::Ggx,
+                ..
+            } => {
+                match model.bxdf(&tex()) {
+                    (bxdf, false) => bxdf,
+                    // Anisotropic: its frame follows the surface's tangent.
+                    (_, true) => return None,
+                }
+            }
+            _ => return None,
+        };
         let lobe = match bxdf {
-            Bxdf::Diffuse(d) => LaneBxdf::Diffuse(*d),
+            Bxdf::Diffuse(d) => LaneBxdf::Diffuse(d),
             Bxdf::Conductor(c) => match c.as_smooth() {
                 Some(smooth) => LaneBxdf::SmoothConductor(smooth),
                 None => LaneBxdf::Conductor(c.as_isotropic_ggx()?),
             },
             Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(d.as_isotropic_ggx()?),
-            Bxdf::Mirror(m) => LaneBxdf::Mirror(*m),
-            Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(*d),
+            Bxdf::Mirror(m) => LaneBxdf::Mirror(m),
+            Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(d),
             _ => return None,
         };
         Some((lobe, *two_sided))

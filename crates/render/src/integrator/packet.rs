@@ -344,7 +344,7 @@ impl PathIntegrator {
                 // `arrive` goes on only at a surface.
                 let Some(si) = &hits[i] else { continue };
                 let material: &Material = scene.material(si.material);
-                let Some((lobe, two_sided)) = material.lane_bxdf() else {
+                let Some((lobe, two_sided)) = material.lane_bxdf(|| scene.tex_point(si)) else {
                     if !self.scatter(scene, st, si, smp, stats) {
                         out(lane.tag, st.l * lane.weight);
                         lanes[i] = None;
