@@ -304,6 +304,18 @@ impl Material {
         })
     }
 
+    /// The reflectance and sidedness of a plain (untextured) Lambertian material.
+    #[inline]
+    pub fn as_lambertian(&self) -> Option<(Diffuse, bool)> {
+        match self {
+            Material::Leaf(Leaf {
+                model: Model::Fixed(Bxdf::Diffuse(d)),
+                two_sided,
+            }) => Some((*d, *two_sided)),
+            _ => None,
+        }
+    }
+
     /// The lobe and sidedness of a material of one lobe that the path tracer's lanes shade
     /// together, its textures read at `tex`: Lambertian, a rough conductor or rough glass of
     /// GGX normals of one roughness, a mirror, a smooth conductor, or smooth glass of exact
