@@ -8,11 +8,13 @@
 //! numbers for all lanes at once.
 //!
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
-//! for every lane and bounce, except where a lane's surface is Lambertian or a rough GGX
-//! conductor ([`Material::lane_bxdf`]) and its light an emitting triangle or an environment
-//! map. There the lanes are shaded together in SIMD registers by the same functions the
-//! one-path code calls, instantiated on eight lanes (the [`Diffuse`] and [`RoughConductor`]
-//! BSDFs, [`TriangleEmitter::sample_li`],
+//! for every lane and bounce, except where a lane's material is one lobe of those the lanes
+//! shade ([`Material::lane_bxdf`]: Lambertian; a mirror; smooth conductors and glass; rough
+//! GGX conductors and glass) and its light an emitting triangle or an environment map (or none,
+//! for the smooth lobes). There the lanes are shaded together in SIMD registers by the same
+//! functions the one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
+//! [`RoughConductor`], [`RoughDielectric`], [`Mirror`], [`SmoothConductor`],
+//! [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
 //! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`], [`offset_ray_origin`],
 //! [`power_heuristic_weight`]; see `scatter_lanes`): this module holds only the scheduling
 //! and the masks that stand for the one-path code's early returns. The rays that leave the
@@ -117,17 +119,18 @@ struct ScatterOut {
     weight: V8,
 }
 
-/// The lanes' scattering at diffuse surfaces, rough conductors and smooth lobes, composed of
-/// the functions the one-path code calls, on lanes: the shading frame ([`Frame::from_normal`], turned
-/// towards wo for a two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does),
+/// The lanes' scattering at the lobes [`Material::lane_bxdf`] gives, composed of the functions
+/// the one-path code calls, on lanes: the shading frame ([`Frame::from_normal`], turned towards
+/// wo for a two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does),
 /// [`super::sample_light`] for a point on an emitting triangle or an environment map's
 /// direction (drawn before, by [`EnvironmentMap::sample_direction_lanes`]) up to the shadow
-/// ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`] or [`RoughConductor::f_and_pdf`],
-/// [`offset_ray_origin`], [`power_heuristic_weight`] against [`Diffuse::pdf_z`] or the
-/// conductor's density; the map's radiance is read after the shadow ray, as there), and
+/// ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`] or
+/// [`RoughDielectric::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`] against
+/// the lobe's density; the map's radiance is read after the shadow ray, as there), and
 /// [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe ([`Diffuse::sample_z`],
-/// [`RoughConductor::sample`], [`RoughDielectric::sample_real`], [`Mirror::sample_real`], [`SmoothConductor::sample`],
-/// [`DielectricLanes::sample`]; smooth lobes have no light sample). Only the control flow is
+/// [`RoughConductor::sample`], [`RoughDielectric::sample_real`], [`Mirror::sample_real`],
+/// [`SmoothConductor::sample`], [`DielectricLanes::sample`]; smooth lobes have no light
+/// sample). Only the control flow is
 /// the lanes' own: masks where the one-path code returns early, and each lobe's functions
 /// skipped where no lane has it (all but the Lambertian ones without `OTHER_LOBES`: a
 /// separate, smaller instance for passes of Lambertian lanes alone).
