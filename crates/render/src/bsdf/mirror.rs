@@ -56,7 +56,11 @@ pub(super) fn specular_reflection(wo: Vec3, weight: Rgb, pdf: f32) -> Option<Loc
 /// [`specular_reflection`] for one direction or lanes: it exists where `wo` is off the
 /// surface and `pdf` is positive.
 #[inline(always)]
-pub(super) fn specular_reflection_real<V: Vector3>(wo: V, weight: V, pdf: V::R) -> DirectionSample<V> {
+pub(super) fn specular_reflection_real<V: Vector3>(
+    wo: V,
+    weight: V,
+    pdf: V::R,
+) -> DirectionSample<V> {
     let zero = V::R::splat(0.0);
     let wi = V::new(-wo.x(), -wo.y(), wo.z());
     DirectionSample {
