@@ -6,8 +6,9 @@ use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
 use pathlab_mc::simd::lanes::{Real, Vector3, M8, V8};
 
-/// A non-delta lobe's sample in the local frame, for one direction (`V = Vec3`) or for eight
-/// lanes ([`crate::simd::lanes::V8`]): it exists where `valid`.
+/// A lobe's sample in the local frame, for one direction (`V = Vec3`) or for eight lanes
+/// ([`crate::simd::lanes::V8`]): it exists where `valid`. Whether the lobe is a delta is the
+/// caller's to say ([`DirectionSample::local`], [`DirectionSample::delta`]).
 #[derive(Clone, Copy, Debug)]
 pub struct DirectionSample<V: Vector3> {
     /// The sampled direction, local.
@@ -21,25 +22,25 @@ pub struct DirectionSample<V: Vector3> {
 }
 
 impl DirectionSample<Vec3> {
-    /// The sample where it exists.
+    /// The sample of a non-delta lobe where it exists.
     #[inline]
     pub fn local(self) -> Option<LocalSample> {
-        self.valid.then_some(LocalSample {
-            f: self.f,
-            wi: self.wi,
-            pdf: self.pdf,
-            delta: false,
-        })
+        self.with_delta(false)
     }
 
     /// The sample of a delta lobe where it exists.
     #[inline]
     pub fn delta(self) -> Option<LocalSample> {
+        self.with_delta(true)
+    }
+
+    #[inline]
+    fn with_delta(self, delta: bool) -> Option<LocalSample> {
         self.valid.then_some(LocalSample {
             f: self.f,
             wi: self.wi,
             pdf: self.pdf,
-            delta: true,
+            delta,
         })
     }
 }

@@ -3,7 +3,7 @@
 
 use super::bxdf::DirectionSample;
 use super::fresnel::ConductorFresnel;
-use super::microfacet::{Distribution, IsotropicGgx, Microfacet, NormalDistribution};
+use super::microfacet::{Distribution, IsotropicGgx, Microfacet};
 use super::mirror::specular_reflection_real;
 use super::scattering::reflect;
 use super::LocalSample;
@@ -53,12 +53,11 @@ impl Conductor {
     /// model the path tracer's lanes shade together, with the same functions.
     #[inline]
     pub fn as_isotropic_ggx(&self) -> Option<RoughConductor<Rgb, IsotropicGgx<f32>>> {
-        let m = self.distribution?;
-        (m.kind == NormalDistribution::Ggx && m.is_isotropic()).then_some(RoughConductor {
+        Some(RoughConductor {
             eta: self.eta,
             k: self.k,
             specular: self.specular,
-            distribution: IsotropicGgx { alpha: m.alpha },
+            distribution: self.distribution?.as_isotropic_ggx()?,
         })
     }
 
@@ -70,15 +69,10 @@ impl Conductor {
     /// A sample: the mirror direction when smooth, otherwise the reflection of `wo` about a
     /// sampled microfacet normal.
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
-        let Some(r) = self.rough() else {
-            let smooth = SmoothConductor {
-                eta: self.eta,
-                k: self.k,
-                specular: self.specular,
-            };
+        if let Some(smooth) = self.as_smooth() {
             return smooth.sample(wo).delta();
-        };
-        r.sample(wo, u.x, u.y).local()
+        }
+        self.rough()?.sample(wo, u.x, u.y).local()
     }
 
     /// Density of [`Conductor::sample`].
@@ -156,7 +150,8 @@ impl<V: ConductorFresnel, M: Distribution<V::R>> RoughConductor<V, M> {
             .mul_axes(V::fresnel_conductor(cos_om, self.eta, self.k));
         let f = fresnel.scale(dg / (four * wo.z() * wi.z()));
         let pdf = m.pdf_wm(wo, wm) / (four * cos_om);
-        // Both below or opposite: nothing (`!(z > 0)` lets NaN through, as `z <= 0`).
+        // Either below or the two opposite: nothing (`z <= 0` is false for NaN, as in the
+        // one-direction code's early returns before it was written over `Real`).
         let none = wo.z().le(zero) | wi.z().le(zero) | sum.dot(sum).equals(zero);
         (
             V::select(none, V::splat(Vec3::ZERO), f),
@@ -214,7 +209,7 @@ impl RoughConductor<V8, IsotropicGgx<F8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::Mirror;
+    use crate::bsdf::{Mirror, NormalDistribution};
     use pathlab_mc::rng::Pcg32;
 
     /// Eight lanes of the rough conductor compute, lane by lane, what the one-direction

@@ -11,7 +11,7 @@ use std::f32::consts::FRAC_1_PI;
 
 /// Lambertian: f = reflectance / π on the upper hemisphere; sampled cosine-weighted. `V` is the
 /// colour type: [`Rgb`], or [`crate::simd::lanes::V8`] for eight lanes' materials.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Diffuse<V = Rgb> {
     /// Albedo.
     pub reflectance: V,
@@ -89,14 +89,6 @@ impl Diffuse {
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         self.pdf_z(wo.z, wi.z)
-    }
-}
-
-impl Default for Diffuse<V8> {
-    fn default() -> Self {
-        Diffuse {
-            reflectance: V8::default(),
-        }
     }
 }
 

@@ -7,9 +7,8 @@
 //! separable Smith form G(wo, wi, wm) = G1(wo, wm) G1(wi, wm) with the exact Λ of each
 //! distribution; GGX samples the distribution of visible normals (Heitz 2018), Beckmann the
 //! distribution of normals D(wm) cos θm.
-
 //!
-//! The GGX pieces that the rough conductor's lanes use (D and Λ of one roughness, the
+//! The GGX pieces that the path tracer's lanes use (D and Λ of one roughness, the
 //! density and sampling of visible normals, Smith's G1) are written once over
 //! [`Real`] (see [`pathlab_mc::simd::lanes`]): [`Microfacet`] calls their `f32` instance, and
 //! [`IsotropicGgx`] is the same distribution for one direction or for eight lanes.
@@ -228,6 +227,13 @@ impl Microfacet {
             .then(|| Microfacet::anisotropic(kind, alpha_x, alpha_y))
     }
 
+    /// This distribution as [`IsotropicGgx`], where it is GGX of one roughness.
+    #[inline]
+    pub fn as_isotropic_ggx(&self) -> Option<IsotropicGgx<f32>> {
+        (self.kind == NormalDistribution::Ggx && self.is_isotropic())
+            .then_some(IsotropicGgx { alpha: self.alpha })
+    }
+
     /// Whether both roughnesses are the same.
     #[inline]
     pub fn is_isotropic(&self) -> bool {
@@ -306,7 +312,7 @@ impl Microfacet {
 
     /// Masking-shadowing G1(wo, wm) G1(wi, wm).
     pub fn g(&self, wo: Vec3, wi: Vec3, wm: Vec3) -> f32 {
-        self.g1(wo, wm) * self.g1(wi, wm)
+        Distribution::g(self, wo, wi, wm)
     }
 
     /// Samples a microfacet normal (upper hemisphere) for light leaving towards `wo`: a

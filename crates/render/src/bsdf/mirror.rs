@@ -8,7 +8,7 @@ use pathlab_mc::simd::lanes::{Real, Vector3, V8};
 
 /// A perfect mirror: wi = (-wo.x, -wo.y, wo.z), scaled by `reflectance` (a delta lobe). `V` is
 /// the colour type: [`Rgb`], or [`V8`] for eight lanes' materials.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Mirror<V = Rgb> {
     /// Reflectance per channel.
     pub reflectance: V,
@@ -26,14 +26,6 @@ impl<V: Vector3> Mirror<V> {
     #[inline(always)]
     pub fn sample_real(&self, wo: V) -> DirectionSample<V> {
         specular_reflection_real(wo, self.reflectance, V::R::splat(1.0))
-    }
-}
-
-impl Default for Mirror<V8> {
-    fn default() -> Self {
-        Mirror {
-            reflectance: V8::default(),
-        }
     }
 }
 

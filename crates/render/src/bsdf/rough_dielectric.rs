@@ -3,7 +3,7 @@
 
 use super::bxdf::DirectionSample;
 use super::fresnel::fresnel_dielectric_real;
-use super::microfacet::{Distribution, IsotropicGgx, Microfacet, NormalDistribution};
+use super::microfacet::{Distribution, IsotropicGgx, Microfacet};
 use super::scattering::{reflect, refract_about_real, relative_eta};
 use super::{Lobes, LocalSample};
 use crate::desc::Rgb;
@@ -65,10 +65,9 @@ impl RoughDielectric {
     /// model the path tracer's lanes shade together, with the same functions.
     #[inline]
     pub fn as_isotropic_ggx(&self) -> Option<RoughDielectric<f32, Rgb, IsotropicGgx<f32>>> {
-        let m = self.distribution;
-        (m.kind == NormalDistribution::Ggx && m.is_isotropic()).then_some(RoughDielectric {
+        Some(RoughDielectric {
             eta: self.eta,
-            distribution: IsotropicGgx { alpha: m.alpha },
+            distribution: self.distribution.as_isotropic_ggx()?,
             reflectance: self.reflectance,
             transmittance: self.transmittance,
         })
@@ -204,6 +203,7 @@ impl RoughDielectric<F8, V8, IsotropicGgx<F8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::NormalDistribution;
     use pathlab_mc::rng::Pcg32;
 
     /// Eight lanes of rough glass compute, lane by lane, what the one-direction model computes
