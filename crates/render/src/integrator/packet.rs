@@ -53,8 +53,8 @@ struct ScatterIn {
     ng: V8,
     ns: V8,
     wo: V8,
-    /// Which lanes have which lobe: `metal`, a rough conductor; `rough_glass`; `mirror`;
-    /// `smooth_metal`, a smooth conductor; `glass`; the others' is `diffuse`.
+    /// Which lanes have which lobe ([`LobeLanes`]): `metal`, a rough conductor; `rough_glass`;
+    /// `mirror`; `smooth_metal`, a smooth conductor; `glass`; the others' is `diffuse`.
     lobes: LobeLanes,
     diffuse: Diffuse<V8>,
     metal: RoughConductor<V8, IsotropicGgx<F8>>,
@@ -85,10 +85,10 @@ struct ScatterIn {
 struct LobeLanes {
     conductor: M8,
     rough_glass: M8,
-    mirror: M8,
     smooth_metal: M8,
     glass: M8,
-    /// The three delta lobes together: no light sample.
+    /// The delta lobes (mirrors, smooth conductors and glass): no light sample. Those in
+    /// neither `smooth_metal` nor `glass` are mirrors.
     delta: M8,
 }
 
@@ -140,6 +140,9 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let flip = a.two_sided & a.wo.dot(a.ns).lt(zero);
     let frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
     let wo_z = a.wo.dot(frame.n);
+    // The other lobes' functions take whole local directions (unused, and not computed, in
+    // the Lambertian instance).
+    let wo_local = frame.to_local(a.wo);
     let metal = a.lobes.conductor;
     let any_metal = OTHER_LOBES && metal.any();
     let rough_glass = a.lobes.rough_glass;
@@ -150,15 +153,14 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let ls = a.emitter.sample_li(a.p, a.u_light[0], a.u_light[1]);
     let wi = env.select3(a.environment_wi, ls.wi);
     let wi_z = wi.dot(frame.n);
+    let wi_local = frame.to_local(wi);
     let (mut f, mut bsdf_pdf) = (a.diffuse.f_z(wo_z, wi_z), a.diffuse.pdf_z(wo_z, wi_z));
     if any_metal {
-        let (f_metal, pdf_metal) = a.metal.f_and_pdf(frame.to_local(a.wo), frame.to_local(wi));
+        let (f_metal, pdf_metal) = a.metal.f_and_pdf(wo_local, wi_local);
         (f, bsdf_pdf) = (metal.select3(f_metal, f), metal.select(pdf_metal, bsdf_pdf));
     }
     if any_rough_glass {
-        let (f_glass, pdf_glass) =
-            a.rough_glass
-                .f_and_pdf(frame.to_local(a.wo), frame.to_local(wi), Lobes::All);
+        let (f_glass, pdf_glass) = a.rough_glass.f_and_pdf(wo_local, wi_local, Lobes::All);
         (f, bsdf_pdf) = (
             rough_glass.select3(f_glass, f),
             rough_glass.select(pdf_glass, bsdf_pdf),
@@ -185,24 +187,22 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     out.weight_over_pdf = mis / pdf;
 
     // BSDF sampling (and `Bsdf::sample_f`'s checks of a positive density and a finite value).
-    let mut bs = a.diffuse.sample_z(wo_z, a.u_bsdf[0], a.u_bsdf[1]);
+    let [u0, u1] = a.u_bsdf;
+    let mut bs = a.diffuse.sample_z(wo_z, u0, u1);
     if any_metal {
-        let m = a
-            .metal
-            .sample(frame.to_local(a.wo), a.u_bsdf[0], a.u_bsdf[1]);
-        bs = DirectionSample::select(metal, m, bs);
+        bs = DirectionSample::select(metal, a.metal.sample(wo_local, u0, u1), bs);
     }
     let mut eta = F8::splat(1.0);
     if any_rough_glass {
-        let wo = frame.to_local(a.wo);
-        let (uc, [u0, u1]) = (a.u_lobe, a.u_bsdf);
-        let g = a.rough_glass.sample_real(wo, uc, u0, u1, Lobes::All);
-        eta = rough_glass.select(a.rough_glass.relative_ior(wo, g.wi), eta);
+        let g = a
+            .rough_glass
+            .sample_real(wo_local, a.u_lobe, u0, u1, Lobes::All);
+        eta = rough_glass.select(a.rough_glass.relative_ior(wo_local, g.wi), eta);
         bs = DirectionSample::select(rough_glass, g, bs);
     }
     let lobes = &a.lobes;
     if OTHER_LOBES && lobes.delta.any() {
-        let wo = frame.to_local(a.wo);
+        let wo = wo_local;
         let mut d = a.mirror.sample_real(wo);
         if lobes.smooth_metal.any() {
             d = DirectionSample::select(lobes.smooth_metal, a.smooth_metal.sample(wo), d);
@@ -442,7 +442,8 @@ impl PathIntegrator {
     /// The end of lane `i`'s bounce after the SIMD scattering: the shadow ray (adding the light
     /// sample's contribution where it is unblocked; an environment map's radiance, from
     /// `directions`, is read then), the throughput times the BSDF sample's weight (and the
-    /// radiance scale by the relative index it crossed), Russian roulette with `u_rr`. Returns whether the path goes on.
+    /// radiance scale by the relative index it crossed), Russian roulette with `u_rr`. Returns
+    /// whether the path goes on.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn finish_bounce(
@@ -661,14 +662,12 @@ fn gather_lobe(
     stats: &mut PathStats,
 ) -> Option<bool> {
     let (lobe, two_sided) = material.lane_bxdf(|| scene.tex_point(si))?;
-    // As `scatter` counts a vertex whose BSDF is not black.
-    stats.random_vertices += 1;
+    // As `scatter` counts a vertex whose BSDF is not black: every lobe but a black diffuse one.
+    let black = matches!(lobe, LaneBxdf::Diffuse(d) if d.reflectance.max_element() <= 0.0);
+    stats.random_vertices += u64::from(!black);
     let lobes = &mut a.lobes;
     match lobe {
-        LaneBxdf::Diffuse(diffuse) => {
-            stats.random_vertices -= u64::from(diffuse.reflectance.max_element() <= 0.0);
-            a.diffuse.set_lane(i, diffuse);
-        }
+        LaneBxdf::Diffuse(diffuse) => a.diffuse.set_lane(i, diffuse),
         LaneBxdf::Conductor(metal) => {
             a.metal.set_lane(i, metal);
             lobes.conductor.set(i, true);
@@ -679,7 +678,6 @@ fn gather_lobe(
         }
         LaneBxdf::Mirror(mirror) => {
             a.mirror.set_lane(i, mirror);
-            lobes.mirror.set(i, true);
             lobes.delta.set(i, true);
         }
         LaneBxdf::SmoothConductor(metal) => {
