@@ -136,6 +136,18 @@ fn malformed_xml_gives_located_errors() {
             r#"<scene><shape type="rectangle"><transform name="to_world"><matrix value="1 2 3"/></transform></shape></scene>"#,
             "16 numbers",
         ),
+        (
+            r#"<scene><shape type="rectangle"><bsdf type="roughconductor"><float name="alpha" value="-0.5"/></bsdf></shape></scene>"#,
+            "alpha must be a number >= 0, got -0.5",
+        ),
+        (
+            r#"<scene><shape type="rectangle"><bsdf type="roughdielectric"><float name="alpha_u" value="0.1"/><float name="alpha_v" value="-1"/></bsdf></shape></scene>"#,
+            "alpha_v must be a number >= 0, got -1",
+        ),
+        (
+            r#"<scene><shape type="rectangle"><bsdf type="roughplastic"><float name="alpha" value="-0.1"/></bsdf></shape></scene>"#,
+            "alpha must be a number >= 0, got -0.1",
+        ),
         (r#"<scene><shape type="rectangle">"#, "malformed XML"),
         (r#"<notscene/>"#, "expected a <scene>"),
         (

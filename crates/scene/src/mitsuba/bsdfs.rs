@@ -92,8 +92,13 @@ fn nested<'t>(ctx: &Ctx<'t>, b: Obj) -> Result<Vec<Obj<'t>>, Error> {
 /// A rough model's α along u and v, each a number or a texture: `alpha`, or `alpha_u` and
 /// `alpha_v` (Mitsuba's default 0.1 each).
 fn alphas(ctx: &mut Ctx, b: Obj) -> Result<(TextureDesc, TextureDesc), Error> {
-    let alpha =
-        |ctx: &mut Ctx, name| ctx.texture(b, name, Vec3::splat(0.1), SpectrumKind::Unbounded);
+    let alpha = |ctx: &mut Ctx, name| {
+        let t = ctx.texture(b, name, Vec3::splat(0.1), SpectrumKind::Unbounded)?;
+        if let Some(a) = t.as_constant() {
+            non_negative_alpha(ctx, b, name, a.x)?;
+        }
+        Ok(t)
+    };
     if ctx.has(b, "alpha_u") || ctx.has(b, "alpha_v") {
         if ctx.has(b, "alpha") {
             return Err(ctx.error(
@@ -105,6 +110,18 @@ fn alphas(ctx: &mut Ctx, b: Obj) -> Result<(TextureDesc, TextureDesc), Error> {
     }
     let a = alpha(ctx, "alpha")?;
     Ok((a.clone(), a))
+}
+
+/// An error at property `name` of `b` unless the roughness `a` is a number ≥ 0 (Mitsuba
+/// gives no meaning to a negative α; it is not taken as smooth).
+fn non_negative_alpha(ctx: &Ctx, b: Obj, name: &str, a: f32) -> Result<(), Error> {
+    if a >= 0.0 && a.is_finite() {
+        return Ok(());
+    }
+    Err(ctx.error(
+        ctx.loc_of(b, name),
+        format!("{}: {name} must be a number >= 0, got {a}", ctx.what(b)),
+    ))
 }
 
 /// The material for BSDF object `b`.
@@ -342,6 +359,7 @@ fn rough_plastic(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
         "<bsdf type=\"roughplastic\">: alpha must be a number (Mitsuba's roughplastic takes no roughness texture)",
     ));
     };
+    non_negative_alpha(ctx, b, "alpha", alpha.x)?;
     Ok(MaterialDesc::RoughPlastic {
         diffuse: ctx.texture(
             b,

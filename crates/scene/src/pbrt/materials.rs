@@ -169,7 +169,9 @@ impl Builder {
                     Some(t)
                 }
                 None if params.has(name) => {
-                    Some(TextureDesc::value(b.float(params, name, 0.0)? as f32))
+                    let value = b.float(params, name, 0.0)?;
+                    b.check_roughness(params, name, value)?;
+                    Some(TextureDesc::value(value as f32))
                 }
                 None => None,
             })
@@ -189,17 +191,32 @@ impl Builder {
         ]))
     }
 
+    /// An error naming parameter `name` unless its roughness `value` is a number ≥ 0 (pbrt-v4
+    /// would take the square root of a negative one).
+    fn check_roughness(&self, params: &ParamList, name: &str, value: f64) -> Result<(), Error> {
+        match params.get(name) {
+            Some(p) if !(value >= 0.0 && value.is_finite()) => Err(self.error(format!(
+                "\"{} {}\" (line {}): roughness must be a number >= 0, got {value}",
+                p.ty, p.name, p.line
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     /// `{prefix}roughness`, `{prefix}uroughness` and `{prefix}vroughness` as α along u and v,
     /// remapped as `remaproughness` says (pbrt-v4's default: remapped).
     fn roughness_of(&mut self, params: &ParamList, prefix: &str) -> Result<(f32, f32), Error> {
         let r = self.float_value(params, &format!("{prefix}roughness"), 0.0)?;
         let u = self.float_value(params, &format!("{prefix}uroughness"), r)?;
         let v = self.float_value(params, &format!("{prefix}vroughness"), r)?;
+        for (value, name) in [(r, "roughness"), (u, "uroughness"), (v, "vroughness")] {
+            self.check_roughness(params, &format!("{prefix}{name}"), value)?;
+        }
         let remap = self.bool(params, "remaproughness", true)?;
         // pbrt-v4's TrowbridgeReitzDistribution::RoughnessToAlpha is √roughness; below
         // α = 10⁻³ a surface is smooth.
         let alpha = |x: f64| {
-            let a = if remap { x.max(0.0).sqrt() } else { x.max(0.0) } as f32;
+            let a = if remap { x.sqrt() } else { x } as f32;
             if a < 1e-3 {
                 0.0
             } else {
