@@ -377,6 +377,14 @@ pub trait Real:
     fn is_infinite(self) -> Self::Mask;
     /// `a` where `m`, else `b`.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// Whether `m` is true in some lane.
+    fn any(m: Self::Mask) -> bool;
+    /// `f` of each lane in the lanes `m` (zero in the others, where `f` is not called): for
+    /// functions that have no lane form, such as `exp`, whose lanes' values are then those of
+    /// `f`, to the bit.
+    fn map_where(self, m: Self::Mask, f: impl Fn(f32) -> f32) -> Self;
+    /// `f` of each lane of `self` and `o` in the lanes `m`, as [`Real::map_where`].
+    fn map2_where(self, o: Self, m: Self::Mask, f: impl Fn(f32, f32) -> f32) -> Self;
 }
 
 /// 3-vectors of a [`Real`]: glam's `Vec3` for `f32`, [`V8`] for eight lanes, with glam's
@@ -488,6 +496,26 @@ impl Real for f32 {
             a
         } else {
             b
+        }
+    }
+    #[inline(always)]
+    fn any(m: bool) -> bool {
+        m
+    }
+    #[inline(always)]
+    fn map_where(self, m: bool, f: impl Fn(f32) -> f32) -> f32 {
+        if m {
+            f(self)
+        } else {
+            0.0
+        }
+    }
+    #[inline(always)]
+    fn map2_where(self, o: f32, m: bool, f: impl Fn(f32, f32) -> f32) -> f32 {
+        if m {
+            f(self, o)
+        } else {
+            0.0
         }
     }
 }
@@ -606,6 +634,22 @@ impl Real for F8 {
     #[inline(always)]
     fn select(m: M8, a: F8, b: F8) -> F8 {
         m.select(a, b)
+    }
+    #[inline(always)]
+    fn any(m: M8) -> bool {
+        m.any()
+    }
+    #[inline(always)]
+    fn map_where(self, m: M8, f: impl Fn(f32) -> f32) -> F8 {
+        self.map2_where(self, m, |x, _| f(x))
+    }
+    #[inline(always)]
+    fn map2_where(self, o: F8, m: M8, f: impl Fn(f32, f32) -> f32) -> F8 {
+        let mut r = [0.0; W];
+        for i in (0..W).filter(|&i| m.get(i)) {
+            r[i] = f(self.0[i], o.0[i]);
+        }
+        F8(r)
     }
 }
 

@@ -3,7 +3,7 @@
 
 use super::bxdf::DirectionSample;
 use super::fresnel::ConductorFresnel;
-use super::microfacet::{Distribution, IsotropicGgx, Microfacet};
+use super::microfacet::{Distribution, IsotropicMicrofacet, Microfacet};
 use super::mirror::specular_reflection_real;
 use super::scattering::reflect;
 use super::LocalSample;
@@ -49,15 +49,15 @@ impl Conductor {
         })
     }
 
-    /// The rough lobe where its distribution is GGX of one roughness in every direction: the
+    /// The rough lobe where its distribution has one roughness in every direction: the
     /// model the path tracer's lanes shade together, with the same functions.
     #[inline]
-    pub fn as_isotropic_ggx(&self) -> Option<RoughConductor<Rgb, IsotropicGgx<f32>>> {
+    pub fn as_isotropic(&self) -> Option<RoughConductor<Rgb, IsotropicMicrofacet<f32>>> {
         Some(RoughConductor {
             eta: self.eta,
             k: self.k,
             specular: self.specular,
-            distribution: self.distribution?.as_isotropic_ggx()?,
+            distribution: self.distribution?.as_isotropic()?,
         })
     }
 
@@ -116,7 +116,7 @@ impl SmoothConductor<V8> {
 }
 
 /// A rough conductor's lobe, written once for one direction (`V = Rgb`, with `Microfacet`
-/// or [`IsotropicGgx`]) and for eight lanes (`V = V8`, with `IsotropicGgx<F8>`): f = D(wm)
+/// or [`IsotropicMicrofacet`]) and for eight lanes (`V = V8`, with `IsotropicMicrofacet<F8>`): f = D(wm)
 /// G(wo, wi, wm) F(wo·wm) / (4 cos θo cos θi) with wm the half vector, sampled by reflecting
 /// `wo` about a normal from the distribution, of density pdf(wm) / (4 wo·wm).
 ///
@@ -188,33 +188,44 @@ impl<V: ConductorFresnel, M: Distribution<V::R>> RoughConductor<V, M> {
     }
 }
 
-impl RoughConductor<V8, IsotropicGgx<F8>> {
+impl RoughConductor<V8, IsotropicMicrofacet<F8>> {
     /// Sets lane `i` to `c`. Every field is taken apart here: a field added to
-    /// [`RoughConductor`] or [`IsotropicGgx`] fails to compile until its lanes are set too.
+    /// [`RoughConductor`] or [`IsotropicMicrofacet`] fails to compile until its lanes are set too.
     #[inline(always)]
-    pub fn set_lane(&mut self, i: usize, c: RoughConductor<Rgb, IsotropicGgx<f32>>) {
+    pub fn set_lane(&mut self, i: usize, c: RoughConductor<Rgb, IsotropicMicrofacet<f32>>) {
         let RoughConductor {
             eta,
             k,
             specular,
-            distribution: IsotropicGgx { alpha },
+            distribution: IsotropicMicrofacet { alpha, beckmann },
         } = c;
         self.eta.set(i, eta);
         self.k.set(i, k);
         self.specular.set(i, specular);
         self.distribution.alpha.0[i] = alpha;
+        self.distribution.beckmann.set(i, beckmann);
     }
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::bsdf::{Mirror, NormalDistribution};
     use pathlab_mc::rng::Pcg32;
 
+    /// Round `round`'s distribution in lane `i`: all lanes GGX, all Beckmann, or the two
+    /// mixed.
+    pub(crate) fn lane_kind(round: usize, i: usize) -> NormalDistribution {
+        match (round % 3, i % 2) {
+            (0, _) | (2, 0) => NormalDistribution::Ggx,
+            _ => NormalDistribution::Beckmann,
+        }
+    }
+
     /// Eight lanes of the rough conductor compute, lane by lane, what the one-direction
     /// [`Conductor`] computes (through [`Microfacet`]), to the bit: f, pdf and the sample,
-    /// for directions above, below and on the horizon, opposite pairs and equal ones.
+    /// for directions above, below and on the horizon, opposite pairs and equal ones, with
+    /// GGX and Beckmann lanes.
     #[test]
     fn lanes_compute_what_the_one_direction_conductor_computes() {
         let mut rng = Pcg32::new(7, 11);
@@ -226,7 +237,7 @@ mod tests {
         };
         let (mut valid, mut lanes_seen) = (0, 0);
         for round in 0..400 {
-            let mut lanes = RoughConductor::<V8, IsotropicGgx<F8>>::default();
+            let mut lanes = RoughConductor::<V8, IsotropicMicrofacet<F8>>::default();
             let (mut wo, mut wi) = (V8::default(), V8::default());
             let (mut u0, mut u1) = (F8::default(), F8::default());
             let mut scalar = Vec::new();
@@ -236,9 +247,9 @@ mod tests {
                     eta: Vec3::new(0.2, 0.9, 1.4) + rng.uniform_f32(),
                     k: Vec3::new(3.9, 2.4, 1.6) * rng.uniform_f32(),
                     specular: Vec3::new(1.0, 0.8, rng.uniform_f32()),
-                    distribution: Some(Microfacet::new(NormalDistribution::Ggx, alpha)),
+                    distribution: Some(Microfacet::new(lane_kind(round, i), alpha)),
                 };
-                lanes.set_lane(i, c.as_isotropic_ggx().expect("isotropic GGX"));
+                lanes.set_lane(i, c.as_isotropic().expect("isotropic"));
                 let (o, mut w) = (direction(&mut rng), direction(&mut rng));
                 match round % 5 {
                     0 => w = -o,

@@ -283,10 +283,10 @@ impl LobeList {
 pub enum LaneBxdf {
     /// Lambertian.
     Diffuse(Diffuse),
-    /// A rough conductor of GGX normals of one roughness.
-    Conductor(RoughConductor<Rgb, IsotropicGgx<f32>>),
-    /// Rough glass of GGX normals of one roughness.
-    RoughDielectric(RoughDielectric<f32, Rgb, IsotropicGgx<f32>>),
+    /// A rough conductor of GGX or Beckmann normals of one roughness.
+    Conductor(RoughConductor<Rgb, IsotropicMicrofacet<f32>>),
+    /// Rough glass of GGX or Beckmann normals of one roughness.
+    RoughDielectric(RoughDielectric<f32, Rgb, IsotropicMicrofacet<f32>>),
     /// A perfect mirror.
     Mirror(Mirror),
     /// A smooth conductor.
@@ -318,10 +318,10 @@ impl Material {
 
     /// The lobe and sidedness of a material of one lobe that the path tracer's lanes shade
     /// together, its textures read at `tex`: Lambertian, a rough conductor or rough glass of
-    /// GGX normals of one roughness, a mirror, a smooth conductor, or smooth glass of exact
-    /// Fresnel reflectance. Textured models are evaluated (as [`Material::bsdf`] evaluates
-    /// them) only where they may give one of those: diffuse, and GGX conductors and glass of
-    /// the same roughness along u and v.
+    /// GGX or Beckmann normals of one roughness, a mirror, a smooth conductor, or smooth glass
+    /// of exact Fresnel reflectance. Textured models are evaluated (as [`Material::bsdf`]
+    /// evaluates them) only where they may give one of those: diffuse, and conductors and
+    /// glass (the same roughness along u and v gives a lane lobe).
     #[inline]
     pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<(LaneBxdf, bool)> {
         let Material::Leaf(Leaf { model, two_sided }) = self else {
@@ -329,15 +329,7 @@ impl Material {
         };
         let bxdf = match model {
             Model::Fixed(bxdf) => *bxdf,
-            Model::Diffuse { .. }
-            | Model::Conductor {
-                kind: NormalDistribution::Ggx,
-                ..
-            }
-            | Model::Dielectric {
-                kind: NormalDistribution::Ggx,
-                ..
-            } => {
+            Model::Diffuse { .. } | Model::Conductor { .. } | Model::Dielectric { .. } => {
                 match model.bxdf(&tex()) {
                     (bxdf, false) => bxdf,
                     // Anisotropic: its frame follows the surface's tangent.
@@ -350,9 +342,9 @@ impl Material {
             Bxdf::Diffuse(d) => LaneBxdf::Diffuse(d),
             Bxdf::Conductor(c) => match c.as_smooth() {
                 Some(smooth) => LaneBxdf::SmoothConductor(smooth),
-                None => LaneBxdf::Conductor(c.as_isotropic_ggx()?),
+                None => LaneBxdf::Conductor(c.as_isotropic()?),
             },
-            Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(d.as_isotropic_ggx()?),
+            Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(d.as_isotropic()?),
             Bxdf::Mirror(m) => LaneBxdf::Mirror(m),
             Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(d),
             _ => return None,

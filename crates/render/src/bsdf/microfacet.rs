@@ -8,10 +8,14 @@
 //! distribution; GGX samples the distribution of visible normals (Heitz 2018), Beckmann the
 //! distribution of normals D(wm) cos θm.
 //!
-//! The GGX pieces that the path tracer's lanes use (D and Λ of one roughness, the
-//! density and sampling of visible normals, Smith's G1) are written once over
-//! [`Real`] (see [`pathlab_mc::simd::lanes`]): [`Microfacet`] calls their `f32` instance, and
-//! [`IsotropicGgx`] is the same distribution for one direction or for eight lanes.
+//! The pieces that the path tracer's lanes use (GGX's D and Λ of one roughness, the
+//! density and sampling of its visible normals, Beckmann's D, Λ and sampling of one
+//! roughness, Smith's G1) are written once over [`Real`] (see [`pathlab_mc::simd::lanes`]):
+//! [`Microfacet`] calls their `f32` instance, and [`IsotropicMicrofacet`] is the same
+//! distribution, GGX or Beckmann in each lane, for one direction or for eight lanes.
+//! Beckmann's exponentials, logarithms, error function and the sine and cosine of its
+//! sampled azimuth have no lane form here: the lanes compute them one lane at a time with
+//! the one-direction functions, in the Beckmann lanes only ([`Real::map2_where`]).
 
 use glam::{Vec2, Vec3};
 use pathlab_mc::simd::lanes::{Real, Vector3};
@@ -61,7 +65,7 @@ fn tan2_theta<R: Real>(w: R::V3) -> R {
 }
 
 /// A distribution of microfacet normals as the microfacet models use it, for one direction
-/// (`R = f32`: [`Microfacet`], every kind) or for lanes ([`IsotropicGgx`]).
+/// (`R = f32`: [`Microfacet`], every kind) or for lanes ([`IsotropicMicrofacet`]).
 pub trait Distribution<R: Real> {
     /// The density of normals D(wm).
     fn d(&self, wm: R::V3) -> R;
@@ -108,6 +112,54 @@ fn ggx_lambda<R: Real>(alpha: R, w: R::V3) -> R {
         !tan2.is_finite(),
         R::splat(f32::INFINITY),
         R::select(tan2.equals(zero), zero, lambda),
+    )
+}
+
+/// Beckmann's D(wm) of roughness `alpha` in every direction, of a normal whose cos θ is
+/// `cos_m` (zero below the surface).
+#[inline]
+fn beckmann_d(alpha: f32, cos_m: f32) -> f32 {
+    if cos_m <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let cos2 = cos_m * cos_m;
+    let tan2 = (1.0 - cos2).max(0.0) / cos2;
+    (-tan2 / a2).exp() / (PI * a2 * cos2 * cos2)
+}
+
+/// Beckmann's Λ of a direction with tan²θ `tan2`, `alpha` the roughness seen along its
+/// azimuth: infinite at the horizon, zero along the normal and where it is below 10⁻¹⁵
+/// (a ≥ 6).
+#[inline]
+fn beckmann_lambda(alpha: f32, tan2: f32) -> f32 {
+    if !tan2.is_finite() {
+        return f32::INFINITY;
+    }
+    if tan2 == 0.0 {
+        return 0.0;
+    }
+    let a = 1.0 / (alpha * tan2.sqrt());
+    if a >= 6.0 {
+        return 0.0;
+    }
+    0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * PI.sqrt())
+}
+
+/// A normal from Beckmann's D(wm) cos θm of roughness `alpha` in every direction:
+/// tan²θ = -α² ln(1 - u0), φ = 2π u1 (in the lanes `lanes`; the others' are meaningless).
+#[inline(always)]
+fn sample_beckmann<R: Real>(alpha: R, u0: R, u1: R, lanes: R::Mask) -> R::V3 {
+    let cos = alpha.map2_where(u0, lanes, |alpha, u| {
+        let tan2 = -alpha * alpha * (1.0 - u).max(f32::MIN_POSITIVE).ln();
+        1.0 / (1.0 + tan2).sqrt()
+    });
+    let sin = (R::splat(1.0) - cos * cos).max(R::splat(0.0)).sqrt();
+    let phi = R::splat(TAU) * u1;
+    R::V3::new(
+        sin * phi.map_where(lanes, f32::cos),
+        sin * phi.map_where(lanes, f32::sin),
+        cos,
     )
 }
 
@@ -176,6 +228,84 @@ impl<R: Real> Distribution<R> for IsotropicGgx<R> {
     }
 }
 
+/// GGX or Beckmann (`beckmann`) of one roughness in every direction, for one direction
+/// (`R = f32`) or for lanes, each lane its own kind: the same functions as [`Microfacet`]'s
+/// for such a distribution, to the bit. Lanes compute Beckmann's functions only where some
+/// lane is Beckmann.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IsotropicMicrofacet<R: Real> {
+    /// Roughness α.
+    pub alpha: R,
+    /// Whether the distribution is Beckmann's (GGX's where not).
+    pub beckmann: R::Mask,
+}
+
+impl<R: Real> IsotropicMicrofacet<R> {
+    /// The lanes' GGX.
+    #[inline(always)]
+    fn ggx(&self) -> IsotropicGgx<R> {
+        IsotropicGgx { alpha: self.alpha }
+    }
+
+    /// `beckmann()` in the Beckmann lanes, `ggx()` in the others (Beckmann's functions
+    /// skipped where no lane is Beckmann).
+    #[inline(always)]
+    fn either<T>(
+        &self,
+        beckmann: impl FnOnce() -> T,
+        ggx: impl FnOnce() -> T,
+        select: impl FnOnce(R::Mask, T, T) -> T,
+    ) -> T {
+        let g = ggx();
+        if R::any(self.beckmann) {
+            select(self.beckmann, beckmann(), g)
+        } else {
+            g
+        }
+    }
+}
+
+impl<R: Real> Distribution<R> for IsotropicMicrofacet<R> {
+    #[inline(always)]
+    fn d(&self, wm: R::V3) -> R {
+        self.either(
+            || self.alpha.map2_where(wm.z(), self.beckmann, beckmann_d),
+            || self.ggx().d(wm),
+            R::select,
+        )
+    }
+
+    #[inline(always)]
+    fn lambda(&self, w: R::V3) -> R {
+        self.either(
+            || {
+                self.alpha
+                    .map2_where(tan2_theta::<R>(w), self.beckmann, beckmann_lambda)
+            },
+            || self.ggx().lambda(w),
+            R::select,
+        )
+    }
+
+    #[inline(always)]
+    fn pdf_wm(&self, wo: R::V3, wm: R::V3) -> R {
+        self.either(
+            || self.d(wm) * wm.z().max(R::splat(0.0)),
+            || self.ggx().pdf_wm(wo, wm),
+            R::select,
+        )
+    }
+
+    #[inline(always)]
+    fn sample_wm(&self, wo: R::V3, u0: R, u1: R) -> R::V3 {
+        self.either(
+            || sample_beckmann(self.alpha, u0, u1, self.beckmann),
+            || self.ggx().sample_wm(wo, u0, u1),
+            <R::V3 as Vector3>::select,
+        )
+    }
+}
+
 impl Distribution<f32> for Microfacet {
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
@@ -227,11 +357,13 @@ impl Microfacet {
             .then(|| Microfacet::anisotropic(kind, alpha_x, alpha_y))
     }
 
-    /// This distribution as [`IsotropicGgx`], where it is GGX of one roughness.
+    /// This distribution as [`IsotropicMicrofacet`], where it has one roughness.
     #[inline]
-    pub fn as_isotropic_ggx(&self) -> Option<IsotropicGgx<f32>> {
-        (self.kind == NormalDistribution::Ggx && self.is_isotropic())
-            .then_some(IsotropicGgx { alpha: self.alpha })
+    pub fn as_isotropic(&self) -> Option<IsotropicMicrofacet<f32>> {
+        self.is_isotropic().then_some(IsotropicMicrofacet {
+            alpha: self.alpha,
+            beckmann: self.kind == NormalDistribution::Beckmann,
+        })
     }
 
     /// Whether both roughnesses are the same.
@@ -273,12 +405,7 @@ impl Microfacet {
             };
         }
         match self.kind {
-            NormalDistribution::Beckmann => {
-                let a2 = self.alpha * self.alpha;
-                let cos2 = wm.z * wm.z;
-                let tan2 = (1.0 - cos2).max(0.0) / cos2;
-                (-tan2 / a2).exp() / (PI * a2 * cos2 * cos2)
-            }
+            NormalDistribution::Beckmann => beckmann_d(self.alpha, wm.z),
             NormalDistribution::Ggx => ggx_d_isotropic(self.alpha, wm),
         }
     }
@@ -289,19 +416,7 @@ impl Microfacet {
         if self.kind == NormalDistribution::Ggx {
             return ggx_lambda(alpha, w);
         }
-        let tan2 = tan2_theta::<f32>(w);
-        if !tan2.is_finite() {
-            return f32::INFINITY;
-        }
-        if tan2 == 0.0 {
-            return 0.0;
-        }
-        // Beckmann.
-        let a = 1.0 / (alpha * tan2.sqrt());
-        if a >= 6.0 {
-            return 0.0;
-        }
-        0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * PI.sqrt())
+        beckmann_lambda(alpha, tan2_theta::<f32>(w))
     }
 
     /// Smith's masking of a facet with normal `wm` seen from `w` (zero when the facet faces
@@ -335,13 +450,7 @@ impl Microfacet {
                 let sin = (1.0 - cos * cos).max(0.0).sqrt();
                 Vec3::new(sin * cos_phi, sin * sin_phi, cos)
             }
-            NormalDistribution::Beckmann => {
-                let tan2 = -self.alpha * self.alpha * (1.0 - u.x).max(f32::MIN_POSITIVE).ln();
-                let cos = 1.0 / (1.0 + tan2).sqrt();
-                let sin = (1.0 - cos * cos).max(0.0).sqrt();
-                let phi = TAU * u.y;
-                Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)
-            }
+            NormalDistribution::Beckmann => sample_beckmann(self.alpha, u.x, u.y, true),
         }
     }
 

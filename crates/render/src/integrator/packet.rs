@@ -10,7 +10,7 @@
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
 //! for every lane and bounce, except where a lane's material is one lobe of those the lanes
 //! shade ([`Material::lane_bxdf`]: Lambertian; a mirror; smooth conductors and glass; rough
-//! GGX conductors and glass) and its light an emitting triangle or an environment map (or none,
+//! GGX or Beckmann conductors and glass) and its light an emitting triangle or an environment map (or none,
 //! for the smooth lobes). There the lanes are shaded together in SIMD registers by the same
 //! functions the one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
 //! [`RoughConductor`], [`RoughDielectric`], [`Mirror`], [`SmoothConductor`],
@@ -33,8 +33,8 @@ use super::{
 use crate::accel::RayLanes;
 use crate::bsdf::bxdf::DirectionSample;
 use crate::bsdf::{
-    DielectricLanes, Diffuse, IsotropicGgx, LaneBxdf, Lobes, Material, Mirror, RoughConductor,
-    RoughDielectric, SmoothConductor,
+    DielectricLanes, Diffuse, IsotropicMicrofacet, LaneBxdf, Lobes, Material, Mirror,
+    RoughConductor, RoughDielectric, SmoothConductor,
 };
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
@@ -57,8 +57,8 @@ struct ScatterIn {
     /// `mirror`; `smooth_metal`, a smooth conductor; `glass`; the others' is `diffuse`.
     lobes: LobeLanes,
     diffuse: Diffuse<V8>,
-    metal: RoughConductor<V8, IsotropicGgx<F8>>,
-    rough_glass: RoughDielectric<F8, V8, IsotropicGgx<F8>>,
+    metal: RoughConductor<V8, IsotropicMicrofacet<F8>>,
+    rough_glass: RoughDielectric<F8, V8, IsotropicMicrofacet<F8>>,
     mirror: Mirror<V8>,
     smooth_metal: SmoothConductor<V8>,
     glass: DielectricLanes,
@@ -416,6 +416,11 @@ impl PathIntegrator {
             if let Some((_, d)) = &directions {
                 (a.environment, a.environment_wi, a.environment_pdf) = (d.found, d.wi, d.pdf);
             }
+            // Beckmann's functions, computed lane by lane, only where a lane has the lobe
+            // now (a lane keeps its lobe's fields from an earlier pass).
+            a.metal.distribution.beckmann = a.metal.distribution.beckmann & a.lobes.conductor;
+            a.rough_glass.distribution.beckmann =
+                a.rough_glass.distribution.beckmann & a.lobes.rough_glass;
             scatter(&a, &mut b);
             for i in 0..W {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
