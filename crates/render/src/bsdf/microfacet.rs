@@ -199,11 +199,12 @@ fn sample_visible_ggx<R: Real>(ax: R, ay: R, wo: R::V3, u0: R, u1: R) -> R::V3 {
 }
 
 /// GGX of one roughness in every direction, for one direction (`R = f32`) or for lanes: the
-/// same functions as [`Microfacet`]'s for such a distribution, to the bit.
+/// GGX half of [`IsotropicMicrofacet`], the same functions as [`Microfacet`]'s for such a
+/// distribution, to the bit.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct IsotropicGgx<R> {
+struct IsotropicGgx<R> {
     /// Roughness α.
-    pub alpha: R,
+    alpha: R,
 }
 
 impl<R: Real> Distribution<R> for IsotropicGgx<R> {

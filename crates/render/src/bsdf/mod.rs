@@ -40,9 +40,7 @@ pub use diffuse_transmission::DiffuseTransmission;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 pub use layered::{Base, Coat, LayerMedium, LayerStack, Layered};
 pub use material::{LaneBxdf, Leaf, Material, Model, ShadingPoint};
-pub use microfacet::{
-    Distribution, IsotropicGgx, IsotropicMicrofacet, Microfacet, NormalDistribution,
-};
+pub use microfacet::{Distribution, IsotropicMicrofacet, Microfacet, NormalDistribution};
 pub use mirror::Mirror;
 pub use mixture::{Bsdf, BsdfSample, Guard, Lobe, MAX_LOBES};
 pub use plastic::Plastic;
