@@ -116,9 +116,10 @@ impl SmoothConductor<V8> {
 }
 
 /// A rough conductor's lobe, written once for one direction (`V = Rgb`, with `Microfacet`
-/// or [`IsotropicMicrofacet`]) and for eight lanes (`V = V8`, with `IsotropicMicrofacet<F8>`): f = D(wm)
-/// G(wo, wi, wm) F(wo·wm) / (4 cos θo cos θi) with wm the half vector, sampled by reflecting
-/// `wo` about a normal from the distribution, of density pdf(wm) / (4 wo·wm).
+/// or [`IsotropicMicrofacet`]) and for eight lanes (`V = V8`, with
+/// `IsotropicMicrofacet<F8>`): f = D(wm) G(wo, wi, wm) F(wo·wm) / (4 cos θo cos θi) with wm
+/// the half vector, sampled by reflecting `wo` about a normal from the distribution, of
+/// density pdf(wm) / (4 wo·wm).
 ///
 /// [`V8`]: crate::simd::lanes::V8
 /// [`F8`]: crate::simd::lanes::F8

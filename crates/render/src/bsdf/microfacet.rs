@@ -248,6 +248,12 @@ impl<R: Real> IsotropicMicrofacet<R> {
         IsotropicGgx { alpha: self.alpha }
     }
 
+    /// Beckmann's D(wm) in the Beckmann lanes (zero in the others).
+    #[inline(always)]
+    fn beckmann_d(&self, wm: R::V3) -> R {
+        self.alpha.map2_where(wm.z(), self.beckmann, beckmann_d)
+    }
+
     /// `beckmann()` in the Beckmann lanes, `ggx()` in the others (Beckmann's functions
     /// skipped where no lane is Beckmann).
     #[inline(always)]
@@ -269,11 +275,7 @@ impl<R: Real> IsotropicMicrofacet<R> {
 impl<R: Real> Distribution<R> for IsotropicMicrofacet<R> {
     #[inline(always)]
     fn d(&self, wm: R::V3) -> R {
-        self.either(
-            || self.alpha.map2_where(wm.z(), self.beckmann, beckmann_d),
-            || self.ggx().d(wm),
-            R::select,
-        )
+        self.either(|| self.beckmann_d(wm), || self.ggx().d(wm), R::select)
     }
 
     #[inline(always)]
@@ -291,7 +293,7 @@ impl<R: Real> Distribution<R> for IsotropicMicrofacet<R> {
     #[inline(always)]
     fn pdf_wm(&self, wo: R::V3, wm: R::V3) -> R {
         self.either(
-            || self.d(wm) * wm.z().max(R::splat(0.0)),
+            || self.beckmann_d(wm) * wm.z().max(R::splat(0.0)),
             || self.ggx().pdf_wm(wo, wm),
             R::select,
         )

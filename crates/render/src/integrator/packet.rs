@@ -10,8 +10,8 @@
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
 //! for every lane and bounce, except where a lane's material is one lobe of those the lanes
 //! shade ([`Material::lane_bxdf`]: Lambertian; a mirror; smooth conductors and glass; rough
-//! GGX or Beckmann conductors and glass) and its light an emitting triangle or an environment map (or none,
-//! for the smooth lobes). There the lanes are shaded together in SIMD registers by the same
+//! GGX or Beckmann conductors and glass) and its light an emitting triangle or an
+//! environment map (or none, for the smooth lobes). There the lanes are shaded together in SIMD registers by the same
 //! functions the one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
 //! [`RoughConductor`], [`RoughDielectric`], [`Mirror`], [`SmoothConductor`],
 //! [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
