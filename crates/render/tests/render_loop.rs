@@ -276,14 +276,56 @@ fn with_smooth_lobes(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with the lights whose samples the lanes draw one lane at a time (besides the point
+/// light and the emitting sphere every `mixed_scene` has): a spot light, a directional light, a
+/// constant environment and a projector of a checkerboard, whose samples' BSDF values and MIS
+/// weights the lanes compute together.
+fn with_more_lights(mut desc: SceneDesc) -> SceneDesc {
+    use pathlab_render::desc::{
+        DirectionalLightDesc, ProjectorDesc, ProjectorKind, SpotFalloff, SpotLightDesc,
+        INVERSE_SQUARE,
+    };
+    desc.spot_lights.push(SpotLightDesc {
+        position: Vec3::new(-0.6, 1.4, 0.8),
+        direction: Vec3::new(0.4, -1.0, -0.5).normalize(),
+        intensity: Vec3::new(2.0, 1.5, 1.0),
+        cutoff_degrees: 35.0,
+        exponent: 2.0,
+        attenuation: INVERSE_SQUARE,
+    });
+    desc.directional_lights.push(DirectionalLightDesc {
+        direction: Vec3::new(0.3, -1.0, -0.2).normalize(),
+        irradiance: Vec3::new(0.6, 0.7, 0.9),
+    });
+    desc.environment = Some(Vec3::new(0.1, 0.12, 0.15));
+    desc.projectors.push(ProjectorDesc {
+        position: Vec3::new(0.8, 1.2, 0.9),
+        frame: glam::Mat3::from_rotation_x(1.9),
+        texture: TextureDesc::Checkerboard {
+            color0: Vec3::new(1.0, 0.2, 0.1),
+            color1: Vec3::new(0.1, 0.3, 1.0),
+            to_uv: glam::Affine2::from_scale(glam::Vec2::splat(4.0)),
+        },
+        kind: ProjectorKind::Spot {
+            intensity: Vec3::splat(3.0),
+            cutoff: 0.6,
+            beam_width: 0.4,
+            falloff: SpotFalloff::LinearInAngle,
+        },
+    });
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
-    // Lambertian surfaces lit by emitting triangles or an environment map in SIMD lanes (and
-    // the environment map's radiance towards the rays that leave the scene) and everything
-    // else with the scalar code (rough GGX conductors and glass of one roughness, mirrors,
-    // smooth conductors and glass too, textured or not, in the scenes `with_metals`,
-    // `with_smooth_lobes` and `with_textures`): every sample's radiance must be the scalar `li`'s to the
+    // Lambertian surfaces in SIMD lanes (and the environment map's radiance towards the rays
+    // that leave the scene), lit by emitting triangles or an environment map sampled in the
+    // lanes or by any other light sampled one lane at a time (`with_more_lights`), and
+    // everything else with the scalar code (rough conductors and glass of one roughness,
+    // mirrors, smooth conductors and glass go through the lanes too, textured or not, in the
+    // scenes `with_metals`, `with_smooth_lobes` and `with_textures`): every sample's radiance
+    // must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these
@@ -304,6 +346,11 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         ),
         (with_textures(mixed_scene()), false),
         (under_a_sky(with_textures(mixed_scene())), false),
+        (with_more_lights(with_metals(mixed_scene())), false),
+        (
+            crowded(with_more_lights(with_smooth_lobes(mixed_scene()))),
+            true,
+        ),
     ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);

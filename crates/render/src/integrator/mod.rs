@@ -25,7 +25,7 @@ pub use path::{PathIntegrator, PathLighting};
 use crate::bsdf::Bsdf;
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, spawn_ray_to, Ray};
-use crate::light::LightLiSample;
+use crate::light::{Light, LightLiSample};
 use crate::scene::{Scene, SurfaceInteraction};
 use glam::{Vec2, Vec3};
 use pathlab_mc::sampler::{AnySampler, Sampler};
@@ -328,13 +328,8 @@ pub(crate) fn visible_light_sample(
     if f.max_element() <= 0.0 {
         return None;
     }
-    let shadow = if light.is_infinite() {
-        Ray::new(offset_ray_origin(si.p, si.ng, ls.wi), ls.wi)
-    } else {
-        spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light)
-    };
     stats.rays += 1;
-    if scene.occluded(&shadow) {
+    if scene.occluded(&shadow_ray(light, si, &ls)) {
         return None;
     }
     let li = light.deferred_li(&deferred);
@@ -347,6 +342,17 @@ pub(crate) fn visible_light_sample(
         ls: LightLiSample { li, ..ls },
         f,
     })
+}
+
+/// The shadow ray from surface point `si` towards `light`'s sample `ls`: along its direction
+/// without end for a light at infinity, otherwise to just short of its point.
+#[inline]
+pub(crate) fn shadow_ray(light: &Light, si: &SurfaceInteraction, ls: &LightLiSample) -> Ray {
+    if light.is_infinite() {
+        Ray::new(offset_ray_origin(si.p, si.ng, ls.wi), ls.wi)
+    } else {
+        spawn_ray_to(si.p, si.ng, ls.p_light, ls.n_light)
+    }
 }
 
 /// A light sample's contribution f · Li · |cos θi| / p at a surface point, weighted by MIS
@@ -380,7 +386,9 @@ pub(crate) fn sample_light(
 
 /// Radiance emitted towards the previous vertex by the surface a ray from `p_prev` hit, and the
 /// density with which light sampling at `p_prev` would have chosen that point (for MIS).
-#[inline]
+/// Inlined always: at every hit of every path, where the compiler's choice to call it or not
+/// moved with unrelated changes (a call measured about 2% slower on the Cornell box).
+#[inline(always)]
 pub(crate) fn emitted(
     scene: &Scene,
     p_prev: Vec3,

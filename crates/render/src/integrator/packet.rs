@@ -10,14 +10,17 @@
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
 //! for every lane and bounce, except where a lane's material is one lobe of those the lanes
 //! shade ([`Material::lane_bxdf`]: Lambertian; a mirror; smooth conductors and glass; rough
-//! GGX or Beckmann conductors and glass) and its light an emitting triangle or an
-//! environment map (or none, for the smooth lobes). There the lanes are shaded together in SIMD registers by the same
-//! functions the one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
-//! [`RoughConductor`], [`RoughDielectric`], [`Mirror`], [`SmoothConductor`],
-//! [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
+//! GGX or Beckmann conductors and glass). There the lanes are shaded together in SIMD
+//! registers by the same functions the one-path code calls, instantiated on eight lanes (the
+//! BSDFs: [`Diffuse`], [`RoughConductor`], [`RoughDielectric`], [`Mirror`],
+//! [`SmoothConductor`], [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
 //! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`], [`offset_ray_origin`],
 //! [`power_heuristic_weight`]; see `scatter_lanes`): this module holds only the scheduling
-//! and the masks that stand for the one-path code's early returns. The rays that leave the
+//! and the masks that stand for the one-path code's early returns. Emitting triangles and
+//! environment maps are sampled in the lanes; any other light (points, spots, directional
+//! lights, spheres, textured emitters, projectors, a constant environment) by its own
+//! [`Light::sample_li`], one lane at a time, the BSDF's value and density towards the sample
+//! and its MIS weight then computed in the lanes with the others. The rays that leave the
 //! scene look the environment map up together too
 //! ([`EnvironmentMap::eval_and_pdf_lanes`]), and `arrive` takes what they found.
 //!
@@ -28,7 +31,7 @@
 
 use super::path::{PathIntegrator, PathState};
 use super::{
-    camera_sample, power_heuristic_weight, sample_light, CameraSample, PathStats, SampleRef,
+    camera_sample, power_heuristic_weight, shadow_ray, CameraSample, PathStats, SampleRef,
 };
 use crate::accel::RayLanes;
 use crate::bsdf::bxdf::DirectionSample;
@@ -39,7 +42,7 @@ use crate::bsdf::{
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
 use crate::light::envmap::{DirectionLanes, EnvironmentMap};
-use crate::light::{AreaShape, Light, TriangleEmitter};
+use crate::light::{AreaShape, Light, LightLiSample, TriangleEmitter};
 use crate::scene::{Scene, SurfaceInteraction};
 use crate::simd::lanes::{F8, M8, V8, W};
 use glam::Vec2;
@@ -72,12 +75,47 @@ struct ScatterIn {
     environment: M8,
     environment_wi: V8,
     environment_pdf: F8,
+    /// Lanes whose light sample was taken one lane at a time by the light's own
+    /// [`Light::sample_li`] (points, spots, directional lights, spheres, textured triangles,
+    /// projectors, a constant environment), and that sample.
+    drawn: DrawnLights,
     /// Probability of choosing the lane's light.
     light_pmf: F8,
     u_light: [F8; 2],
     /// The lobe choice's number (glass's choice between reflection and refraction).
     u_lobe: F8,
     u_bsdf: [F8; 2],
+}
+
+/// Light samples taken one lane at a time ([`gather_light`]), whose BSDF values, MIS weights
+/// and contributions the lanes compute together: each lane's direction, radiance, density per
+/// solid angle, whether the light is a delta distribution, and its shadow ray
+/// ([`super::shadow_ray`]).
+#[derive(Clone, Copy, Default)]
+struct DrawnLights {
+    lanes: M8,
+    wi: V8,
+    li: V8,
+    pdf: F8,
+    delta: M8,
+    shadow_o: V8,
+    shadow_d: V8,
+    shadow_t_max: F8,
+}
+
+impl DrawnLights {
+    /// Lane `i`'s sample `ls` and its shadow ray.
+    #[inline(always)]
+    fn set(&mut self, i: usize, ls: &LightLiSample, shadow: &Ray) {
+        self.lanes.set(i, true);
+        self.wi.set(i, ls.wi);
+        self.li.set(i, ls.li);
+        self.pdf.0[i] = ls.pdf;
+        self.delta.set(i, ls.is_delta);
+        self.shadow_o.set(i, shadow.o);
+        self.shadow_d.set(i, shadow.d);
+        self.shadow_t_max.0[i] = shadow.t_max;
+    }
 }
 
 /// Which lanes have which lobe (the rest: Lambertian).
@@ -100,6 +138,7 @@ struct ScatterOut {
     shadow: M8,
     shadow_o: V8,
     shadow_d: V8,
+    shadow_t_max: F8,
     /// The light sample's contribution f Li |cos θi| w / p, before visibility and throughput
     /// (for an emitting triangle).
     ld: V8,
@@ -122,18 +161,19 @@ struct ScatterOut {
 /// The lanes' scattering at the lobes [`Material::lane_bxdf`] gives, composed of the functions
 /// the one-path code calls, on lanes: the shading frame ([`Frame::from_normal`], turned towards
 /// wo for a two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does),
-/// [`super::sample_light`] for a point on an emitting triangle or an environment map's
-/// direction (drawn before, by [`EnvironmentMap::sample_direction_lanes`]) up to the shadow
-/// ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`] or
-/// [`RoughDielectric::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`] against
-/// the lobe's density; the map's radiance is read after the shadow ray, as there), and
-/// [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe ([`Diffuse::sample_z`],
-/// [`RoughConductor::sample`], [`RoughDielectric::sample_real`], [`Mirror::sample_real`],
-/// [`SmoothConductor::sample`], [`DielectricLanes::sample`]; smooth lobes have no light
-/// sample). Only the control flow is
-/// the lanes' own: masks where the one-path code returns early, and each lobe's functions
-/// skipped where no lane has it (all but the Lambertian ones without `OTHER_LOBES`: a
-/// separate, smaller instance for passes of Lambertian lanes alone).
+/// [`super::sample_light`] for a point on an emitting triangle, an environment map's
+/// direction (drawn before, by [`EnvironmentMap::sample_direction_lanes`]) or a sample of
+/// another light (drawn before, one lane at a time, into [`ScatterIn::drawn`]) up to the
+/// shadow ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`]
+/// or [`RoughDielectric::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`]
+/// against the lobe's density, weight one for a delta light; the map's radiance is read after
+/// the shadow ray, as there), and [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe
+/// ([`Diffuse::sample_z`], [`RoughConductor::sample`], [`RoughDielectric::sample_real`],
+/// [`Mirror::sample_real`], [`SmoothConductor::sample`], [`DielectricLanes::sample`]; smooth
+/// lobes have no light sample). Only the control flow is the lanes' own: masks where the
+/// one-path code returns early, and each lobe's functions skipped where no lane has it (all
+/// but the Lambertian ones and the triangles' and maps' light samples without
+/// `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes alone).
 #[inline(always)]
 fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let zero = F8::splat(0.0);
@@ -148,10 +188,16 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let rough_glass = a.lobes.rough_glass;
     let any_rough_glass = OTHER_LOBES && rough_glass.any();
 
-    // Light sampling: a point on a triangle, or an environment map's direction.
+    // Light sampling: a point on a triangle, an environment map's direction, or a sample
+    // drawn one lane at a time.
     let env = a.environment;
+    let drawn = &a.drawn;
+    let any_drawn = OTHER_LOBES && drawn.lanes.any();
     let ls = a.emitter.sample_li(a.p, a.u_light[0], a.u_light[1]);
-    let wi = env.select3(a.environment_wi, ls.wi);
+    let mut wi = env.select3(a.environment_wi, ls.wi);
+    if any_drawn {
+        wi = drawn.lanes.select3(drawn.wi, wi);
+    }
     let wi_z = wi.dot(frame.n);
     let wi_local = frame.to_local(wi);
     let (mut f, mut bsdf_pdf) = (a.diffuse.f_z(wo_z, wi_z), a.diffuse.pdf_z(wo_z, wi_z));
@@ -174,15 +220,31 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
         & !ls.pdf.le(zero)
         & !ls.li.max_element().le(zero);
     let environment = env & !a.environment_pdf.le(zero);
-    out.shadow = (triangle | environment) & !f.max_element().le(zero);
+    // (A drawn sample's checks of its density and radiance were made where it was drawn.)
+    out.shadow = (triangle | environment | drawn.lanes) & !f.max_element().le(zero);
     // Towards the triangle's point (`spawn_ray_to`), or along the direction (`spawn_ray`).
     let o = offset_ray_origin(a.p, a.ng, env.select3(wi, ls.p_light - a.p));
     let end = offset_ray_origin(ls.p_light, a.emitter.normal, o - ls.p_light);
     out.shadow_o = o;
     out.shadow_d = env.select3(wi, end - o);
-    let pdf = a.light_pmf * env.select(a.environment_pdf, ls.pdf);
-    let mis = power_heuristic_weight(pdf, bsdf_pdf);
-    out.ld = f.mul_axes(ls.li).scale(mis / pdf);
+    out.shadow_t_max = env.select(F8::splat(f32::INFINITY), F8::splat(SHADOW_RAY_END));
+    let mut light_pdf = env.select(a.environment_pdf, ls.pdf);
+    let mut li = ls.li;
+    if any_drawn {
+        let on = drawn.lanes;
+        out.shadow_o = on.select3(drawn.shadow_o, out.shadow_o);
+        out.shadow_d = on.select3(drawn.shadow_d, out.shadow_d);
+        out.shadow_t_max = on.select(drawn.shadow_t_max, out.shadow_t_max);
+        light_pdf = on.select(drawn.pdf, light_pdf);
+        li = on.select3(drawn.li, li);
+    }
+    let pdf = a.light_pmf * light_pdf;
+    let mut mis = power_heuristic_weight(pdf, bsdf_pdf);
+    if any_drawn {
+        // A delta light's sample has weight one (no BSDF sample finds it).
+        mis = (drawn.lanes & drawn.delta).select(F8::splat(1.0), mis);
+    }
+    out.ld = f.mul_axes(li).scale(mis / pdf);
     out.f = f;
     out.weight_over_pdf = mis / pdf;
 
@@ -236,24 +298,32 @@ fn scatter_avx2<const OTHER_LOBES: bool>(
 }
 
 /// [`scatter_lanes`] on the best vector unit this CPU has, its Lambertian instance where no
-/// lane has another lobe.
+/// lane has another lobe or a light sample drawn one lane at a time.
+#[inline]
 fn scatter(a: &ScatterIn, out: &mut ScatterOut) {
-    let other = (a.lobes.conductor | a.lobes.rough_glass | a.lobes.delta).any();
+    let other = (a.lobes.conductor | a.lobes.rough_glass | a.lobes.delta | a.drawn.lanes).any();
+    if other {
+        return scatter_other_lobes(a, out);
+    }
     #[cfg(target_arch = "x86_64")]
     if let Some(avx2) = crate::simd::Avx2::detect() {
         // SAFETY: `scatter_avx2` requires AVX2 and FMA, which `avx2` proves this CPU has. Its
         // body is safe code.
-        return unsafe {
-            match other {
-                true => scatter_avx2::<true>(avx2, a, out),
-                false => scatter_avx2::<false>(avx2, a, out),
-            }
-        };
+        return unsafe { scatter_avx2::<false>(avx2, a, out) };
     }
-    match other {
-        true => scatter_lanes::<true>(a, out),
-        false => scatter_lanes::<false>(a, out),
+    scatter_lanes::<false>(a, out)
+}
+
+/// [`scatter`]'s instance for every lobe and light, out of line so that the Lambertian one
+/// stays small enough to be inlined into the path loop.
+#[inline(never)]
+fn scatter_other_lobes(a: &ScatterIn, out: &mut ScatterOut) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx2) = crate::simd::Avx2::detect() {
+        // SAFETY: as in `scatter`.
+        return unsafe { scatter_avx2::<true>(avx2, a, out) };
     }
+    scatter_lanes::<true>(a, out)
 }
 
 /// One lane's path: its sample's tag and where the path stands.
@@ -389,8 +459,9 @@ impl PathIntegrator {
             // hits were cleared above).
             let mut environment = None;
             let mut environment_lanes = 0u32;
+            a.drawn.lanes = M8::default();
             for i in 0..W {
-                let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
+                let (Some(_), Some(si)) = (&lanes[i], &hits[i]) else {
                     continue;
                 };
                 // Smooth lobes take no light sample (their numbers are drawn all the same).
@@ -399,8 +470,7 @@ impl PathIntegrator {
                     continue;
                 }
                 let u_light = Vec2::new(u[1][i], u[2][i]);
-                let light =
-                    gather_light(scene, i, si, &mut lane.st, u[0][i], u_light, &mut a, stats);
+                let light = gather_light(scene, i, si, u[0][i], u_light, &mut a);
                 a.light.set(i, matches!(light, LaneLight::Triangle));
                 if let LaneLight::Environment(map) = light {
                     environment = Some(map);
@@ -469,10 +539,7 @@ impl PathIntegrator {
                 o: b.shadow_o.get(i),
                 d: b.shadow_d.get(i),
                 t_min: 0.0,
-                t_max: match environment {
-                    Some(_) => f32::INFINITY,
-                    None => SHADOW_RAY_END,
-                },
+                t_max: b.shadow_t_max.0[i],
             };
             if !scene.occluded(&shadow) {
                 match environment {
@@ -705,28 +772,28 @@ enum LaneLight<'a> {
     Triangle,
     /// A direction of this environment map, in the SIMD lanes.
     Environment(&'a EnvironmentMap),
-    /// Already taken one lane at a time, or no light at all.
-    Taken,
+    /// Drawn one lane at a time into [`ScatterIn::drawn`].
+    Drawn,
+    /// None: no light, or a sample of no density or no radiance.
+    Nothing,
 }
 
 /// Lane `i`'s light choice from `u_select`: an emitting triangle's data go to the lane of `a`
 /// for the SIMD light sample, as does the light's probability for an environment map; any
-/// other light is sampled here with the scalar code, its contribution added to `st.l`. No
-/// light: nothing (as the scalar code).
-#[allow(clippy::too_many_arguments)]
+/// other light is sampled here by its own [`Light::sample_li`] with `u_light`, its sample and
+/// shadow ray going to `a.drawn` (where it has a density and radiance: otherwise, as for no
+/// light at all, nothing, as [`super::visible_light_sample`] returns early).
 #[inline]
 fn gather_light<'a>(
     scene: &'a Scene,
     i: usize,
     si: &SurfaceInteraction,
-    st: &mut PathState,
     u_select: f32,
     u_light: Vec2,
     a: &mut ScatterIn,
-    stats: &mut PathStats,
 ) -> LaneLight<'a> {
     let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
-        return LaneLight::Taken;
+        return LaneLight::Nothing;
     };
     match &scene.lights()[index] {
         Light::Area {
@@ -743,14 +810,29 @@ fn gather_light<'a>(
             a.light_pmf.0[i] = pmf;
             LaneLight::Environment(map)
         }
-        _ => {
-            let wo = -st.ray.d;
-            let bsdf = scene.bsdf(si, wo);
-            let ld = sample_light(scene, si, &bsdf, wo, u_select, u_light, 1, 1, stats);
-            // (The scalar code divides by the one light sample: exact.)
-            st.l += st.beta * ld;
-            LaneLight::Taken
+        light => draw_light_sample(light, pmf, i, si, u_light, a),
+    }
+}
+
+/// [`gather_light`]'s sample of a light the lanes do not sample together, drawn by the light's
+/// own [`Light::sample_li`] into lane `i` of `a.drawn`. Out of line: the path loop stays as
+/// small as it is for the common lights.
+#[inline(never)]
+fn draw_light_sample<'a>(
+    light: &Light,
+    pmf: f32,
+    i: usize,
+    si: &SurfaceInteraction,
+    u_light: Vec2,
+    a: &mut ScatterIn,
+) -> LaneLight<'a> {
+    match light.sample_li(si.p, u_light) {
+        Some(ls) if !(ls.pdf <= 0.0 || ls.li.max_element() <= 0.0) => {
+            a.drawn.set(i, &ls, &shadow_ray(light, si, &ls));
+            a.light_pmf.0[i] = pmf;
+            LaneLight::Drawn
         }
+        _ => LaneLight::Nothing,
     }
 }
 

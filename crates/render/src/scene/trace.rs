@@ -595,15 +595,7 @@ impl Scene {
                         &rays.t_min,
                         &nearest.t,
                     ),
-                    _ => std::array::from_fn(|i| {
-                        let ray = Ray {
-                            o: rays.o.get(i),
-                            d: rays.d.get(i),
-                            t_min: rays.t_min.0[i],
-                            t_max: nearest.t.0[i],
-                        };
-                        self.shape_hit(slot, &ray).unwrap_or(f32::NAN)
-                    }),
+                    _ => self.shape_hits_one_by_one(slot, rays, nearest.t),
                 };
                 for (i, &t) in t.iter().enumerate() {
                     if !t.is_nan() {
@@ -616,6 +608,24 @@ impl Scene {
             }
         }
         nearest
+    }
+
+    /// The distances at which each lane's ray, up to its `t_max`, meets the shape in leaf
+    /// slot `slot` (NaN where it does not), one ray at a time. Out of line: the shapes that
+    /// take it (voxel grids) are rare, and the trace's loop stays small without it.
+    #[inline(never)]
+    fn shape_hits_one_by_one(&self, slot: u32, rays: &RayLanes, t_max: F8) -> [f32; W] {
+        let mut t = [f32::NAN; W];
+        for (i, t) in t.iter_mut().enumerate() {
+            let ray = Ray {
+                o: rays.o.get(i),
+                d: rays.d.get(i),
+                t_min: rays.t_min.0[i],
+                t_max: t_max.0[i],
+            };
+            *t = self.shape_hit(slot, &ray).unwrap_or(f32::NAN);
+        }
+        t
     }
 
     /// `f(nearest, block, lane, leaf slot)` for every lane of every leaf block that holds a

@@ -37,14 +37,24 @@ pub(crate) struct RayBoxLanes {
 impl RayBoxLanes {
     #[inline(always)]
     pub(crate) fn new(rays: &RayLanes) -> RayBoxLanes {
+        // Plain loops rather than `array::map`: its closures are not always inlined, and
+        // where they are not, each lane's sign is a call.
         let d = [rays.d.x, rays.d.y, rays.d.z];
-        let inv_d = d.map(|d| F8::splat(1.0) / d);
+        let (mut inv_d, mut inv_far) = ([F8::splat(0.0); 3], [F8::splat(0.0); 3]);
+        let mut negative = [M8::default(); 3];
+        for axis in 0..3 {
+            inv_d[axis] = F8::splat(1.0) / d[axis];
+            inv_far[axis] = inv_d[axis] * F8::splat(FAR_SCALE);
+            for (m, x) in negative[axis].0.iter_mut().zip(d[axis].0) {
+                *m = if x.is_sign_negative() { !0 } else { 0 };
+            }
+        }
         let zero = F8::splat(0.0);
         RayBoxLanes {
             o: [rays.o.x, rays.o.y, rays.o.z],
             inv_d,
-            inv_far: inv_d.map(|i| i * F8::splat(FAR_SCALE)),
-            negative: d.map(|d| M8(d.0.map(|x| if x.is_sign_negative() { !0 } else { 0 }))),
+            inv_far,
+            negative,
             t_min: rays.t_min.gt(zero).select(rays.t_min, zero),
         }
     }
