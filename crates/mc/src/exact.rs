@@ -52,17 +52,58 @@ pub fn add_fixed(sum: i128, x: f64) -> i128 {
     }
 }
 
-/// Four values and their squares added to eight sums: `sums[k]` gains `x[k]` and
-/// `sums[4 + k]` gains `x[k]²` (the value widened to `f64`, then squared), each by
-/// [`add_fixed`]. In a build for AVX-512 CPUs the eight go together (F and DQ, whose
-/// conversion of eight `f64` to `i64` is the one-value path's conversion) where every value
-/// converts within `i64` and no sum saturates; otherwise one at a time. The same sums to the
-/// bit either way. (Only where the whole build has AVX-512, so that the eight-lane code is
-/// inlined: called out of line from a build for older CPUs it measured slower than the
-/// one-at-a-time code inlined; and inlined always, since its values passed through memory
-/// would be stored one at a time and read back as one block.)
+/// Eight 128-bit fixed-point sums, each held as its low 64 bits (in `lo`) and its high 64 bits
+/// (in `hi`): the eight low halves side by side, then the eight high halves, so that
+/// [`add_fixed_with_squares`] in AVX-512 registers reads and writes each half of all eight as
+/// one block, with no shuffling between halves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(C)]
+pub struct Sums8 {
+    lo: [u64; 8],
+    hi: [i64; 8],
+}
+
+impl Sums8 {
+    /// The sums `v`.
+    pub fn from_array(v: [i128; 8]) -> Sums8 {
+        let mut s = Sums8::default();
+        for (k, &v) in v.iter().enumerate() {
+            s.set(k, v);
+        }
+        s
+    }
+
+    /// The eight sums.
+    pub fn to_array(&self) -> [i128; 8] {
+        std::array::from_fn(|k| self.get(k))
+    }
+
+    /// Sum `k`.
+    #[inline]
+    pub fn get(&self, k: usize) -> i128 {
+        (i128::from(self.hi[k]) << 64) | i128::from(self.lo[k])
+    }
+
+    /// Sets sum `k` to `v`.
+    #[inline]
+    pub fn set(&mut self, k: usize, v: i128) {
+        // The low 64 bits, and the high 64 (an arithmetic shift: exact).
+        self.lo[k] = v as u64;
+        self.hi[k] = (v >> 64) as i64;
+    }
+}
+
+/// Four values and their squares added to eight sums: sum `k` gains `x[k]` and sum `4 + k`
+/// gains `x[k]²` (the value widened to `f64`, then squared), each by [`add_fixed`]. In a build
+/// for AVX-512 CPUs the eight go together (F and DQ, whose conversion of eight `f64` to `i64`
+/// is the one-value path's conversion) where every value converts within `i64` and no sum
+/// saturates; otherwise one at a time. The same sums to the bit either way. (Only where the
+/// whole build has AVX-512, so that the eight-lane code is inlined: called out of line from a
+/// build for older CPUs it measured slower than the one-at-a-time code inlined; and inlined
+/// always, since its values passed through memory would be stored one at a time and read back
+/// as one block.)
 #[inline(always)]
-pub fn add_fixed_with_squares(sums: &mut [i128; 8], x: [f32; 4]) {
+pub fn add_fixed_with_squares(sums: &mut Sums8, x: [f32; 4]) {
     #[cfg(all(
         target_arch = "x86_64",
         target_feature = "avx512f",
@@ -83,11 +124,11 @@ pub fn add_fixed_with_squares(sums: &mut [i128; 8], x: [f32; 4]) {
 /// they would go through memory, stored one at a time and read back as one block, a read that
 /// waits for the stores (as they would in a loop over an array).
 #[inline]
-fn add_fixed_with_squares_one_at_a_time(sums: &mut [i128; 8], r: f32, g: f32, b: f32, y: f32) {
+fn add_fixed_with_squares_one_at_a_time(sums: &mut Sums8, r: f32, g: f32, b: f32, y: f32) {
     let mut add = |k: usize, x: f32| {
         let v = f64::from(x);
-        sums[k] = add_fixed(sums[k], v);
-        sums[4 + k] = add_fixed(sums[4 + k], v * v);
+        sums.set(k, add_fixed(sums.get(k), v));
+        sums.set(4 + k, add_fixed(sums.get(4 + k), v * v));
     };
     add(0, r);
     add(1, g);
@@ -96,11 +137,11 @@ fn add_fixed_with_squares_one_at_a_time(sums: &mut [i128; 8], r: f32, g: f32, b:
 }
 
 /// [`add_fixed_with_squares`] in AVX-512 registers: the values and squares widened and
-/// multiplied as there, each scaled and rounded as [`to_fixed`]
-/// does (adding ±½ below 2^52, where the scaled value may have a fraction; truncating), each
-/// 128-bit sum split into its low and high 64 bits, added with the carry. Returns false, with
-/// `sums` untouched, where a scaled value is 2^63 or more in magnitude or NaN (its conversion
-/// is not an `i64`'s) or a sum would saturate: the one-value path handles those.
+/// multiplied as there, each scaled and rounded as [`to_fixed`] does (adding ±½ below 2^52,
+/// where the scaled value may have a fraction; truncating), and added to the sums' low halves,
+/// the carry and the sign extension to their high halves. Returns false, with `sums`
+/// untouched, where a scaled value is 2^63 or more in magnitude or NaN (its conversion is not
+/// an `i64`'s) or a sum would saturate: the one-value path handles those.
 #[cfg(target_arch = "x86_64")]
 #[cfg_attr(
     not(all(target_feature = "avx512f", target_feature = "avx512dq")),
@@ -108,11 +149,7 @@ fn add_fixed_with_squares_one_at_a_time(sums: &mut [i128; 8], r: f32, g: f32, b:
 )]
 #[target_feature(enable = "avx512f,avx512dq")]
 #[inline]
-fn add_fixed_with_squares_avx512(
-    _: crate::simd::Avx512,
-    sums: &mut [i128; 8],
-    x: [f32; 4],
-) -> bool {
+fn add_fixed_with_squares_avx512(_: crate::simd::Avx512, sums: &mut Sums8, x: [f32; 4]) -> bool {
     use std::arch::x86_64::*;
     // Set from the four values, not loaded as one block: a caller that has just stored them
     // one at a time would make a 16-byte load wait for the four stores to retire.
@@ -129,18 +166,13 @@ fn add_fixed_with_squares_avx512(
     let small = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(abs, _mm512_set1_pd((1u64 << 52) as f64));
     let half = _mm512_or_pd(_mm512_and_pd(v, sign), _mm512_set1_pd(0.5));
     let r = _mm512_cvttpd_epi64(_mm512_mask_add_pd(v, small, v, half));
-    // An i128 is its low then its high 64 bits (little-endian): `a` holds sums 0..4 as such
-    // pairs, `b` sums 4..8; `lo` and `hi` gather each half of all eight.
-    let p = sums.as_mut_ptr().cast::<i64>();
-    // SAFETY: `sums` is 128 bytes, read unaligned as two halves of 64.
-    let (a, b) = unsafe {
+    // SAFETY: `lo` and `hi` are eight 64-bit integers each, read unaligned as one block.
+    let (lo, hi) = unsafe {
         (
-            _mm512_loadu_si512(p.cast()),
-            _mm512_loadu_si512(p.add(8).cast()),
+            _mm512_loadu_si512(sums.lo.as_ptr().cast()),
+            _mm512_loadu_si512(sums.hi.as_ptr().cast()),
         )
     };
-    let lo = _mm512_permutex2var_epi64(a, _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14), b);
-    let hi = _mm512_permutex2var_epi64(a, _mm512_setr_epi64(1, 3, 5, 7, 9, 11, 13, 15), b);
     // (hi, lo) + (r's sign extension, r): the low halves wrap, and carry where the wrapped
     // sum is below the addend (as unsigned numbers).
     let lo_sum = _mm512_add_epi64(lo, r);
@@ -156,16 +188,10 @@ fn add_fixed_with_squares_avx512(
     if _mm512_movepi64_mask(overflow) != 0 {
         return false;
     }
-    let a = _mm512_permutex2var_epi64(lo_sum, _mm512_setr_epi64(0, 8, 1, 9, 2, 10, 3, 11), hi_sum);
-    let b = _mm512_permutex2var_epi64(
-        lo_sum,
-        _mm512_setr_epi64(4, 12, 5, 13, 6, 14, 7, 15),
-        hi_sum,
-    );
     // SAFETY: as the loads above, written back.
     unsafe {
-        _mm512_storeu_si512(p.cast(), a);
-        _mm512_storeu_si512(p.add(8).cast(), b);
+        _mm512_storeu_si512(sums.lo.as_mut_ptr().cast(), lo_sum);
+        _mm512_storeu_si512(sums.hi.as_mut_ptr().cast(), hi_sum);
     }
     true
 }
@@ -396,17 +422,31 @@ mod tests {
                 0 => sums[pick(sums.len())],
                 _ => sums[pick(5)],
             });
+            // The one-value path on plain 128-bit integers.
             let mut want = start;
-            add_fixed_with_squares_one_at_a_time(&mut want, x[0], x[1], x[2], x[3]);
+            let mut add = |k: usize, x: f32| {
+                let v = f64::from(x);
+                want[k] = add_fixed(want[k], v);
+                want[4 + k] = add_fixed(want[4 + k], v * v);
+            };
+            (0..4).for_each(|k| add(k, x[k]));
+            let start = Sums8::from_array(start);
+            assert_eq!(
+                start.to_array(),
+                Sums8::from_array(start.to_array()).to_array()
+            );
+            let mut one = start;
+            add_fixed_with_squares_one_at_a_time(&mut one, x[0], x[1], x[2], x[3]);
+            assert_eq!(one.to_array(), want, "{start:?} + {x:?}");
             let mut got = start;
             add_fixed_with_squares(&mut got, x);
-            assert_eq!(got, want, "{start:?} + {x:?}");
+            assert_eq!(got.to_array(), want, "{start:?} + {x:?}");
             #[cfg(target_arch = "x86_64")]
             if let Some(avx512) = crate::simd::Avx512::detect() {
                 let mut lanes = start;
                 // SAFETY: `avx512` proves the features the function requires.
                 if unsafe { add_fixed_with_squares_avx512(avx512, &mut lanes, x) } {
-                    assert_eq!(lanes, want, "{start:?} + {x:?}");
+                    assert_eq!(lanes.to_array(), want, "{start:?} + {x:?}");
                     at_once += 1;
                 } else {
                     assert_eq!(lanes, start, "declined, yet changed");

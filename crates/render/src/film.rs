@@ -2,7 +2,7 @@
 
 use crate::desc::Rgb;
 use glam::{DVec3, Vec3};
-use pathlab_mc::exact::{add_fixed, add_fixed_with_squares, from_fixed, ExactStats};
+use pathlab_mc::exact::{add_fixed, add_fixed_with_squares, from_fixed, ExactStats, Sums8};
 
 /// Statistics of one pixel's samples: their count, and exact sums of each channel and of
 /// luminance and of their squares ([`pathlab_mc::exact`]): the same for any order in which
@@ -12,7 +12,7 @@ use pathlab_mc::exact::{add_fixed, add_fixed_with_squares, from_fixed, ExactStat
 pub struct PixelStats {
     n: u64,
     /// Σ of R, G, B and luminance, then Σ of their squares, in fixed point.
-    sums: [i128; 8],
+    sums: Sums8,
 }
 
 /// Bytes of one pixel in [`PixelStats::to_bytes`].
@@ -30,7 +30,7 @@ impl PixelStats {
     /// Statistics of channel `c` (0, 1, 2: R, G, B; 3: luminance).
     #[inline]
     fn channel(&self, c: usize) -> ExactStats {
-        ExactStats::from_raw(self.n, self.sums[c], self.sums[4 + c])
+        ExactStats::from_raw(self.n, self.sums.get(c), self.sums.get(4 + c))
     }
 
     /// Statistics of the samples' luminance (the "illuminance" of the course's adaptive
@@ -42,8 +42,9 @@ impl PixelStats {
     /// Combines with another set of samples of the same pixel (exactly).
     pub fn merge(&mut self, o: &PixelStats) {
         self.n += o.n;
-        for (s, o) in self.sums.iter_mut().zip(&o.sums) {
-            *s = s.saturating_add(*o);
+        for k in 0..8 {
+            self.sums
+                .set(k, self.sums.get(k).saturating_add(o.sums.get(k)));
         }
     }
 
@@ -83,7 +84,7 @@ impl PixelStats {
     /// The exact state, little-endian: count, then the sums, then the sums of squares.
     pub fn to_bytes(&self, out: &mut Vec<u8>) {
         out.extend(self.n.to_le_bytes());
-        for v in &self.sums {
+        for v in self.sums.to_array() {
             out.extend(v.to_le_bytes());
         }
     }
@@ -98,7 +99,10 @@ impl PixelStats {
         for (k, chunk) in b[8..].chunks_exact(16).enumerate() {
             v[k] = i128::from_le_bytes(chunk.try_into().ok()?);
         }
-        Some(PixelStats { n, sums: v })
+        Some(PixelStats {
+            n,
+            sums: Sums8::from_array(v),
+        })
     }
 }
 
