@@ -143,8 +143,11 @@ pub(crate) struct CameraSample {
 }
 
 /// [`camera_ray`]'s use of the sampler: positions it at pixel sample `s` and draws the
-/// position in the pixel, then the point on the lens.
-#[inline]
+/// position in the pixel, then the point on the lens. Inlined always: called, it returns the
+/// sample through memory, written field by field, and the caller's copy of it as one block
+/// then waits for those writes to finish (a failed store-to-load forward; half of the
+/// eight-lane path's `start_paths` in the profile of a cheap scene).
+#[inline(always)]
 pub(crate) fn camera_sample(scene: &Scene, sampler: &mut AnySampler, s: SampleRef) -> CameraSample {
     sampler.start_pixel_sample(s.pixel, s.index, 0);
     let (film, weight) = scene.camera().film_sample(s.pixel, sampler.next_pixel_2d());
