@@ -324,7 +324,7 @@ pub(crate) fn visible_light_sample(
     // An environment map's radiance is read last, once the sample is known to count.
     let deferred = light.sample_li_deferred(si.p, u_light)?;
     let ls = deferred.ls;
-    if ls.pdf <= 0.0 || (deferred.has_li() && ls.li.max_element() <= 0.0) {
+    if !ls.may_carry_light(deferred.has_li()) {
         return None;
     }
     let f = bsdf.f_cos(wo, ls.wi);

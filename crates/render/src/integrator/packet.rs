@@ -772,10 +772,9 @@ enum LaneLight<'a> {
     Triangle,
     /// A direction of this environment map, in the SIMD lanes.
     Environment(&'a EnvironmentMap),
-    /// Drawn one lane at a time into [`ScatterIn::drawn`].
-    Drawn,
-    /// None: no light, or a sample of no density or no radiance.
-    Nothing,
+    /// Any other: drawn one lane at a time into [`ScatterIn::drawn`] (whose mask says whether
+    /// there is a sample), or no light at all.
+    Other,
 }
 
 /// Lane `i`'s light choice from `u_select`: an emitting triangle's data go to the lane of `a`
@@ -793,7 +792,7 @@ fn gather_light<'a>(
     a: &mut ScatterIn,
 ) -> LaneLight<'a> {
     let Some((index, pmf)) = scene.light_sampler().sample(u_select) else {
-        return LaneLight::Nothing;
+        return LaneLight::Other;
     };
     match &scene.lights()[index] {
         Light::Area {
@@ -810,29 +809,31 @@ fn gather_light<'a>(
             a.light_pmf.0[i] = pmf;
             LaneLight::Environment(map)
         }
-        light => draw_light_sample(light, pmf, i, si, u_light, a),
+        light => {
+            draw_light_sample(light, pmf, i, si, u_light, a);
+            LaneLight::Other
+        }
     }
 }
 
 /// [`gather_light`]'s sample of a light the lanes do not sample together, drawn by the light's
-/// own [`Light::sample_li`] into lane `i` of `a.drawn`. Out of line: the path loop stays as
-/// small as it is for the common lights.
+/// own [`Light::sample_li`] into lane `i` of `a.drawn` where it may carry light (the lane
+/// stays off otherwise). Out of line: the path loop stays as small as it is for the common
+/// lights.
 #[inline(never)]
-fn draw_light_sample<'a>(
+fn draw_light_sample(
     light: &Light,
     pmf: f32,
     i: usize,
     si: &SurfaceInteraction,
     u_light: Vec2,
     a: &mut ScatterIn,
-) -> LaneLight<'a> {
-    match light.sample_li(si.p, u_light) {
-        Some(ls) if !(ls.pdf <= 0.0 || ls.li.max_element() <= 0.0) => {
+) {
+    if let Some(ls) = light.sample_li(si.p, u_light) {
+        if ls.may_carry_light(true) {
             a.drawn.set(i, &ls, &shadow_ray(light, si, &ls));
             a.light_pmf.0[i] = pmf;
-            LaneLight::Drawn
         }
-        _ => LaneLight::Nothing,
     }
 }
 

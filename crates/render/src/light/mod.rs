@@ -121,6 +121,17 @@ pub struct DeferredLiSample {
     at: Option<Vec2>,
 }
 
+impl LightLiSample {
+    /// Whether the sample may carry light: a density not at or below zero and, where its
+    /// radiance is known already (`li_known`), a radiance not at or below zero (a NaN is
+    /// neither, and passes). The light sample's early return, for one lane and for the lanes
+    /// alike.
+    #[inline]
+    pub fn may_carry_light(&self, li_known: bool) -> bool {
+        !(self.pdf <= 0.0 || (li_known && self.li.max_element() <= 0.0))
+    }
+}
+
 impl DeferredLiSample {
     /// Whether `ls.li` is the radiance already (otherwise [`Light::deferred_li`] reads it).
     pub fn has_li(&self) -> bool {
