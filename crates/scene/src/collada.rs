@@ -367,7 +367,16 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         };
         self.has_cgl_lights |= is_cgl;
         let color = match child(kind, "color") {
-            Some(c) => Vec3::from_slice(&self.file.floats_n(c, 3)?),
+            Some(c) => {
+                let color = Vec3::from_slice(&self.file.floats_n(c, 3)?);
+                if !(color.min_element() >= 0.0 && color.is_finite()) {
+                    return Err(self.file.error(
+                        c,
+                        format!("a light's colour must be >= 0 in every channel, got {color}"),
+                    ));
+                }
+                color
+            }
             None => Vec3::ONE,
         };
         let scalar = |name: &str, default: f32| -> Result<f32, Error> {

@@ -140,7 +140,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, Error> {
             camera = node.camera().and_then(|c| perspective_camera(&c, world));
         }
         if let Some(light) = node.light() {
-            add_light(&mut desc, &light, world);
+            add_light(&mut desc, &light, world).map_err(|message| parse_error(path, message))?;
         }
         stack.extend(node.children().map(|c| (c, world)));
     }
@@ -337,9 +337,20 @@ fn perspective_camera(cam: &gltf::Camera, world: Mat4) -> Option<(CameraDesc, Op
     ))
 }
 
-/// Adds a `KHR_lights_punctual` light placed by `world`.
-fn add_light(desc: &mut SceneDesc, light: &gltf::khr_lights_punctual::Light, world: Mat4) {
+/// Adds a `KHR_lights_punctual` light placed by `world`; what is wrong with it otherwise.
+fn add_light(
+    desc: &mut SceneDesc,
+    light: &gltf::khr_lights_punctual::Light,
+    world: Mat4,
+) -> Result<(), String> {
     let color = Vec3::from_array(light.color()) * light.intensity();
+    if !(color.min_element() >= 0.0 && color.is_finite()) {
+        return Err(format!(
+            "light {} ('{}'): color times intensity must be >= 0 in every channel, got {color}",
+            light.index(),
+            light.name().unwrap_or("")
+        ));
+    }
     let position = world.transform_point3(Vec3::ZERO);
     let direction = world
         .transform_vector3(Vec3::NEG_Z)
@@ -365,6 +376,7 @@ fn add_light(desc: &mut SceneDesc, light: &gltf::khr_lights_punctual::Light, wor
             attenuation: INVERSE_SQUARE,
         }),
     }
+    Ok(())
 }
 
 /// A glTF base-colour image as a linear texture (8-bit channels are sRGB-encoded).

@@ -90,10 +90,19 @@ pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
                 two_sided: true,
             },
         });
-        let ke = m
-            .emissive
-            .map(Vec3::from_array)
-            .filter(|e| e.is_finite() && e.max_element() > 0.0);
+        let ke = m.emissive.map(Vec3::from_array);
+        if let Some(ke) = ke.filter(|e| !(e.min_element() >= 0.0 && e.is_finite())) {
+            return Err(Error::Parse {
+                path: path.display().to_string(),
+                line: 0,
+                column: 0,
+                message: format!(
+                    "material '{}' (in the MTL file): Ke is an emission and must be >= 0 in every channel, got {ke}",
+                    m.name
+                ),
+            });
+        }
+        let ke = ke.filter(|e| e.max_element() > 0.0);
         emissions.push(ke);
         if m.shininess.is_some_and(|ns| ns > 100.0) {
             desc.warnings.push(format!(

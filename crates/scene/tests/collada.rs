@@ -194,6 +194,16 @@ fn malformed_files_give_located_errors() {
             "malformed XML",
         ),
         ("<notcollada/>".to_string(), "expected a <COLLADA>"),
+        // A negative light would render black without a word.
+        (
+            std::fs::read_to_string(data("CBempty.dae"))
+                .unwrap()
+                .replace(
+                    "<color sid=\"color\">5 5 5</color>",
+                    "<color sid=\"color\">5 -5 5</color>",
+                ),
+            "<color>: a light's colour must be >= 0 in every channel, got [5, -5, 5]",
+        ),
     ];
     for (text, expected) in cases {
         let e = parse_err(&text);

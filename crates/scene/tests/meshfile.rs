@@ -81,6 +81,20 @@ fn obj_with_mtl_round_trips_and_renders() {
     // An emissive material (Ke) makes the mesh a light; no default lights are added then.
     std::fs::write(scratch("box.mtl"), "newmtl red\nKd 0.8 0.1 0.1\nKe 2 2 2\n").unwrap();
     check_box(obj.to_str().unwrap(), true);
+    // A negative emission is refused, naming the material.
+    std::fs::write(
+        scratch("box.mtl"),
+        "newmtl red\nKd 0.8 0.1 0.1\nKe 2 -2 2\n",
+    )
+    .unwrap();
+    let msg = load(obj.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        msg.contains("box.obj")
+            && msg.contains("material 'red'")
+            && msg.contains("Ke is an emission and must be >= 0"),
+        "{msg}"
+    );
+    std::fs::write(scratch("box.mtl"), "newmtl red\nKd 0.8 0.1 0.1\nKe 2 2 2\n").unwrap();
     // Without its MTL file, the mesh is grey, with a warning naming the file.
     let mtl = scratch("box.mtl"); // (`scratch` removes the file)
     assert!(!mtl.exists());
@@ -261,6 +275,19 @@ fn gltf_round_trips_and_renders() {
     let msg = load(bad.to_str().unwrap()).unwrap_err().to_string();
     assert!(
         msg.contains("bad.gltf") && msg.contains("out of range"),
+        "{msg}"
+    );
+    // A light of negative intensity is refused, naming it.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let negative = path.with_file_name("negative.gltf");
+    std::fs::write(
+        &negative,
+        text.replace("\"intensity\": 20", "\"intensity\": -20"),
+    )
+    .unwrap();
+    let msg = load(negative.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        msg.contains("negative.gltf") && msg.contains("light 0") && msg.contains("must be >= 0"),
         "{msg}"
     );
     let garbage = scratch("garbage.gltf");

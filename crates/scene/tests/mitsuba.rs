@@ -148,6 +148,32 @@ fn malformed_xml_gives_located_errors() {
             r#"<scene><shape type="rectangle"><bsdf type="roughplastic"><float name="alpha" value="-0.1"/></bsdf></shape></scene>"#,
             "alpha must be a number >= 0, got -0.1",
         ),
+        // A negative emission has no meaning; rendered, its samples would carry no light
+        // and the image would come out black without a word.
+        (
+            r#"<scene><emitter type="point"><rgb name="intensity" value="-1"/></emitter></scene>"#,
+            "<emitter type=\"point\">: 'intensity' is an emission and must be >= 0 in every channel",
+        ),
+        (
+            r#"<scene><shape type="rectangle"><emitter type="area"><rgb name="radiance" value="1, -1, 1"/></emitter></shape></scene>"#,
+            "'radiance' is an emission and must be >= 0",
+        ),
+        (
+            r#"<scene><emitter type="constant"><spectrum name="radiance" value="-2"/></emitter></scene>"#,
+            "'radiance' is an emission and must be >= 0",
+        ),
+        (
+            r#"<scene><emitter type="constant"><spectrum name="radiance" value="400:1, 700:-1"/></emitter></scene>"#,
+            "'radiance' is an emission and must be >= 0",
+        ),
+        (
+            r#"<scene><emitter type="directional"><float name="irradiance" value="NaN"/></emitter></scene>"#,
+            "is not a number",
+        ),
+        (
+            r#"<scene><emitter type="projector"><float name="scale" value="-3"/></emitter></scene>"#,
+            "'scale' must be a number >= 0, got -3",
+        ),
         (r#"<scene><shape type="rectangle">"#, "malformed XML"),
         (r#"<notscene/>"#, "expected a <scene>"),
         (

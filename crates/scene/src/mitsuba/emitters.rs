@@ -86,7 +86,7 @@ pub(super) fn emitter(ctx: &mut Ctx, e: Obj) -> Result<(), Error> {
             };
             let aspect = w / h;
             let fov_x = sensors::fov_x(ctx, e, aspect)?;
-            let scale = ctx.float(e, "scale", 1.0)? as f32;
+            let scale = ctx.non_negative(e, "scale", 1.0)? as f32;
             ctx.desc.projectors.push(ProjectorDesc {
                 position,
                 frame,

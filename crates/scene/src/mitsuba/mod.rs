@@ -25,7 +25,7 @@ pub mod volume;
 use crate::spectrum::{constant_to_rgb, sampled_to_rgb, SpectrumKind};
 use crate::Error;
 use glam::{DMat4, DVec3, Mat4, Vec3};
-use parse::{Spectrum, Tree, Value};
+use parse::{Prop, Spectrum, Tree, Value};
 use pathlab_render::desc::*;
 use std::cell::Cell;
 use std::collections::HashMap;
@@ -200,14 +200,37 @@ impl<'t> Ctx<'t> {
 
     /// A positive number.
     pub(crate) fn positive(&self, o: Obj, name: &str, default: f64) -> Result<f64, Error> {
+        self.number_where(o, name, default, |v| v > 0.0, "positive")
+    }
+
+    /// A number >= 0.
+    pub(crate) fn non_negative(&self, o: Obj, name: &str, default: f64) -> Result<f64, Error> {
+        self.number_where(
+            o,
+            name,
+            default,
+            |v| v >= 0.0 && v.is_finite(),
+            "a number >= 0",
+        )
+    }
+
+    /// A number for which `ok` holds, or an error at the property saying it must be `what`.
+    fn number_where(
+        &self,
+        o: Obj,
+        name: &str,
+        default: f64,
+        ok: fn(f64) -> bool,
+        what: &str,
+    ) -> Result<f64, Error> {
         let v = self.float(o, name, default)?;
-        if v > 0.0 {
+        if ok(v) {
             return Ok(v);
         }
         let loc = self.prop(o, name).map_or(o.loc, |p| p.loc);
         Err(self.error(
             loc,
-            format!("{}: '{name}' must be positive, got {v}", self.what(o)),
+            format!("{}: '{name}' must be {what}, got {v}", self.what(o)),
         ))
     }
 
@@ -342,16 +365,49 @@ impl<'t> Ctx<'t> {
         let Some(p) = self.prop(o, name) else {
             return Ok(None);
         };
+        let c = self.color_of(o, name, p, kind)?;
+        let negative_sample = match &p.value {
+            Value::Spectrum(Spectrum::Sampled(samples)) => {
+                samples.iter().any(|s| s.1 < 0.0 || s.1.is_nan())
+            }
+            _ => false,
+        };
+        let negative = negative_sample || !(c.min_element() >= 0.0 && c.is_finite());
+        if kind == SpectrumKind::Emission && negative {
+            return Err(self.error(
+                p.loc,
+                format!(
+                    "{}: '{name}' is an emission and must be >= 0 {}",
+                    self.what(o),
+                    if negative_sample {
+                        "at every wavelength".to_string()
+                    } else {
+                        format!("in every channel, got {c}")
+                    }
+                ),
+            ));
+        }
+        Ok(Some(c))
+    }
+
+    /// The constant colour property `p` (named `name`) of `o` holds.
+    fn color_of(
+        &mut self,
+        o: Obj,
+        name: &str,
+        p: &Prop,
+        kind: SpectrumKind,
+    ) -> Result<Vec3, Error> {
         match &p.value {
-            Value::Rgb(c) => Ok(Some(c.as_vec3())),
-            Value::Float(v) => Ok(Some(Vec3::splat(*v as f32))),
-            Value::Int(v) => Ok(Some(Vec3::splat(*v as f32))),
-            Value::Spectrum(s) => Ok(Some(self.spectrum_rgb(s, kind))),
+            Value::Rgb(c) => Ok(c.as_vec3()),
+            Value::Float(v) => Ok(Vec3::splat(*v as f32)),
+            Value::Int(v) => Ok(Vec3::splat(*v as f32)),
+            Value::Spectrum(s) => Ok(self.spectrum_rgb(s, kind)),
             Value::Object(_) | Value::Ref(_) => {
                 let t = self.object_value(p)?.map(|i| self.obj(i));
                 let Some(t) = t else { unreachable!() };
                 match textures::constant(self, t, kind)? {
-                    Some(c) => Ok(Some(c)),
+                    Some(c) => Ok(c),
                     None => Err(self.error(
                         p.loc,
                         format!(

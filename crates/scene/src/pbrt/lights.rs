@@ -18,11 +18,18 @@ impl Builder {
     /// A light's `scale`, times what `power`-like parameters ask for (`per_unit`: the
     /// factor from the spectrum's unit to the requested quantity).
     fn light_scale(&mut self, params: &ParamList, power_name: &str, k: f64) -> Result<f32, Error> {
-        let mut scale = self.float(params, "scale", 1.0)?;
+        let mut scale = self.emission_scale(params)? as f64;
         let power = self.float(params, power_name, -1.0)?;
         if power > 0.0 {
             scale *= power / k;
         }
+        Ok(scale as f32)
+    }
+
+    /// A light's `scale` (default 1): an error naming its line unless it is a number >= 0.
+    pub(crate) fn emission_scale(&self, params: &ParamList) -> Result<f32, Error> {
+        let scale = self.float(params, "scale", 1.0)?;
+        self.check_non_negative(params, "scale", scale, "a light's scale")?;
         Ok(scale as f32)
     }
 
@@ -201,7 +208,7 @@ impl Builder {
                             "infinite: portals are not supported; the light is sampled without one",
                         );
                     }
-                    let scale = self.float(&params, "scale", 1.0)? as f32;
+                    let scale = self.emission_scale(&params)?;
                     let illuminance = self.float(&params, "illuminance", -1.0)?;
                     let path = self.resolve(&file);
                     match self.image_light(&path, m, scale, illuminance) {

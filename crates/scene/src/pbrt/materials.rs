@@ -194,9 +194,21 @@ impl Builder {
     /// An error naming parameter `name` unless its roughness `value` is a number ≥ 0 (pbrt-v4
     /// would take the square root of a negative one).
     fn check_roughness(&self, params: &ParamList, name: &str, value: f64) -> Result<(), Error> {
+        self.check_non_negative(params, name, value, "roughness")
+    }
+
+    /// An error naming parameter `name` and its line unless `value`, what it gave for `what`,
+    /// is a number ≥ 0.
+    pub(crate) fn check_non_negative(
+        &self,
+        params: &ParamList,
+        name: &str,
+        value: f64,
+        what: &str,
+    ) -> Result<(), Error> {
         match params.get(name) {
             Some(p) if !(value >= 0.0 && value.is_finite()) => Err(self.error(format!(
-                "\"{} {}\" (line {}): roughness must be a number >= 0, got {value}",
+                "\"{} {}\" (line {}): {what} must be a number >= 0, got {value}",
                 p.ty, p.name, p.line
             ))),
             _ => Ok(()),

@@ -173,7 +173,7 @@ impl Builder {
             return Ok(None);
         }
         let l = self.spectrum(&params, "L", Use::Illuminant)?;
-        let scale = self.float(&params, "scale", 1.0)? as f32;
+        let scale = self.emission_scale(&params)?;
         let two_sided = self.bool(&params, "twosided", false)?;
         // pbrt-v4: a power of 0 or less is no power at all.
         let power = Some(self.float(&params, "power", -1.0)?).filter(|&p| p > 0.0);

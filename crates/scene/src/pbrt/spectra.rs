@@ -87,6 +87,16 @@ impl Builder {
                     )));
                 }
                 let pairs: Vec<(f64, f64)> = v.chunks(2).map(|c| (c[0], c[1])).collect();
+                if let Some(&(nm, value)) = pairs
+                    .iter()
+                    .find(|(_, value)| *value < 0.0 || value.is_nan())
+                {
+                    if usage == Use::Illuminant {
+                        return Err(self.error(format!(
+                            "{decl}: a light's emission must be >= 0 at every wavelength, got {value} at {nm} nm"
+                        )));
+                    }
+                }
                 sampled_spectrum(&pairs, usage)
                     .ok_or_else(|| self.error(format!("{decl}: wavelengths must increase")))?
             }
@@ -109,6 +119,11 @@ impl Builder {
                 return Err(self.error(format!("{decl}: a '{ty}' where a spectrum was expected")))
             }
         };
+        if usage == Use::Illuminant && !(rgb.min_element() >= 0.0 && rgb.is_finite()) {
+            return Err(self.error(format!(
+                "{decl}: a light's emission must be >= 0 in every channel, got {rgb}"
+            )));
+        }
         Ok(rgb.as_vec3())
     }
 
