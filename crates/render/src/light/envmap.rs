@@ -105,7 +105,7 @@ impl EnvironmentMap {
                     texels[(j + 1) * width + i1],
                 ];
                 let mean = corners.iter().map(|&c| luminance(c)).sum::<f32>() / 4.0;
-                weights.push(cell_weight(corners, band));
+                weights.push(cell_weight(&corners, band));
                 luminance_integral += (mean * band) as f64 * (TAU / nu as f32) as f64;
             }
         }
@@ -232,7 +232,7 @@ impl EnvironmentMap {
             }
             (fx.0[i], fy.0[i], band.0[i]) = (x, y, self.bands[row]);
         }
-        let pdf_uv = self.cell_pdf(cell_weight(corners, band));
+        let pdf_uv = self.cell_pdf(cell_weight(&corners, band));
         (bilinear(corners, fx, fy), solid_angle_pdf(d, pdf_uv))
     }
 
@@ -261,7 +261,7 @@ impl EnvironmentMap {
         // than from the distribution's table (one lookup in memory instead of two; the same
         // number: the table holds the same weight of the same cell).
         let cell = self.texels_around(uv);
-        let pdf_uv = self.cell_pdf(cell_weight(cell.corners, self.bands[cell.row]));
+        let pdf_uv = self.cell_pdf(cell_weight(&cell.corners, self.bands[cell.row]));
         (cell.radiance(), solid_angle_pdf(d, pdf_uv))
     }
 
@@ -413,13 +413,14 @@ impl TexelCell {
 /// call it.
 /// For one value or lanes.
 #[inline(always)]
-fn cell_weight<V: Vector3>(corners: [V; 4], band: V::R) -> V::R {
+fn cell_weight<V: Vector3>(corners: &[V; 4], band: V::R) -> V::R {
     let [r, g, b] = LUMINANCE_WEIGHTS.map(|w| w as f32);
     let weights = V::splat(Vec3::new(r, g, b));
-    // `luminance`'s sum, (r x + g y) + b z, is glam's dot product's.
+    // `luminance`'s sum, (r x + g y) + b z, is glam's dot product's. By reference: the
+    // lanes' corners are 384 bytes, which an array's `into_iter` copied twice.
     corners
-        .into_iter()
-        .map(|c| weights.dot(c))
+        .iter()
+        .map(|&c| weights.dot(c))
         .fold(V::R::splat(0.0), V::R::max)
         * band
 }
