@@ -117,7 +117,7 @@ impl Triangle {
 
 /// A ray's quadratic a t² + 2b t + c = 0 against a sphere, and its discriminant written as
 /// a (r² - |o - (b/a) d|²) (see [`Sphere::intersect`]).
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Default)]
 struct SphereQuadratic {
     a: f64,
     b: f64,
@@ -198,13 +198,23 @@ impl Sphere {
     /// compiled for wide registers computes the eight lanes together.
     #[inline(always)]
     pub fn intersect_lanes(&self, o: &V8, d: &V8, t_min: &F8, t_max: &F8) -> [f32; W] {
-        // A loop over the lanes rather than `array::from_fn`, whose closure the compiler
+        // Loops over the lanes rather than `array::from_fn`, whose closure the compiler
         // keeps out of line, one lane at a time.
-        let mut t = [0.0; W];
+        let mut q = [SphereQuadratic::default(); W];
+        let mut any_roots = false;
+        for (i, q) in q.iter_mut().enumerate() {
+            *q = self.quadratic(o.get(i), d.get(i));
+            any_roots |= q.has_roots();
+        }
+        // Most groups of rays miss a sphere altogether: they end here, before the roots'
+        // square root and divisions, as one ray does.
+        let mut t = [f32::NAN; W];
+        if !any_roots {
+            return t;
+        }
         for (i, t) in t.iter_mut().enumerate() {
-            let q = self.quadratic(o.get(i), d.get(i));
-            let root = q.nearest_root(t_min.0[i], t_max.0[i]);
-            *t = if q.has_roots() { root } else { f32::NAN };
+            let root = q[i].nearest_root(t_min.0[i], t_max.0[i]);
+            *t = if q[i].has_roots() { root } else { f32::NAN };
         }
         t
     }
