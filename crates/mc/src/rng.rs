@@ -135,14 +135,16 @@ impl Pcg32 {
         let mut state: [u64; LANES] = std::array::from_fn(|i| rngs[i].state);
         let inc: [u64; LANES] = std::array::from_fn(|i| rngs[i].inc);
         let mut drawn = [[0.0f32; LANES]; 8];
+        // The lanes' draws replace `out`'s values where a lane is active: by a mask of bits
+        // rather than a branch per lane, so that the copy is one blend per row.
+        let keep: [u32; LANES] = std::array::from_fn(|i| 0u32.wrapping_sub((lanes >> i) & 1));
         for chunk in out.chunks_mut(drawn.len()) {
             let drawn = &mut drawn[..chunk.len()];
             draw_lanes(&mut state, &inc, drawn);
             for (o, d) in chunk.iter_mut().zip(drawn.iter()) {
-                for (i, (o, d)) in o.iter_mut().zip(d).enumerate() {
-                    if lanes & (1 << i) != 0 {
-                        *o = *d;
-                    }
+                for i in 0..LANES {
+                    let bits = (d[i].to_bits() & keep[i]) | (o[i].to_bits() & !keep[i]);
+                    o[i] = f32::from_bits(bits);
                 }
             }
         }
