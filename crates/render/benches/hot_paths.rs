@@ -205,6 +205,25 @@ fn environment_map(c: &mut Criterion) {
                 .sum::<f32>()
         })
     });
+    // Draws spread over the whole table, as a render's are: the rows a lane reads are then
+    // mostly out of the first-level caches, as they are there.
+    let many: Vec<F8> = (0..2 * 65536 / 8)
+        .map(|_| F8(std::array::from_fn(|_| rng.uniform_f32())))
+        .collect();
+    c.bench_function(
+        "environment map sample in lanes, 65536 distinct draws",
+        |b| {
+            b.iter(|| {
+                many.chunks_exact(2)
+                    .map(|u| {
+                        map.sample_direction_lanes(black_box([u[0], u[1]]), 0xff)
+                            .pdf
+                            .0[3]
+                    })
+                    .sum::<f32>()
+            })
+        },
+    );
     let ws: Vec<Vec3> = us
         .iter()
         .map(|u| pathlab_mc::warp::sample_uniform_sphere(*u))
