@@ -46,6 +46,30 @@ fn shards_merge_into_the_single_render_to_the_bit_and_bad_sets_are_reported() {
     assert!(pathlab(&args).status.success());
     assert_magic(&exr, EXR);
     let p = |i: usize| parts[i].to_str().unwrap();
+    // `-o`, as `render` takes it, names the output; every file is then a part.
+    let with_o = scratch("merged-o.plf");
+    let o = pathlab(&[
+        "merge",
+        p(0),
+        p(1),
+        "-o",
+        with_o.to_str().unwrap(),
+        p(2),
+        p(3),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        std::fs::read(&with_o).unwrap(),
+        std::fs::read(&single).unwrap()
+    );
+    // An output that is one of the parts would destroy it: refused, the part untouched.
+    let before = std::fs::read(&parts[0]).unwrap();
+    assert_one_line_error(
+        &pathlab(&["merge", "-o", p(0), p(0), p(1), p(2), p(3)]),
+        "is also one of the parts",
+    );
+    assert_one_line_error(&pathlab(&["merge", "m.exr"]), "at least one part");
+    assert_eq!(std::fs::read(&parts[0]).unwrap(), before);
     assert_one_line_error(
         &pathlab(&["merge", "m.exr", p(0), p(1), p(3)]),
         "samples 16..24 are missing",
