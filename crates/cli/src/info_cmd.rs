@@ -9,7 +9,9 @@ use pathlab_lab::info::SceneReport;
 pub struct InfoArgs {
     /// The scene: a file (.xml Mitsuba 3, .pbrt pbrt-v4, .dae the course's COLLADA, .obj, .ply,
     /// .gltf, .glb) or
-    /// a built-in scene's name (cornell-box).
+    /// a built-in scene's name (cornell-box), as `render` takes it (and, as there, the built-in
+    /// Cornell box when none is given).
+    #[arg(value_name = "SCENE", default_value = "cornell-box")]
     pub scene: String,
     /// Print the summary as JSON on stdout.
     #[arg(long)]

@@ -305,6 +305,9 @@ fn bad_scene_files_are_short_errors() {
         "/no/such/file.dae",
     );
     assert_one_line_error(&pathlab(&["info", "model.fbx"]), "unknown scene format");
+    // Without a scene, `info` describes the built-in Cornell box, as `render` renders it.
+    let built_in = String::from_utf8(pathlab(&["info"]).stdout).unwrap();
+    assert!(built_in.starts_with("cornell-box"), "{built_in}");
 }
 
 #[test]
