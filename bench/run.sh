@@ -67,8 +67,8 @@ if [ "$what" = all ] || [ "$what" = rays ]; then
         for level in x86-64-v4 x86-64-v3; do
             [ -z "$(x86_level_missing "$level")" ] || continue
             RUSTFLAGS="-C target-cpu=$level" CARGO_TARGET_DIR="$root/target/variants/$level" \
-                cargo build --release --quiet -p pathlab-bench --features obvhs --target "$host"
-            bench="$root/target/variants/$level/$host/release/pathlab-bench"
+                cargo build --profile dist --quiet -p pathlab-bench --features obvhs --target "$host"
+            bench="$root/target/variants/$level/$host/dist/pathlab-bench"
             break
         done
     fi
