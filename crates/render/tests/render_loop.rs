@@ -316,6 +316,62 @@ fn with_more_lights(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with blends: of two Lambertian materials by a checkerboard weight (one Lambertian
+/// lobe, shaded in the lanes), of a Lambertian one and a rough conductor (one lane at a time),
+/// and of two Lambertian ones of different sidedness (one lane at a time); on the floor and on
+/// spheres.
+fn with_blends(mut desc: SceneDesc) -> SceneDesc {
+    let diffuse = |r: Vec3, two_sided| MaterialDesc::Diffuse {
+        reflectance: r,
+        two_sided,
+    };
+    let blend = |first, second| MaterialDesc::Blend {
+        weight: TextureDesc::Checkerboard {
+            color0: Vec3::splat(0.25),
+            color1: Vec3::splat(0.9),
+            to_uv: glam::Affine2::from_scale(glam::Vec2::splat(5.0)),
+        },
+        first: Box::new(first),
+        second: Box::new(second),
+    };
+    desc.materials[0] = blend(
+        diffuse(Vec3::new(0.0, 0.5, 0.5), false),
+        diffuse(Vec3::new(1.0, 1.0, 0.0), false),
+    );
+    let first = desc.materials.len();
+    desc.materials.extend([
+        blend(
+            diffuse(Vec3::new(0.7, 0.2, 0.2), true),
+            diffuse(Vec3::new(0.1, 0.2, 0.9), true),
+        ),
+        blend(
+            diffuse(Vec3::new(0.7, 0.6, 0.2), false),
+            MaterialDesc::Conductor {
+                alpha: 0.2,
+                eta: Vec3::new(0.2, 0.9, 1.1),
+                k: Vec3::new(3.9, 2.4, 2.2),
+                distribution: NormalDistribution::Ggx,
+            },
+        ),
+        blend(
+            diffuse(Vec3::new(0.3, 0.8, 0.2), false),
+            diffuse(Vec3::new(0.9, 0.9, 0.9), true),
+        ),
+    ]);
+    for (k, (x, z)) in [(-0.5, 0.4), (0.45, -0.3), (0.1, 0.5)]
+        .into_iter()
+        .enumerate()
+    {
+        desc.spheres.push(SphereDesc {
+            center: Vec3::new(x, 0.18, z),
+            radius: 0.18,
+            material: first + k,
+            ..Default::default()
+        });
+    }
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -351,6 +407,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
             crowded(with_more_lights(with_smooth_lobes(mixed_scene()))),
             true,
         ),
+        (with_blends(mixed_scene()), false),
+        (under_a_sky(with_blends(mixed_scene())), false),
     ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);

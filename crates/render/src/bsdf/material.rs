@@ -269,13 +269,37 @@ struct LobeList([Option<Lobe>; MAX_LOBES]);
 
 impl LobeList {
     fn push(&mut self, lobe: Lobe) {
-        // `weight > 0` also leaves out NaN weights.
-        if lobe.weight > 0.0 {
-            if let Some(slot) = self.0.iter_mut().find(|l| l.is_none()) {
-                *slot = Some(lobe);
+        // Only lobes of weight > 0 (not NaN either).
+        if lobe.weight <= 0.0 || lobe.weight.is_nan() {
+            return;
+        }
+        // A Lambertian lobe joins one already there of the same frame: the two are one
+        // Lambertian lobe (the same f, density and samples), which is cheaper to evaluate and
+        // which the path tracer's lanes shade (a blend of two diffuse materials).
+        if let (Bxdf::Diffuse(d), None) = (lobe.bxdf, lobe.guard) {
+            for l in self.0.iter_mut().flatten() {
+                if let (Bxdf::Diffuse(e), None) = (&mut l.bxdf, l.guard) {
+                    if l.frame == lobe.frame {
+                        (l.weight, *e) = merged_diffuse(l.weight, *e, lobe.weight, d);
+                        return;
+                    }
+                }
             }
         }
+        if let Some(slot) = self.0.iter_mut().find(|l| l.is_none()) {
+            *slot = Some(lobe);
+        }
     }
+}
+
+/// Lambertian lobes `a` and `b` of one frame, of mixture weights `wa` and `wb` (both > 0), as
+/// one lobe: its weight the sum, its reflectance the weights' mean of theirs, so that its
+/// f, weight times reflectance over π, is the sum of theirs. Their samples are the same
+/// cosine-weighted directions, so the mixture's density is the merged lobe's too.
+fn merged_diffuse(wa: f32, a: Diffuse, wb: f32, b: Diffuse) -> (f32, Diffuse) {
+    let w = wa + wb;
+    let reflectance = (a.reflectance * wa + b.reflectance * wb) / w;
+    (w, Diffuse { reflectance })
 }
 
 /// A lobe the path tracer's lanes shade together ([`Material::lane_bxdf`]).
@@ -325,7 +349,7 @@ impl Material {
     #[inline]
     pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<(LaneBxdf, bool)> {
         let Material::Leaf(Leaf { model, two_sided }) = self else {
-            return None;
+            return self.lane_blend(tex);
         };
         let bxdf = match model {
             Model::Fixed(bxdf) => *bxdf,
@@ -350,6 +374,36 @@ impl Material {
             _ => return None,
         };
         Some((lobe, *two_sided))
+    }
+
+    /// [`Material::lane_bxdf`] of a blend of two Lambertian materials of one sidedness: the
+    /// one Lambertian lobe [`Material::collect`] merges them into (`LobeList::push`), or none
+    /// for any other material.
+    fn lane_blend<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<(LaneBxdf, bool)> {
+        let Material::Blend(weight, ab) = self else {
+            return None;
+        };
+        let (Material::Leaf(a), Material::Leaf(b)) = (&ab.0, &ab.1) else {
+            return None;
+        };
+        if a.two_sided != b.two_sided {
+            return None;
+        }
+        let tex = tex();
+        let diffuse = |leaf: &Leaf| match leaf.model.bxdf(&tex) {
+            (Bxdf::Diffuse(d), false) => Some(d),
+            _ => None,
+        };
+        let (da, db) = (diffuse(a)?, diffuse(b)?);
+        // The weights `collect` gives the two at the top of the tree (1 - w and w, times one).
+        let w = weight.eval_float(&tex).clamp(0.0, 1.0);
+        let d = match (1.0 - w, w) {
+            (wa, wb) if wa > 0.0 && wb > 0.0 => merged_diffuse(wa, da, wb, db).1,
+            (wa, _) if wa > 0.0 => da,
+            (_, wb) if wb > 0.0 => db,
+            _ => return None,
+        };
+        Some((LaneBxdf::Diffuse(d), a.two_sided))
     }
 
     /// Whether evaluating the material may read a texture at the surface's (u, v): every
@@ -640,13 +694,22 @@ mod tests {
         Material::Blend(Tex::Constant(Rgb::splat(w)), Box::new((a, b)))
     }
 
+    fn mirror(r: f32) -> Material {
+        Material::new(
+            Bxdf::Mirror(Mirror {
+                reflectance: Rgb::splat(r),
+            }),
+            false,
+        )
+    }
+
     #[test]
     fn a_tree_gives_its_first_lobes_in_order_up_to_the_most_a_bsdf_holds() {
         // Five leaves, the last two at an eighth each: the BSDF keeps the first four.
         let tree = blend(
             0.5,
-            blend(0.5, diffuse(0.1), diffuse(0.2)),
-            blend(0.5, diffuse(0.3), blend(0.5, diffuse(0.4), diffuse(0.5))),
+            blend(0.5, mirror(0.1), mirror(0.2)),
+            blend(0.5, mirror(0.3), blend(0.5, mirror(0.4), mirror(0.5))),
         );
         let bsdf = tree.bsdf(&ShadingPoint::at(Vec3::Z), Vec3::Z);
         let lobes: Vec<(f32, Bxdf)> = bsdf.lobes().map(|l| (l.weight, l.bxdf)).collect();
@@ -655,16 +718,77 @@ mod tests {
             .into_iter()
             .enumerate()
         {
-            let Bxdf::Diffuse(d) = lobes[k].1 else {
+            let Bxdf::Mirror(m) = lobes[k].1 else {
                 panic!("lobe {k}: {:?}", lobes[k].1);
             };
             assert_eq!(
-                (lobes[k].0, d.reflectance),
+                (lobes[k].0, m.reflectance),
                 (weight, Rgb::splat(r)),
                 "lobe {k}"
             );
         }
         assert_eq!(bsdf.pass_through(), 0.0);
+    }
+
+    #[test]
+    fn lambertian_lobes_of_one_frame_are_one_lobe_of_the_same_value_and_density() {
+        // Five Lambertian leaves (the tree above's, diffuse): one lobe, nothing dropped, of
+        // weight one and the weights' mean reflectance.
+        let tree = blend(
+            0.5,
+            blend(0.5, diffuse(0.1), diffuse(0.2)),
+            blend(0.5, diffuse(0.3), blend(0.5, diffuse(0.4), diffuse(0.5))),
+        );
+        let bsdf = tree.bsdf(&ShadingPoint::at(Vec3::Z), Vec3::Z);
+        let lobes: Vec<&Lobe> = bsdf.lobes().collect();
+        assert_eq!(lobes.len(), 1);
+        assert_eq!(lobes[0].weight, 1.0);
+        let mean = 0.25 * (0.1 + 0.2 + 0.3) + 0.125 * (0.4 + 0.5);
+        let Bxdf::Diffuse(d) = lobes[0].bxdf else {
+            panic!("{:?}", lobes[0].bxdf);
+        };
+        assert!((d.reflectance - Rgb::splat(mean)).abs().max_element() < 1e-6);
+        // f and the density against the sums the mixture of five would give.
+        let (wo, wi) = (
+            Vec3::new(0.3, 0.1, 0.9).normalize(),
+            Vec3::new(-0.5, 0.2, 0.6).normalize(),
+        );
+        let f = bsdf.f(wo, wi);
+        assert!(
+            (f - Rgb::splat(mean * std::f32::consts::FRAC_1_PI))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+        let cos = wi.z;
+        assert!((bsdf.pdf(wo, wi) - cos * std::f32::consts::FRAC_1_PI).abs() < 1e-6);
+        // Under a mask, the merged lobe keeps the mask's share; passing through the rest.
+        let masked = Material::Mask(
+            Tex::Constant(Rgb::splat(0.4)),
+            Box::new(blend(0.3, diffuse(0.2), diffuse(0.8))),
+        );
+        let bsdf = masked.bsdf(&ShadingPoint::at(Vec3::Z), Vec3::Z);
+        let lobes: Vec<&Lobe> = bsdf.lobes().collect();
+        assert_eq!(lobes.len(), 1);
+        assert!((lobes[0].weight - 0.4).abs() < 1e-6);
+        assert!((bsdf.pass_through() - 0.6).abs() < 1e-6);
+        let Bxdf::Diffuse(d) = lobes[0].bxdf else {
+            panic!("{:?}", lobes[0].bxdf);
+        };
+        assert!(
+            (d.reflectance - Rgb::splat(0.7 * 0.2 + 0.3 * 0.8))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+        // A Lambertian leaf and a mirror stay two lobes.
+        let two = blend(0.5, diffuse(0.5), mirror(0.5));
+        assert_eq!(
+            two.bsdf(&ShadingPoint::at(Vec3::Z), Vec3::Z)
+                .lobes()
+                .count(),
+            2
+        );
     }
 
     #[test]
