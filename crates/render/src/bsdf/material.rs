@@ -343,9 +343,10 @@ impl Material {
     /// The lobe and sidedness of a material of one lobe that the path tracer's lanes shade
     /// together, its textures read at `tex`: Lambertian, a rough conductor or rough glass of
     /// GGX or Beckmann normals of one roughness, a mirror, a smooth conductor, or smooth glass
-    /// of exact Fresnel reflectance. Textured models are evaluated (as [`Material::bsdf`]
-    /// evaluates them) only where they may give one of those: diffuse, and conductors and
-    /// glass (the same roughness along u and v gives a lane lobe).
+    /// of exact Fresnel reflectance; or a blend of two Lambertian materials, which is one
+    /// Lambertian lobe. Textured models are evaluated (as [`Material::bsdf`] evaluates them)
+    /// only where they may give one of those: diffuse, and conductors and glass (the same
+    /// roughness along u and v gives a lane lobe).
     #[inline]
     pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<(LaneBxdf, bool)> {
         let Material::Leaf(Leaf { model, two_sided }) = self else {

@@ -9,8 +9,9 @@
 //!
 //! The physics is the one-path code's ([`super::path`]): `arrive`, `scatter` and `survive`
 //! for every lane and bounce, except where a lane's material is one lobe of those the lanes
-//! shade ([`Material::lane_bxdf`]: Lambertian; a mirror; smooth conductors and glass; rough
-//! GGX or Beckmann conductors and glass). There the lanes are shaded together in SIMD
+//! shade ([`Material::lane_bxdf`]: Lambertian, or a blend of two Lambertian materials, which
+//! is one Lambertian lobe; a mirror; smooth conductors and glass; rough GGX or Beckmann
+//! conductors and glass). There the lanes are shaded together in SIMD
 //! registers by the same functions the one-path code calls, instantiated on eight lanes (the
 //! BSDFs: [`Diffuse`], [`RoughConductor`], [`RoughDielectric`], [`Mirror`],
 //! [`SmoothConductor`], [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
