@@ -369,7 +369,7 @@ impl<'f, 'a, 'input> Loader<'f, 'a, 'input> {
         let color = match child(kind, "color") {
             Some(c) => {
                 let color = Vec3::from_slice(&self.file.floats_n(c, 3)?);
-                if !(color.min_element() >= 0.0 && color.is_finite()) {
+                if !crate::spectrum::is_emission(color) {
                     return Err(self.file.error(
                         c,
                         format!("a light's colour must be >= 0 in every channel, got {color}"),

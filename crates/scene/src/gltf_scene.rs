@@ -344,7 +344,7 @@ fn add_light(
     world: Mat4,
 ) -> Result<(), String> {
     let color = Vec3::from_array(light.color()) * light.intensity();
-    if !(color.min_element() >= 0.0 && color.is_finite()) {
+    if !crate::spectrum::is_emission(color) {
         return Err(format!(
             "light {} ('{}'): color times intensity must be >= 0 in every channel, got {color}",
             light.index(),

@@ -91,7 +91,7 @@ pub fn load_obj(path: &Path) -> Result<SceneDesc, Error> {
             },
         });
         let ke = m.emissive.map(Vec3::from_array);
-        if let Some(ke) = ke.filter(|e| !(e.min_element() >= 0.0 && e.is_finite())) {
+        if let Some(ke) = ke.filter(|&e| !crate::spectrum::is_emission(e)) {
             return Err(Error::Parse {
                 path: path.display().to_string(),
                 line: 0,

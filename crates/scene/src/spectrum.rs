@@ -9,7 +9,7 @@
 //! sRGB, whose white point is D65); the integral is a 1000-point Riemann sum over 360–830 nm
 //! that skips wavelengths outside the list's range.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 /// First wavelength of the tables (nm).
 pub const CIE_MIN: f64 = 360.0;
@@ -34,6 +34,13 @@ fn lookup(table: &[f64; SAMPLES], w: f64) -> f64 {
     let i0 = (t as usize).min(SAMPLES - 2);
     let w1 = t - i0 as f64;
     (1.0 - w1) * table[i0] + w1 * table[i0 + 1]
+}
+
+/// Whether `c` is a colour a light may emit: finite and at least zero in every channel (a
+/// negative one means nothing, and rendered it would carry no light: a black image, without a
+/// word). Every loader refuses a light's colour that is not.
+pub(crate) fn is_emission(c: Vec3) -> bool {
+    c.is_finite() && c.min_element() >= 0.0
 }
 
 /// The CIE 1931 colour-matching functions (x̄, ȳ, z̄) at wavelength `w` (nm).

@@ -22,7 +22,7 @@ mod shapes;
 mod textures;
 pub mod volume;
 
-use crate::spectrum::{constant_to_rgb, sampled_to_rgb, SpectrumKind};
+use crate::spectrum::{constant_to_rgb, is_emission, sampled_to_rgb, SpectrumKind};
 use crate::Error;
 use glam::{DMat4, DVec3, Mat4, Vec3};
 use parse::{Prop, Spectrum, Tree, Value};
@@ -372,7 +372,7 @@ impl<'t> Ctx<'t> {
             }
             _ => false,
         };
-        let negative = negative_sample || !(c.min_element() >= 0.0 && c.is_finite());
+        let negative = negative_sample || !is_emission(c);
         if kind == SpectrumKind::Emission && negative {
             return Err(self.error(
                 p.loc,

@@ -10,7 +10,7 @@
 use super::params::{Param, ParamList};
 use super::Builder;
 use crate::mitsuba::ior::named_conductor;
-use crate::spectrum::{blackbody_to_rgb, sampled_to_rgb, xyz_to_srgb, SpectrumKind};
+use crate::spectrum::{blackbody_to_rgb, is_emission, sampled_to_rgb, xyz_to_srgb, SpectrumKind};
 use crate::Error;
 use glam::DVec3;
 use pathlab_render::color::luminance_f64 as luminance;
@@ -119,12 +119,13 @@ impl Builder {
                 return Err(self.error(format!("{decl}: a '{ty}' where a spectrum was expected")))
             }
         };
-        if usage == Use::Illuminant && !(rgb.min_element() >= 0.0 && rgb.is_finite()) {
+        let rgb = rgb.as_vec3();
+        if usage == Use::Illuminant && !is_emission(rgb) {
             return Err(self.error(format!(
                 "{decl}: a light's emission must be >= 0 in every channel, got {rgb}"
             )));
         }
-        Ok(rgb.as_vec3())
+        Ok(rgb)
     }
 
     /// The spectrum in file `name` (relative to the scene file): numbers separated by
