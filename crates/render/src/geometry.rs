@@ -146,7 +146,7 @@ impl Aabb {
 /// frames of eight lanes.
 ///
 /// [`V8`]: crate::simd::lanes::V8
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Frame<V = Vec3> {
     /// Local x.
     pub s: V,

@@ -145,9 +145,9 @@ fn under_a_sky(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
-/// `desc` with rough conductors: GGX of one roughness on the wall and the mirror sphere (the
-/// lanes shade those together), and two the lanes leave to the scalar code, a Beckmann sphere
-/// and an anisotropic GGX one; and rough glass spheres, GGX (the lanes') and Beckmann.
+/// `desc` with rough conductors: GGX of one roughness on the wall and the mirror sphere, a
+/// Beckmann sphere and an anisotropic GGX one (its frame along the sphere's tangent), all
+/// shaded in the lanes; and rough glass spheres, GGX and Beckmann.
 fn with_metals(mut desc: SceneDesc) -> SceneDesc {
     let gold = |alpha: f32, distribution| MaterialDesc::Conductor {
         alpha,
@@ -193,9 +193,9 @@ fn with_metals(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
-/// `desc` with textured materials: a diffuse checkerboard (the lanes'), a rough GGX conductor
-/// whose roughness is a checkerboard (the lanes'), and one whose roughness differs along u and
-/// v (left to the scalar code), on the floor and two spheres.
+/// `desc` with textured materials: a diffuse checkerboard, a rough GGX conductor whose
+/// roughness is a checkerboard, an anisotropic one (a checkerboard along u, 0.2 along v)
+/// and anisotropic Beckmann glass, on the floor and three spheres; all shaded in the lanes.
 fn with_textures(mut desc: SceneDesc) -> SceneDesc {
     let checks = |a: Vec3, b: Vec3| TextureDesc::Checkerboard {
         color0: a,
@@ -220,7 +220,18 @@ fn with_textures(mut desc: SceneDesc) -> SceneDesc {
         .push(metal(checks(Vec3::splat(0.05), Vec3::splat(0.4))));
     desc.materials
         .push(metal(TextureDesc::Constant(Vec3::splat(0.2))));
-    for (k, (x, z)) in [(-0.4, 0.4), (0.4, -0.3)].into_iter().enumerate() {
+    desc.materials.push(MaterialDesc::RoughGlass {
+        alpha_u: checks(Vec3::splat(0.05), Vec3::splat(0.3)),
+        alpha_v: TextureDesc::Constant(Vec3::splat(0.15)),
+        ior: 1.5,
+        distribution: NormalDistribution::Beckmann,
+        reflectance: Vec3::ONE,
+        transmittance: Vec3::new(0.9, 1.0, 0.95),
+    });
+    for (k, (x, z)) in [(-0.4, 0.4), (0.4, -0.3), (0.0, 0.0)]
+        .into_iter()
+        .enumerate()
+    {
         desc.spheres.push(SphereDesc {
             center: Vec3::new(x, 0.2, z),
             radius: 0.2,
@@ -378,9 +389,10 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // Lambertian surfaces in SIMD lanes (and the environment map's radiance towards the rays
     // that leave the scene), lit by emitting triangles or an environment map sampled in the
     // lanes or by any other light sampled one lane at a time (`with_more_lights`), and
-    // everything else with the scalar code (rough conductors and glass of one roughness,
-    // mirrors, smooth conductors and glass go through the lanes too, textured or not, in the
-    // scenes `with_metals`, `with_smooth_lobes` and `with_textures`): every sample's radiance
+    // everything else with the scalar code (rough conductors, anisotropic ones included, and
+    // glass of one roughness, mirrors, smooth conductors and glass go through the lanes too,
+    // textured or not, in the scenes `with_metals`, `with_smooth_lobes` and `with_textures`;
+    // blends of two diffuse materials in `with_blends`): every sample's radiance
     // must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same

@@ -3,13 +3,13 @@
 
 use super::bxdf::DirectionSample;
 use super::fresnel::ConductorFresnel;
-use super::microfacet::{Distribution, IsotropicMicrofacet, Microfacet};
+use super::microfacet::{Distribution, Microfacet, MicrofacetLanes};
 use super::mirror::specular_reflection_real;
 use super::scattering::reflect;
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
-use pathlab_mc::simd::lanes::{Real, F8, V8};
+use pathlab_mc::simd::lanes::{Real, V8};
 
 /// A conductor with complex index η + i k per channel. Smooth without a distribution;
 /// otherwise f = D(wm) G(wo, wi, wm) F(wo·wm) / (4 cos θo cos θi) with wm the half vector
@@ -38,26 +38,15 @@ impl Conductor {
         })
     }
 
-    /// The rough lobe (`None` when smooth).
+    /// The rough lobe (`None` when smooth): the model the path tracer's lanes shade together,
+    /// with the same functions.
     #[inline]
-    fn rough(&self) -> Option<RoughConductor<Rgb, Microfacet>> {
+    pub fn rough(&self) -> Option<RoughConductor<Rgb, Microfacet>> {
         self.distribution.map(|distribution| RoughConductor {
             eta: self.eta,
             k: self.k,
             specular: self.specular,
             distribution,
-        })
-    }
-
-    /// The rough lobe where its distribution has one roughness in every direction: the
-    /// model the path tracer's lanes shade together, with the same functions.
-    #[inline]
-    pub fn as_isotropic(&self) -> Option<RoughConductor<Rgb, IsotropicMicrofacet<f32>>> {
-        Some(RoughConductor {
-            eta: self.eta,
-            k: self.k,
-            specular: self.specular,
-            distribution: self.distribution?.as_isotropic()?,
         })
     }
 
@@ -116,8 +105,8 @@ impl SmoothConductor<V8> {
 }
 
 /// A rough conductor's lobe, written once for one direction (`V = Rgb`, with `Microfacet`
-/// or [`IsotropicMicrofacet`]) and for eight lanes (`V = V8`, with
-/// `IsotropicMicrofacet<F8>`): f = D(wm) G(wo, wi, wm) F(wo·wm) / (4 cos θo cos θi) with wm
+/// or [`super::IsotropicMicrofacet`]) and for eight lanes (`V = V8`, with
+/// [`MicrofacetLanes`]): f = D(wm) G(wo, wi, wm) F(wo·wm) / (4 cos θo cos θi) with wm
 /// the half vector, sampled by reflecting `wo` about a normal from the distribution, of
 /// density pdf(wm) / (4 wo·wm).
 ///
@@ -189,22 +178,21 @@ impl<V: ConductorFresnel, M: Distribution<V::R>> RoughConductor<V, M> {
     }
 }
 
-impl RoughConductor<V8, IsotropicMicrofacet<F8>> {
+impl RoughConductor<V8, MicrofacetLanes> {
     /// Sets lane `i` to `c`. Every field is taken apart here: a field added to
-    /// [`RoughConductor`] or [`IsotropicMicrofacet`] fails to compile until its lanes are set too.
+    /// [`RoughConductor`] fails to compile until its lanes are set too.
     #[inline(always)]
-    pub fn set_lane(&mut self, i: usize, c: RoughConductor<Rgb, IsotropicMicrofacet<f32>>) {
+    pub fn set_lane(&mut self, i: usize, c: RoughConductor<Rgb, Microfacet>) {
         let RoughConductor {
             eta,
             k,
             specular,
-            distribution: IsotropicMicrofacet { alpha, beckmann },
+            distribution,
         } = c;
         self.eta.set(i, eta);
         self.k.set(i, k);
         self.specular.set(i, specular);
-        self.distribution.alpha.0[i] = alpha;
-        self.distribution.beckmann.set(i, beckmann);
+        self.distribution.set_lane(i, distribution);
     }
 }
 
@@ -213,6 +201,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::bsdf::{Mirror, NormalDistribution};
     use pathlab_mc::rng::Pcg32;
+    use pathlab_mc::simd::lanes::F8;
 
     /// Round `round`'s distribution in lane `i`: all lanes GGX, all Beckmann, or the two
     /// mixed.
@@ -226,7 +215,7 @@ pub(crate) mod tests {
     /// Eight lanes of the rough conductor compute, lane by lane, what the one-direction
     /// [`Conductor`] computes (through [`Microfacet`]), to the bit: f, pdf and the sample,
     /// for directions above, below and on the horizon, opposite pairs and equal ones, with
-    /// GGX and Beckmann lanes.
+    /// GGX and Beckmann lanes, of one roughness or anisotropic.
     #[test]
     fn lanes_compute_what_the_one_direction_conductor_computes() {
         let mut rng = Pcg32::new(7, 11);
@@ -238,7 +227,7 @@ pub(crate) mod tests {
         };
         let (mut valid, mut lanes_seen) = (0, 0);
         for round in 0..400 {
-            let mut lanes = RoughConductor::<V8, IsotropicMicrofacet<F8>>::default();
+            let mut lanes = RoughConductor::<V8, MicrofacetLanes>::default();
             let (mut wo, mut wi) = (V8::default(), V8::default());
             let (mut u0, mut u1) = (F8::default(), F8::default());
             let mut scalar = Vec::new();
@@ -248,9 +237,14 @@ pub(crate) mod tests {
                     eta: Vec3::new(0.2, 0.9, 1.4) + rng.uniform_f32(),
                     k: Vec3::new(3.9, 2.4, 1.6) * rng.uniform_f32(),
                     specular: Vec3::new(1.0, 0.8, rng.uniform_f32()),
-                    distribution: Some(Microfacet::new(lane_kind(round, i), alpha)),
+                    // Every fourth round, every third lane anisotropic.
+                    distribution: Some(if round % 4 == 3 && i % 3 == 0 {
+                        Microfacet::anisotropic(lane_kind(round, i), alpha, 0.4 * alpha + 0.05)
+                    } else {
+                        Microfacet::new(lane_kind(round, i), alpha)
+                    }),
                 };
-                lanes.set_lane(i, c.as_isotropic().expect("isotropic"));
+                lanes.set_lane(i, c.rough().expect("rough"));
                 let (o, mut w) = (direction(&mut rng), direction(&mut rng));
                 match round % 5 {
                     0 => w = -o,

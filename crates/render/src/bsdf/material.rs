@@ -262,6 +262,25 @@ fn tangent_frame(n: Vec3, dpdu: Vec3) -> Frame {
     }
 }
 
+/// The shading frame of a leaf's lobe at unit normal `n` seen from `wo`: around `n`, turned
+/// towards `wo` where the leaf is two-sided and `wo` is below; or, where `tangent` (an
+/// anisotropic lobe, or a normal map's), its x axis along `dpdu` projected off `n`, and on a
+/// two-sided leaf's back side only its z mirrored (as Mitsuba does). The one-path BSDF and
+/// the path tracer's lanes both take their frames from here.
+#[inline]
+pub fn leaf_frame(n: Vec3, dpdu: Vec3, two_sided: bool, wo: Vec3, tangent: bool) -> Frame {
+    let side = if two_sided && wo.dot(n) < 0.0 { -n } else { n };
+    if tangent {
+        let mut f = tangent_frame(n, dpdu);
+        if side != n {
+            f.n = -f.n;
+        }
+        f
+    } else {
+        Frame::from_normal(side)
+    }
+}
+
 /// The lobes a material tree gathers at a point, in order: those of positive weight, the
 /// first [`MAX_LOBES`] of them (a BSDF holds no more), on the stack.
 #[derive(Default)]
@@ -302,15 +321,27 @@ fn merged_diffuse(wa: f32, a: Diffuse, wb: f32, b: Diffuse) -> (f32, Diffuse) {
     (w, Diffuse { reflectance })
 }
 
-/// A lobe the path tracer's lanes shade together ([`Material::lane_bxdf`]).
+/// A lobe the path tracer's lanes shade together ([`Material::lane_bxdf`]), its sidedness,
+/// and whether its frame follows the surface's tangent ([`leaf_frame`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LaneLobe {
+    /// The lobe.
+    pub bxdf: LaneBxdf,
+    /// Whether the material is two-sided.
+    pub two_sided: bool,
+    /// Whether its frame's x axis follows ∂p/∂u (anisotropic roughness).
+    pub tangent_frame: bool,
+}
+
+/// A lobe's model in the path tracer's lanes ([`LaneLobe`]).
 #[derive(Clone, Copy, Debug)]
 pub enum LaneBxdf {
     /// Lambertian.
     Diffuse(Diffuse),
-    /// A rough conductor of GGX or Beckmann normals of one roughness.
-    Conductor(RoughConductor<Rgb, IsotropicMicrofacet<f32>>),
-    /// Rough glass of GGX or Beckmann normals of one roughness.
-    RoughDielectric(RoughDielectric<f32, Rgb, IsotropicMicrofacet<f32>>),
+    /// A rough conductor of GGX or Beckmann normals, of one roughness or anisotropic.
+    Conductor(RoughConductor<Rgb, Microfacet>),
+    /// Rough glass of GGX or Beckmann normals, of one roughness or anisotropic.
+    RoughDielectric(RoughDielectric),
     /// A perfect mirror.
     Mirror(Mirror),
     /// A smooth conductor.
@@ -340,47 +371,50 @@ impl Material {
         }
     }
 
-    /// The lobe and sidedness of a material of one lobe that the path tracer's lanes shade
-    /// together, its textures read at `tex`: Lambertian, a rough conductor or rough glass of
-    /// GGX or Beckmann normals of one roughness, a mirror, a smooth conductor, or smooth glass
-    /// of exact Fresnel reflectance; or a blend of two Lambertian materials, which is one
-    /// Lambertian lobe. Textured models are evaluated (as [`Material::bsdf`] evaluates them)
-    /// only where they may give one of those: diffuse, and conductors and glass (the same
-    /// roughness along u and v gives a lane lobe).
+    /// The lobe of a material of one lobe that the path tracer's lanes shade together, its
+    /// textures read at `tex`: Lambertian, a rough conductor or rough glass of GGX or Beckmann
+    /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, or smooth glass
+    /// of exact Fresnel reflectance; or a blend of
+    /// two Lambertian materials, which is one Lambertian lobe. Textured models are evaluated
+    /// (as [`Material::bsdf`] evaluates them) only where they may give one of those: diffuse,
+    /// conductors and glass.
     #[inline]
-    pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<(LaneBxdf, bool)> {
+    pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<LaneLobe> {
         let Material::Leaf(Leaf { model, two_sided }) = self else {
             return self.lane_blend(tex);
         };
-        let bxdf = match model {
-            Model::Fixed(bxdf) => *bxdf,
+        // Borrowed where the model is fixed: a `Bxdf` is large, and only its lobe is taken.
+        let textured;
+        let (bxdf, tangent_frame) = match model {
+            Model::Fixed(bxdf) => (bxdf, false),
             Model::Diffuse { .. } | Model::Conductor { .. } | Model::Dielectric { .. } => {
-                match model.bxdf(&tex()) {
-                    (bxdf, false) => bxdf,
-                    // Anisotropic: its frame follows the surface's tangent.
-                    (_, true) => return None,
-                }
+                textured = model.bxdf(&tex());
+                (&textured.0, textured.1)
             }
             _ => return None,
         };
         let lobe = match bxdf {
-            Bxdf::Diffuse(d) => LaneBxdf::Diffuse(d),
+            Bxdf::Diffuse(d) => LaneBxdf::Diffuse(*d),
             Bxdf::Conductor(c) => match c.as_smooth() {
                 Some(smooth) => LaneBxdf::SmoothConductor(smooth),
-                None => LaneBxdf::Conductor(c.as_isotropic()?),
+                None => LaneBxdf::Conductor(c.rough()?),
             },
-            Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(d.as_isotropic()?),
-            Bxdf::Mirror(m) => LaneBxdf::Mirror(m),
-            Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(d),
+            Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(*d),
+            Bxdf::Mirror(m) => LaneBxdf::Mirror(*m),
+            Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(*d),
             _ => return None,
         };
-        Some((lobe, *two_sided))
+        Some(LaneLobe {
+            bxdf: lobe,
+            two_sided: *two_sided,
+            tangent_frame,
+        })
     }
 
     /// [`Material::lane_bxdf`] of a blend of two Lambertian materials of one sidedness: the
     /// one Lambertian lobe [`Material::collect`] merges them into (`LobeList::push`), or none
     /// for any other material.
-    fn lane_blend<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<(LaneBxdf, bool)> {
+    fn lane_blend<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<LaneLobe> {
         let Material::Blend(weight, ab) = self else {
             return None;
         };
@@ -404,7 +438,11 @@ impl Material {
             (_, wb) if wb > 0.0 => db,
             _ => return None,
         };
-        Some((LaneBxdf::Diffuse(d), a.two_sided))
+        Some(LaneLobe {
+            bxdf: LaneBxdf::Diffuse(d),
+            two_sided: a.two_sided,
+            tangent_frame: false,
+        })
     }
 
     /// Whether evaluating the material may read a texture at the surface's (u, v): every
@@ -488,22 +526,9 @@ impl Material {
         }
         match self {
             Material::Leaf(leaf) => {
-                let n = if leaf.two_sided && wo.dot(at.n) < 0.0 {
-                    -at.n
-                } else {
-                    at.n
-                };
                 let (bxdf, anisotropic) = leaf.model.bxdf(&p.tex);
-                let frame = if anisotropic || at.guard.is_some() {
-                    let mut f = tangent_frame(at.n, at.dpdu);
-                    if n != at.n {
-                        // The back side: Mitsuba mirrors the local z only.
-                        f.n = -f.n;
-                    }
-                    f
-                } else {
-                    Frame::from_normal(n)
-                };
+                let tangent = anisotropic || at.guard.is_some();
+                let frame = leaf_frame(at.n, at.dpdu, leaf.two_sided, wo, tangent);
                 lobes.push(Lobe {
                     weight,
                     frame,

@@ -18,7 +18,7 @@
 //! the one-direction functions, in the Beckmann lanes only ([`Real::map2_where`]).
 
 use glam::{Vec2, Vec3};
-use pathlab_mc::simd::lanes::{Real, Vector3};
+use pathlab_mc::simd::lanes::{Real, Vector3, F8, M8, V8, W};
 use pathlab_mc::warp::uniform_disk_concentric;
 use std::f32::consts::{PI, TAU};
 
@@ -328,6 +328,113 @@ impl Distribution<f32> for Microfacet {
     #[inline]
     fn sample_wm(&self, wo: Vec3, u0: f32, u1: f32) -> Vec3 {
         Microfacet::sample_wm(self, wo, Vec2::new(u0, u1))
+    }
+}
+
+/// Eight lanes' distributions, any [`Microfacet`] in each: the lanes of one roughness in every
+/// direction in SIMD registers ([`IsotropicMicrofacet`]), and the `anisotropic` lanes by their
+/// own [`Microfacet`]'s functions, one lane at a time, written over what the SIMD functions
+/// computed there. Every lane gets what its [`Microfacet`] computes, to the bit; the
+/// anisotropic functions exist once, in [`Microfacet`].
+#[derive(Clone, Copy, Debug)]
+pub struct MicrofacetLanes {
+    /// The lanes' roughness and kind (an anisotropic lane's roughness along x and GGX, so that
+    /// the SIMD functions, whose results it discards, compute on a roughness it has).
+    isotropic: IsotropicMicrofacet<F8>,
+    /// Lanes whose distribution's roughness differs along x and y.
+    anisotropic: M8,
+    /// Each anisotropic lane's distribution.
+    each: [Microfacet; W],
+}
+
+impl Default for MicrofacetLanes {
+    fn default() -> Self {
+        MicrofacetLanes {
+            isotropic: IsotropicMicrofacet::default(),
+            anisotropic: M8::default(),
+            each: [Microfacet::new(NormalDistribution::Ggx, 1.0); W],
+        }
+    }
+}
+
+impl MicrofacetLanes {
+    /// Sets lane `i` to `m`.
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, m: Microfacet) {
+        let iso = match m.as_isotropic() {
+            Some(iso) => iso,
+            None => {
+                self.each[i] = m;
+                // GGX there, whatever the lane's kind: Beckmann's functions go one lane at a
+                // time, and their results would be written over.
+                IsotropicMicrofacet {
+                    alpha: m.alpha,
+                    beckmann: false,
+                }
+            }
+        };
+        // Every field taken apart: a field added to `IsotropicMicrofacet` fails to compile
+        // until its lanes are set too.
+        let IsotropicMicrofacet { alpha, beckmann } = iso;
+        self.anisotropic.set(i, !m.is_isotropic());
+        self.isotropic.alpha.0[i] = alpha;
+        self.isotropic.beckmann.set(i, beckmann);
+    }
+
+    /// Computes the functions that go one lane at a time (Beckmann's, anisotropic
+    /// distributions') only in the lanes `lanes`: the others' results are not wanted.
+    #[inline(always)]
+    pub fn only_in(&mut self, lanes: M8) {
+        self.isotropic.beckmann = self.isotropic.beckmann & lanes;
+        self.anisotropic = self.anisotropic & lanes;
+    }
+
+    /// `simd`, its anisotropic lanes written over by `one` of their distribution and lane.
+    #[inline(always)]
+    fn with_anisotropic<T>(&self, mut simd: T, one: impl Fn(&mut T, usize, &Microfacet)) -> T {
+        if self.anisotropic.any() {
+            self.overwrite_anisotropic(&mut simd, one);
+        }
+        simd
+    }
+
+    /// [`MicrofacetLanes::with_anisotropic`]'s loop over the lanes, out of line: inlined, it
+    /// would make the SIMD functions around it too large to be inlined themselves.
+    #[inline(never)]
+    fn overwrite_anisotropic<T>(&self, simd: &mut T, one: impl Fn(&mut T, usize, &Microfacet)) {
+        for (i, m) in self.each.iter().enumerate() {
+            if self.anisotropic.get(i) {
+                one(simd, i, m);
+            }
+        }
+    }
+}
+
+impl Distribution<F8> for MicrofacetLanes {
+    #[inline(always)]
+    fn d(&self, wm: V8) -> F8 {
+        let simd = self.isotropic.d(wm);
+        self.with_anisotropic(simd, |r, i, m| r.0[i] = m.d(wm.get(i)))
+    }
+
+    #[inline(always)]
+    fn lambda(&self, w: V8) -> F8 {
+        let simd = self.isotropic.lambda(w);
+        self.with_anisotropic(simd, |r, i, m| r.0[i] = m.lambda(w.get(i)))
+    }
+
+    #[inline(always)]
+    fn pdf_wm(&self, wo: V8, wm: V8) -> F8 {
+        let simd = self.isotropic.pdf_wm(wo, wm);
+        self.with_anisotropic(simd, |r, i, m| r.0[i] = m.pdf_wm(wo.get(i), wm.get(i)))
+    }
+
+    #[inline(always)]
+    fn sample_wm(&self, wo: V8, u0: F8, u1: F8) -> V8 {
+        let simd = self.isotropic.sample_wm(wo, u0, u1);
+        self.with_anisotropic(simd, |r, i, m| {
+            r.set(i, m.sample_wm(wo.get(i), Vec2::new(u0.0[i], u1.0[i])))
+        })
     }
 }
 

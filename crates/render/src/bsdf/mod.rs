@@ -39,8 +39,10 @@ pub use diffuse::Diffuse;
 pub use diffuse_transmission::DiffuseTransmission;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 pub use layered::{Base, Coat, LayerMedium, LayerStack, Layered};
-pub use material::{LaneBxdf, Leaf, Material, Model, ShadingPoint};
-pub use microfacet::{Distribution, IsotropicMicrofacet, Microfacet, NormalDistribution};
+pub use material::{leaf_frame, LaneBxdf, LaneLobe, Leaf, Material, Model, ShadingPoint};
+pub use microfacet::{
+    Distribution, IsotropicMicrofacet, Microfacet, MicrofacetLanes, NormalDistribution,
+};
 pub use mirror::Mirror;
 pub use mixture::{Bsdf, BsdfSample, Guard, Lobe, MAX_LOBES};
 pub use plastic::Plastic;

@@ -1,10 +1,9 @@
 //! A rough dielectric interface: microfacet reflection and transmission (Walter et al. 2007),
-//! written once for one direction and for eight lanes (GGX or Beckmann of one roughness
-//! there).
+//! written once for one direction and for eight lanes.
 
 use super::bxdf::DirectionSample;
 use super::fresnel::fresnel_dielectric_real;
-use super::microfacet::{Distribution, IsotropicMicrofacet, Microfacet};
+use super::microfacet::{Distribution, Microfacet, MicrofacetLanes};
 use super::scattering::{reflect, refract_about_real, relative_eta};
 use super::{Lobes, LocalSample};
 use crate::desc::Rgb;
@@ -19,7 +18,7 @@ use pathlab_mc::simd::lanes::{Real, Vector3, F8, V8};
 /// with probability F(wo·wm) and refraction otherwise.
 ///
 /// `R`, `V` and `M` are the number, colour and distribution types: `f32`, [`Rgb`] and
-/// [`Microfacet`] for one direction, or [`F8`], [`V8`] and `IsotropicMicrofacet<F8>` for eight
+/// [`Microfacet`] for one direction, or [`F8`], [`V8`] and [`MicrofacetLanes`] for eight
 /// lanes (the path tracer's).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RoughDielectric<R = f32, V = Rgb, M = Microfacet> {
@@ -62,18 +61,6 @@ fn half_vector<V: Vector3>(wo: V, wi: V, eta: V::R) -> (V, V::R, MaskOf<V>, Mask
 }
 
 impl RoughDielectric {
-    /// The same model with a distribution of one roughness, where it has one: the
-    /// model the path tracer's lanes shade together, with the same functions.
-    #[inline]
-    pub fn as_isotropic(&self) -> Option<RoughDielectric<f32, Rgb, IsotropicMicrofacet<f32>>> {
-        Some(RoughDielectric {
-            eta: self.eta,
-            distribution: self.distribution.as_isotropic()?,
-            reflectance: self.reflectance,
-            transmittance: self.transmittance,
-        })
-    }
-
     /// f(wo, wi).
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
         self.f_and_pdf(wo, wi, Lobes::All).0
@@ -183,20 +170,19 @@ where
     }
 }
 
-impl RoughDielectric<F8, V8, IsotropicMicrofacet<F8>> {
+impl RoughDielectric<F8, V8, MicrofacetLanes> {
     /// Sets lane `i` to `d`. Every field is taken apart here: a field added to
-    /// [`RoughDielectric`] or [`IsotropicMicrofacet`] fails to compile until its lanes are set too.
+    /// [`RoughDielectric`] fails to compile until its lanes are set too.
     #[inline(always)]
-    pub fn set_lane(&mut self, i: usize, d: RoughDielectric<f32, Rgb, IsotropicMicrofacet<f32>>) {
+    pub fn set_lane(&mut self, i: usize, d: RoughDielectric) {
         let RoughDielectric {
             eta,
-            distribution: IsotropicMicrofacet { alpha, beckmann },
+            distribution,
             reflectance,
             transmittance,
         } = d;
         self.eta.0[i] = eta;
-        self.distribution.alpha.0[i] = alpha;
-        self.distribution.beckmann.set(i, beckmann);
+        self.distribution.set_lane(i, distribution);
         self.reflectance.set(i, reflectance);
         self.transmittance.set(i, transmittance);
     }
@@ -209,7 +195,8 @@ mod tests {
 
     /// Eight lanes of rough glass compute, lane by lane, what the one-direction model computes
     /// (through [`Microfacet`]), to the bit: f, the density and the sample for each choice of
-    /// lobes, from both sides, for reflected, refracted and opposite pairs.
+    /// lobes, from both sides, for reflected, refracted and opposite pairs, with distributions
+    /// of one roughness and anisotropic ones.
     #[test]
     fn lanes_compute_what_one_direction_computes() {
         let mut rng = Pcg32::new(4, 8);
@@ -222,21 +209,27 @@ mod tests {
         let mut valid = [0; 3];
         for round in 0..600 {
             let lobes = [Lobes::All, Lobes::Reflection, Lobes::Transmission][round % 3];
-            let mut lanes = RoughDielectric::<F8, V8, IsotropicMicrofacet<F8>>::default();
+            let mut lanes = RoughDielectric::<F8, V8, MicrofacetLanes>::default();
             let (mut wo, mut wi) = (V8::default(), V8::default());
             let (mut uc, mut u0, mut u1) = (F8::default(), F8::default(), F8::default());
             let mut one = Vec::new();
             for i in 0..8 {
+                let (kind, alpha) = (
+                    crate::bsdf::conductor::tests::lane_kind(round / 3, i),
+                    [0.01, 0.1, 0.3, 0.8, 1.5][(round + i) % 5],
+                );
                 let d = RoughDielectric {
                     eta: [1.5, 1.0 / 1.33, 2.4, 1.0001][(round / 3 + i) % 4],
-                    distribution: Microfacet::new(
-                        crate::bsdf::conductor::tests::lane_kind(round / 3, i),
-                        [0.01, 0.1, 0.3, 0.8, 1.5][(round + i) % 5],
-                    ),
+                    // Every fourth round, every third lane anisotropic.
+                    distribution: if round % 4 == 3 && i % 3 == 0 {
+                        Microfacet::anisotropic(kind, alpha, 0.3 * alpha + 0.05)
+                    } else {
+                        Microfacet::new(kind, alpha)
+                    },
                     reflectance: Vec3::new(1.0, rng.uniform_f32(), 0.5),
                     transmittance: Vec3::new(rng.uniform_f32(), 1.0, 0.9),
                 };
-                lanes.set_lane(i, d.as_isotropic().expect("isotropic"));
+                lanes.set_lane(i, d);
                 let (o, mut w) = (direction(&mut rng), direction(&mut rng));
                 match round % 7 {
                     0 => w = -o,

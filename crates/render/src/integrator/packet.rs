@@ -11,11 +11,15 @@
 //! for every lane and bounce, except where a lane's material is one lobe of those the lanes
 //! shade ([`Material::lane_bxdf`]: Lambertian, or a blend of two Lambertian materials, which
 //! is one Lambertian lobe; a mirror; smooth conductors and glass; rough GGX or Beckmann
-//! conductors and glass). There the lanes are shaded together in SIMD
-//! registers by the same functions the one-path code calls, instantiated on eight lanes (the
-//! BSDFs: [`Diffuse`], [`RoughConductor`], [`RoughDielectric`], [`Mirror`],
+//! conductors and glass, of one roughness or anisotropic). There the lanes
+//! are shaded together in SIMD registers by the same functions the one-path code calls,
+//! instantiated on eight lanes (the BSDFs: [`Diffuse`], [`RoughConductor`],
+//! [`RoughDielectric`] (an anisotropic lane's distribution by its own functions, one lane at
+//! a time: [`MicrofacetLanes`]), [`Mirror`],
 //! [`SmoothConductor`], [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
-//! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`], [`offset_ray_origin`],
+//! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`] (or, for an
+//! anisotropic lobe, the frame along the surface's tangent that [`leaf_frame`] gives each
+//! lane), [`offset_ray_origin`],
 //! [`power_heuristic_weight`]; see `scatter_lanes`): this module holds only the scheduling
 //! and the masks that stand for the one-path code's early returns. Emitting triangles and
 //! environment maps are sampled in the lanes; any other light (points, spots, directional
@@ -37,7 +41,7 @@ use super::{
 use crate::accel::RayLanes;
 use crate::bsdf::bxdf::DirectionSample;
 use crate::bsdf::{
-    DielectricLanes, Diffuse, IsotropicMicrofacet, LaneBxdf, Lobes, Material, Mirror,
+    leaf_frame, DielectricLanes, Diffuse, LaneBxdf, Lobes, Material, MicrofacetLanes, Mirror,
     RoughConductor, RoughDielectric, SmoothConductor,
 };
 use crate::desc::{RayKind, Rgb};
@@ -61,12 +65,15 @@ struct ScatterIn {
     /// `mirror`; `smooth_metal`, a smooth conductor; `glass`; the others' is `diffuse`.
     lobes: LobeLanes,
     diffuse: Diffuse<V8>,
-    metal: RoughConductor<V8, IsotropicMicrofacet<F8>>,
-    rough_glass: RoughDielectric<F8, V8, IsotropicMicrofacet<F8>>,
+    metal: RoughConductor<V8, MicrofacetLanes>,
+    rough_glass: RoughDielectric<F8, V8, MicrofacetLanes>,
     mirror: Mirror<V8>,
     smooth_metal: SmoothConductor<V8>,
     glass: DielectricLanes,
     two_sided: M8,
+    /// The shading frames of the lanes in `lobes.tangent` ([`leaf_frame`]; the others' frame
+    /// is made in the lanes, around the shading normal).
+    frame: Frame<V8>,
     /// Lanes whose light sample is a point on an emitting triangle.
     light: M8,
     emitter: TriangleEmitter<V8>,
@@ -122,6 +129,9 @@ impl DrawnLights {
 /// Which lanes have which lobe (the rest: Lambertian).
 #[derive(Clone, Copy, Default)]
 struct LobeLanes {
+    /// Lanes whose frame follows the surface's tangent (anisotropic roughness), given in
+    /// [`ScatterIn::frame`].
+    tangent: M8,
     conductor: M8,
     rough_glass: M8,
     smooth_metal: M8,
@@ -179,7 +189,15 @@ struct ScatterOut {
 fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let zero = F8::splat(0.0);
     let flip = a.two_sided & a.wo.dot(a.ns).lt(zero);
-    let frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
+    let mut frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
+    let tangent = a.lobes.tangent;
+    if OTHER_LOBES && tangent.any() {
+        frame = Frame {
+            s: tangent.select3(a.frame.s, frame.s),
+            t: tangent.select3(a.frame.t, frame.t),
+            n: tangent.select3(a.frame.n, frame.n),
+        };
+    }
     let wo_z = a.wo.dot(frame.n);
     // The other lobes' functions take whole local directions (unused, and not computed, in
     // the Lambertian instance).
@@ -302,7 +320,9 @@ fn scatter_avx2<const OTHER_LOBES: bool>(
 /// lane has another lobe or a light sample drawn one lane at a time.
 #[inline]
 fn scatter(a: &ScatterIn, out: &mut ScatterOut) {
-    let other = (a.lobes.conductor | a.lobes.rough_glass | a.lobes.delta | a.drawn.lanes).any();
+    let lobes = &a.lobes;
+    let other =
+        (lobes.conductor | lobes.rough_glass | lobes.delta | lobes.tangent | a.drawn.lanes).any();
     if other {
         return scatter_other_lobes(a, out);
     }
@@ -426,7 +446,7 @@ impl PathIntegrator {
                         a.diffuse.set_lane(i, diffuse);
                         two_sided
                     }
-                    None => match gather_lobe(scene, si, material, i, &mut a, stats) {
+                    None => match gather_lobe(scene, si, -st.ray.d, material, i, &mut a, stats) {
                         Some(two_sided) => two_sided,
                         None => {
                             if !self.scatter(scene, st, si, smp, stats) {
@@ -487,11 +507,11 @@ impl PathIntegrator {
             if let Some((_, d)) = &directions {
                 (a.environment, a.environment_wi, a.environment_pdf) = (d.found, d.wi, d.pdf);
             }
-            // Beckmann's functions, computed lane by lane, only where a lane has the lobe
-            // now (a lane keeps its lobe's fields from an earlier pass).
-            a.metal.distribution.beckmann = a.metal.distribution.beckmann & a.lobes.conductor;
-            a.rough_glass.distribution.beckmann =
-                a.rough_glass.distribution.beckmann & a.lobes.rough_glass;
+            // The distributions' functions computed lane by lane (Beckmann's, anisotropic
+            // ones) only where a lane has the lobe now (a lane keeps its lobe's fields from an
+            // earlier pass).
+            a.metal.distribution.only_in(a.lobes.conductor);
+            a.rough_glass.distribution.only_in(a.lobes.rough_glass);
             scatter(&a, &mut b);
             for i in 0..W {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
@@ -722,19 +742,26 @@ fn eval_and_pdf_lanes_avx2(
     map.eval_and_pdf_lanes(w, active)
 }
 
-/// Lane `i`'s lobe at `si` into `a`, where `material` is one the lanes shade together other
-/// than a plain Lambertian one ([`Material::lane_bxdf`]): returns its sidedness, or `None`
-/// for a material the lanes leave to the one-path code.
+/// Lane `i`'s lobe at `si` seen from `wo` into `a`, where `material` is one the lanes shade
+/// together other than a plain Lambertian one ([`Material::lane_bxdf`]): returns its
+/// sidedness, or `None` for a material the lanes leave to the one-path code. A lobe whose
+/// frame follows the surface's tangent gets it here, as the one-path BSDF does
+/// ([`Scene::bsdf`]: the tangent ∂p/∂u, [`leaf_frame`]).
 #[inline(always)]
 fn gather_lobe(
     scene: &Scene,
     si: &SurfaceInteraction,
+    wo: glam::Vec3,
     material: &Material,
     i: usize,
     a: &mut ScatterIn,
     stats: &mut PathStats,
 ) -> Option<bool> {
-    let (lobe, two_sided) = material.lane_bxdf(|| scene.tex_point(si))?;
+    let lane = material.lane_bxdf(|| scene.tex_point(si))?;
+    let (lobe, two_sided) = (lane.bxdf, lane.two_sided);
+    if lane.tangent_frame {
+        gather_tangent_frame(scene, si, wo, two_sided, i, a);
+    }
     // As `scatter` counts a vertex whose BSDF is not black: every lobe but a black diffuse one.
     let black = matches!(lobe, LaneBxdf::Diffuse(d) if d.reflectance.max_element() <= 0.0);
     stats.random_vertices += u64::from(!black);
@@ -765,6 +792,25 @@ fn gather_lobe(
         }
     }
     Some(two_sided)
+}
+
+/// Lane `i`'s frame along the surface's tangent at `si` seen from `wo` into `a`
+/// ([`gather_lobe`]'s rarer case, out of line).
+#[inline(never)]
+fn gather_tangent_frame(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    wo: glam::Vec3,
+    two_sided: bool,
+    i: usize,
+    a: &mut ScatterIn,
+) {
+    let (dpdu, _) = scene.tangents(si);
+    let frame = leaf_frame(si.ns, dpdu, two_sided, wo, true);
+    a.frame.s.set(i, frame.s);
+    a.frame.t.set(i, frame.t);
+    a.frame.n.set(i, frame.n);
+    a.lobes.tangent.set(i, true);
 }
 
 /// How a lane's light sample is taken.
