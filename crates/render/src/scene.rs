@@ -256,22 +256,25 @@ impl Scene {
     /// The BSDF at a surface point seen from `wo`.
     #[inline]
     pub fn bsdf(&self, si: &SurfaceInteraction, wo: Vec3) -> crate::bsdf::Bsdf {
-        let m = &self.materials[si.material as usize];
+        self.materials[si.material as usize].bsdf(&self.shading_point(si), wo)
+    }
+
+    /// What a material reads at `si`: the shading and geometric normals, the tangents where
+    /// the material needs them (zero otherwise), and where textures are read.
+    #[inline]
+    pub fn shading_point(&self, si: &SurfaceInteraction) -> ShadingPoint<'_> {
         let (dpdu, dpdv) = if self.needs_tangents[si.material as usize] {
             self.tangents(si)
         } else {
             (Vec3::ZERO, Vec3::ZERO)
         };
-        m.bsdf(
-            &ShadingPoint {
-                n: si.ns,
-                dpdu,
-                dpdv,
-                ng: si.ng,
-                tex: self.tex_point(si),
-            },
-            wo,
-        )
+        ShadingPoint {
+            n: si.ns,
+            dpdu,
+            dpdv,
+            ng: si.ng,
+            tex: self.tex_point(si),
+        }
     }
 
     /// ∂p/∂u and ∂p/∂v at `si` (pathlab's (u, v)): from a triangle's texture coordinates

@@ -383,6 +383,81 @@ fn with_blends(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with normal and bump maps: a normal map over the floor's diffuse material; over an
+/// anisotropic rough conductor, a mirror and a two-sided diffuse material (on spheres), all
+/// shaded in the lanes; a bump map over a diffuse sphere (in the lanes); and a normal map over
+/// a blend of diffuse and conductor (one lane at a time).
+fn with_maps(mut desc: SceneDesc) -> SceneDesc {
+    let normals = |scale: f32| TextureDesc::Bilerp {
+        corners: [
+            Vec3::new(0.7, 0.5, 0.9),
+            Vec3::new(0.3, 0.6, 0.8),
+            Vec3::new(0.5, 0.2, 0.7),
+            Vec3::new(0.5, 0.5, 1.0),
+        ],
+        to_uv: glam::Affine2::from_scale(glam::Vec2::splat(scale)),
+    };
+    let normal_map = |inner, scale| MaterialDesc::NormalMap {
+        normals: normals(scale),
+        inner: Box::new(inner),
+    };
+    let diffuse = |r: Vec3, two_sided| MaterialDesc::Diffuse {
+        reflectance: r,
+        two_sided,
+    };
+    let metal = MaterialDesc::RoughConductor {
+        alpha_u: TextureDesc::Constant(Vec3::splat(0.25)),
+        alpha_v: TextureDesc::Constant(Vec3::splat(0.05)),
+        eta: Vec3::new(0.2, 0.9, 1.1),
+        k: Vec3::new(3.9, 2.4, 2.2),
+        specular: TextureDesc::Constant(Vec3::ONE),
+        distribution: NormalDistribution::Ggx,
+    };
+    desc.materials[0] = normal_map(diffuse(Vec3::new(0.6, 0.5, 0.4), false), 1.0);
+    let first = desc.materials.len();
+    desc.materials.extend([
+        normal_map(metal.clone(), 3.0),
+        normal_map(
+            MaterialDesc::Mirror {
+                reflectance: Vec3::new(0.9, 0.8, 0.7),
+            },
+            2.0,
+        ),
+        normal_map(diffuse(Vec3::new(0.2, 0.7, 0.3), true), 4.0),
+        MaterialDesc::BumpMap {
+            height: normals(5.0),
+            scale: 0.05,
+            inner: Box::new(diffuse(Vec3::new(0.8, 0.8, 0.2), false)),
+        },
+        normal_map(
+            MaterialDesc::Blend {
+                weight: TextureDesc::Constant(Vec3::splat(0.5)),
+                first: Box::new(diffuse(Vec3::new(0.5, 0.5, 0.9), false)),
+                second: Box::new(metal),
+            },
+            2.0,
+        ),
+    ]);
+    for (k, (x, z)) in [
+        (-0.5, 0.4),
+        (0.45, -0.3),
+        (0.1, 0.5),
+        (-0.3, -0.4),
+        (0.6, 0.4),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        desc.spheres.push(SphereDesc {
+            center: Vec3::new(x, 0.16, z),
+            radius: 0.16,
+            material: first + k,
+            ..Default::default()
+        });
+    }
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -392,7 +467,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // everything else with the scalar code (rough conductors, anisotropic ones included, and
     // glass of one roughness, mirrors, smooth conductors and glass go through the lanes too,
     // textured or not, in the scenes `with_metals`, `with_smooth_lobes` and `with_textures`;
-    // blends of two diffuse materials in `with_blends`): every sample's radiance
+    // blends of two diffuse materials in `with_blends`; those lobes under normal and bump
+    // maps in `with_maps`): every sample's radiance
     // must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
@@ -421,6 +497,9 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         ),
         (with_blends(mixed_scene()), false),
         (under_a_sky(with_blends(mixed_scene())), false),
+        (with_maps(mixed_scene()), false),
+        (under_a_sky(with_maps(mixed_scene())), false),
+        (with_more_lights(with_maps(mixed_scene())), false),
     ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);

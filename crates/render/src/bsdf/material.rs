@@ -219,6 +219,16 @@ struct Local {
 }
 
 impl Local {
+    /// The frame at the top of a material's tree at `p`.
+    fn at(p: &ShadingPoint) -> Local {
+        Local {
+            n: p.n,
+            dpdu: p.dpdu,
+            dpdv: p.dpdv,
+            guard: None,
+        }
+    }
+
     /// The frame a normal or bump map makes from `n_local`, the perturbed normal in this
     /// frame's tangent coordinates (unnormalised), as Mitsuba's perturbed BSDFs make it: a
     /// normal that `wo` sees from behind is mirrored about this normal (Schüssler et al.
@@ -322,15 +332,20 @@ fn merged_diffuse(wa: f32, a: Diffuse, wb: f32, b: Diffuse) -> (f32, Diffuse) {
 }
 
 /// A lobe the path tracer's lanes shade together ([`Material::lane_bxdf`]), its sidedness,
-/// and whether its frame follows the surface's tangent ([`leaf_frame`]).
+/// its frame where that is not the one around the shading normal, and a normal or bump map's
+/// guard: what [`Material::bsdf`] makes of a material of that one lobe.
 #[derive(Clone, Copy, Debug)]
 pub struct LaneLobe {
     /// The lobe.
     pub bxdf: LaneBxdf,
     /// Whether the material is two-sided.
     pub two_sided: bool,
-    /// Whether its frame's x axis follows ∂p/∂u (anisotropic roughness).
-    pub tangent_frame: bool,
+    /// Its frame where that follows the surface's tangent ([`leaf_frame`]: anisotropic
+    /// roughness, or a normal or bump map's frame); `None`: the frame around the shading
+    /// normal, turned towards wo on a two-sided material's back side.
+    pub frame: Option<Frame>,
+    /// A normal or bump map's guard.
+    pub guard: Option<Guard>,
 }
 
 /// A lobe's model in the path tracer's lanes ([`LaneLobe`]).
@@ -348,6 +363,48 @@ pub enum LaneBxdf {
     SmoothConductor(SmoothConductor<Rgb>),
     /// Smooth glass of exact Fresnel reflectance.
     Dielectric(SmoothDielectric),
+}
+
+impl LaneBxdf {
+    /// The lane lobe `bxdf` is, where it is one.
+    #[inline]
+    fn of(bxdf: &Bxdf) -> Option<LaneBxdf> {
+        Some(match bxdf {
+            Bxdf::Diffuse(d) => LaneBxdf::Diffuse(*d),
+            Bxdf::Conductor(c) => match c.as_smooth() {
+                Some(smooth) => LaneBxdf::SmoothConductor(smooth),
+                None => LaneBxdf::Conductor(c.rough()?),
+            },
+            Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(*d),
+            Bxdf::Mirror(m) => LaneBxdf::Mirror(*m),
+            Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(*d),
+            _ => return None,
+        })
+    }
+}
+
+impl Leaf {
+    /// [`Material::lane_bxdf`] of this leaf at `p` in the frame `at` (perhaps a normal or bump
+    /// map's), seen from `wo`: the lobe, frame and guard [`Material::collect`] gives it.
+    fn lane_lobe(&self, p: &ShadingPoint, at: &Local, wo: Vec3) -> Option<LaneLobe> {
+        // Borrowed where the model is fixed: a `Bxdf` is large, and only its lobe is taken.
+        let textured;
+        let (bxdf, anisotropic) = match &self.model {
+            Model::Fixed(bxdf) => (bxdf, false),
+            Model::Diffuse { .. } | Model::Conductor { .. } | Model::Dielectric { .. } => {
+                textured = self.model.bxdf(&p.tex);
+                (&textured.0, textured.1)
+            }
+            _ => return None,
+        };
+        let tangent = anisotropic || at.guard.is_some();
+        Some(LaneLobe {
+            bxdf: LaneBxdf::of(bxdf)?,
+            two_sided: self.two_sided,
+            frame: tangent.then(|| leaf_frame(at.n, at.dpdu, self.two_sided, wo, true)),
+            guard: at.guard,
+        })
+    }
 }
 
 impl Material {
@@ -371,44 +428,59 @@ impl Material {
         }
     }
 
-    /// The lobe of a material of one lobe that the path tracer's lanes shade together, its
-    /// textures read at `tex`: Lambertian, a rough conductor or rough glass of GGX or Beckmann
-    /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, or smooth glass
-    /// of exact Fresnel reflectance; or a blend of
-    /// two Lambertian materials, which is one Lambertian lobe. Textured models are evaluated
-    /// (as [`Material::bsdf`] evaluates them) only where they may give one of those: diffuse,
+    /// The lobe of a material of one lobe that the path tracer's lanes shade together, at
+    /// the point `point` gives (asked for only where the material reads textures or tangents)
+    /// seen from `wo`: Lambertian, a rough conductor or rough glass of GGX or Beckmann normals
+    /// (of one roughness or anisotropic), a mirror, a smooth conductor, or smooth glass of
+    /// exact Fresnel reflectance; one of those under a normal or bump map; or a blend of two
+    /// Lambertian materials, which is one Lambertian lobe. Textured models are evaluated (as
+    /// [`Material::bsdf`] evaluates them) only where they may give one of those: diffuse,
     /// conductors and glass.
     #[inline]
-    pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<LaneLobe> {
-        let Material::Leaf(Leaf { model, two_sided }) = self else {
-            return self.lane_blend(tex);
-        };
-        // Borrowed where the model is fixed: a `Bxdf` is large, and only its lobe is taken.
-        let textured;
-        let (bxdf, tangent_frame) = match model {
-            Model::Fixed(bxdf) => (bxdf, false),
-            Model::Diffuse { .. } | Model::Conductor { .. } | Model::Dielectric { .. } => {
-                textured = model.bxdf(&tex());
-                (&textured.0, textured.1)
+    pub fn lane_bxdf<'a>(
+        &self,
+        point: impl FnOnce() -> ShadingPoint<'a>,
+        wo: Vec3,
+    ) -> Option<LaneLobe> {
+        match self {
+            Material::Leaf(Leaf {
+                model: Model::Fixed(bxdf),
+                two_sided,
+            }) => Some(LaneLobe {
+                bxdf: LaneBxdf::of(bxdf)?,
+                two_sided: *two_sided,
+                frame: None,
+                guard: None,
+            }),
+            _ => self.lane_bxdf_general(point, wo),
+        }
+    }
+
+    /// [`Material::lane_bxdf`] of a material that reads its shading point (textured, a blend,
+    /// a normal or bump map): out of line, so that the fixed models' case stays small where
+    /// it is inlined.
+    #[inline(never)]
+    fn lane_bxdf_general<'a>(
+        &self,
+        point: impl FnOnce() -> ShadingPoint<'a>,
+        wo: Vec3,
+    ) -> Option<LaneLobe> {
+        match self {
+            Material::Leaf(leaf) => {
+                let p = point();
+                leaf.lane_lobe(&p, &Local::at(&p), wo)
             }
-            _ => return None,
-        };
-        let lobe = match bxdf {
-            Bxdf::Diffuse(d) => LaneBxdf::Diffuse(*d),
-            Bxdf::Conductor(c) => match c.as_smooth() {
-                Some(smooth) => LaneBxdf::SmoothConductor(smooth),
-                None => LaneBxdf::Conductor(c.rough()?),
-            },
-            Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(*d),
-            Bxdf::Mirror(m) => LaneBxdf::Mirror(*m),
-            Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(*d),
-            _ => return None,
-        };
-        Some(LaneLobe {
-            bxdf: lobe,
-            two_sided: *two_sided,
-            tangent_frame,
-        })
+            Material::Blend(..) => self.lane_blend(|| point().tex),
+            Material::NormalMap(..) | Material::BumpMap(..) => {
+                let p = point();
+                let (at, inner) = self.perturbation(&p, &Local::at(&p), wo)?;
+                match inner {
+                    Material::Leaf(leaf) => leaf.lane_lobe(&p, &at, wo),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
     }
 
     /// [`Material::lane_bxdf`] of a blend of two Lambertian materials of one sidedness: the
@@ -441,7 +513,8 @@ impl Material {
         Some(LaneLobe {
             bxdf: LaneBxdf::Diffuse(d),
             two_sided: a.two_sided,
-            tangent_frame: false,
+            frame: None,
+            guard: None,
         })
     }
 
@@ -512,6 +585,31 @@ impl Material {
         Bsdf::mixture(first, rest, null)
     }
 
+    /// A normal or bump map's frame for its inner material at `p` (the frame `at` there)
+    /// seen from `wo`, and that material; `None` for any other material.
+    fn perturbation(&self, p: &ShadingPoint, at: &Local, wo: Vec3) -> Option<(Local, &Material)> {
+        match self {
+            Material::NormalMap(map, inner) => {
+                let n_local = map.eval(&p.tex) * 2.0 - Rgb::ONE;
+                Some((at.perturbed(n_local, wo), inner))
+            }
+            Material::BumpMap(height, scale, inner) => {
+                // Mitsuba's bumpmap: the tangents displaced by the height's gradient (its
+                // v grows the other way: pathlab's ∂/∂v and ∂p/∂v are its negatives).
+                let g = height.grad_float(&p.tex) * *scale;
+                let dpdu = at.dpdu + at.n * (g.x - at.n.dot(at.dpdu));
+                let dpdv = at.dpdv + at.n * (g.y - at.n.dot(at.dpdv));
+                let mut n = dpdu.cross(dpdv);
+                if n.dot(p.ng) < 0.0 {
+                    n = -n;
+                }
+                let n_local = tangent_frame(at.n, at.dpdu).to_local(n);
+                Some((at.perturbed(n_local, wo), inner))
+            }
+            _ => None,
+        }
+    }
+
     fn collect(
         &self,
         p: &ShadingPoint,
@@ -554,22 +652,10 @@ impl Material {
                     ab.1.collect(p, &flipped, wo, weight, lobes, null);
                 }
             }
-            Material::NormalMap(map, inner) => {
-                let n_local = map.eval(&p.tex) * 2.0 - Rgb::ONE;
-                inner.collect(p, &at.perturbed(n_local, wo), wo, weight, lobes, null);
-            }
-            Material::BumpMap(height, scale, inner) => {
-                // Mitsuba's bumpmap: the tangents displaced by the height's gradient (its
-                // v grows the other way: pathlab's ∂/∂v and ∂p/∂v are its negatives).
-                let g = height.grad_float(&p.tex) * *scale;
-                let dpdu = at.dpdu + at.n * (g.x - at.n.dot(at.dpdu));
-                let dpdv = at.dpdv + at.n * (g.y - at.n.dot(at.dpdv));
-                let mut n = dpdu.cross(dpdv);
-                if n.dot(p.ng) < 0.0 {
-                    n = -n;
+            Material::NormalMap(..) | Material::BumpMap(..) => {
+                if let Some((perturbed, inner)) = self.perturbation(p, at, wo) {
+                    inner.collect(p, &perturbed, wo, weight, lobes, null);
                 }
-                let n_local = tangent_frame(at.n, at.dpdu).to_local(n);
-                inner.collect(p, &at.perturbed(n_local, wo), wo, weight, lobes, null);
             }
         }
     }

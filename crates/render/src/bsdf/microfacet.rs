@@ -229,6 +229,60 @@ impl<R: Real> Distribution<R> for IsotropicGgx<R> {
     }
 }
 
+/// GGX's D(wm) of roughness `ax` along x and `ay` along y:
+/// 1 / (π αx αy cos⁴θ (1 + e)²), e = (x²/αx² + y²/αy²) / z² (zero below the surface).
+#[inline(always)]
+fn ggx_d_anisotropic<R: Real>(ax: R, ay: R, wm: R::V3) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let cos2 = wm.z() * wm.z();
+    // tan²θ (cos²φ / αx² + sin²φ / αy²) = (x²/αx² + y²/αy²) / z².
+    let e = (wm.x() * wm.x() / (ax * ax) + wm.y() * wm.y() / (ay * ay)) / cos2;
+    let t = one + e;
+    let d = one / (R::splat(PI) * ax * ay * cos2 * cos2 * t * t);
+    R::select(wm.z().le(zero), zero, d)
+}
+
+/// The roughness of (`ax`, `ay`) seen along the azimuth of `w`: sqrt(cos²φ αx² + sin²φ αy²)
+/// (`ax` along the normal).
+#[inline(always)]
+fn projected_alpha<R: Real>(ax: R, ay: R, w: R::V3) -> R {
+    let r2 = w.x() * w.x() + w.y() * w.y();
+    let alpha = ((w.x() * w.x() * ax * ax + w.y() * w.y() * ay * ay) / r2).sqrt();
+    R::select(r2.equals(R::splat(0.0)), ax, alpha)
+}
+
+/// Anisotropic GGX, for one direction (`R = f32`, what [`Microfacet`] computes for such a
+/// distribution) or for lanes ([`MicrofacetLanes`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct AnisotropicGgx<R> {
+    /// Roughness along x.
+    ax: R,
+    /// Roughness along y.
+    ay: R,
+}
+
+impl<R: Real> Distribution<R> for AnisotropicGgx<R> {
+    #[inline(always)]
+    fn d(&self, wm: R::V3) -> R {
+        ggx_d_anisotropic(self.ax, self.ay, wm)
+    }
+
+    #[inline(always)]
+    fn lambda(&self, w: R::V3) -> R {
+        ggx_lambda(projected_alpha(self.ax, self.ay, w), w)
+    }
+
+    #[inline(always)]
+    fn pdf_wm(&self, wo: R::V3, wm: R::V3) -> R {
+        visible_normal_pdf(self, wo, wm)
+    }
+
+    #[inline(always)]
+    fn sample_wm(&self, wo: R::V3, u0: R, u1: R) -> R::V3 {
+        sample_visible_ggx(self.ax, self.ay, wo, u0, u1)
+    }
+}
+
 /// GGX or Beckmann (`beckmann`) of one roughness in every direction, for one direction
 /// (`R = f32`) or for lanes, each lane its own kind: the same functions as [`Microfacet`]'s
 /// for such a distribution, to the bit. Lanes compute Beckmann's functions only where some
@@ -332,16 +386,20 @@ impl Distribution<f32> for Microfacet {
 }
 
 /// Eight lanes' distributions, any [`Microfacet`] in each: the lanes of one roughness in every
-/// direction in SIMD registers ([`IsotropicMicrofacet`]), and the `anisotropic` lanes by their
-/// own [`Microfacet`]'s functions, one lane at a time, written over what the SIMD functions
-/// computed there. Every lane gets what its [`Microfacet`] computes, to the bit; the
-/// anisotropic functions exist once, in [`Microfacet`].
+/// direction and anisotropic GGX in SIMD registers ([`IsotropicMicrofacet`],
+/// `AnisotropicGgx`, the functions [`Microfacet`] calls too), anisotropic Beckmann by each
+/// lane's own [`Microfacet`], one lane at a time (its exponential, tangent and arctangent
+/// have no lane form here), written over what the SIMD functions computed there. Every lane
+/// gets what its [`Microfacet`] computes, to the bit.
 #[derive(Clone, Copy, Debug)]
 pub struct MicrofacetLanes {
-    /// The lanes' roughness and kind (an anisotropic lane's roughness along x and GGX, so that
-    /// the SIMD functions, whose results it discards, compute on a roughness it has).
+    /// The lanes' roughness (along x) and kind (GGX in anisotropic Beckmann lanes, so that
+    /// the SIMD functions, whose results they discard, compute on a roughness they have).
     isotropic: IsotropicMicrofacet<F8>,
-    /// Lanes whose distribution's roughness differs along x and y.
+    /// Lanes of anisotropic GGX, and their roughness along y.
+    ggx_anisotropic: M8,
+    alpha_y: F8,
+    /// Lanes of anisotropic Beckmann.
     anisotropic: M8,
     /// Each anisotropic lane's distribution.
     each: [Microfacet; W],
@@ -351,6 +409,8 @@ impl Default for MicrofacetLanes {
     fn default() -> Self {
         MicrofacetLanes {
             isotropic: IsotropicMicrofacet::default(),
+            ggx_anisotropic: M8::default(),
+            alpha_y: F8::default(),
             anisotropic: M8::default(),
             each: [Microfacet::new(NormalDistribution::Ggx, 1.0); W],
         }
@@ -365,8 +425,9 @@ impl MicrofacetLanes {
             Some(iso) => iso,
             None => {
                 self.each[i] = m;
-                // GGX there, whatever the lane's kind: Beckmann's functions go one lane at a
-                // time, and their results would be written over.
+                self.alpha_y.0[i] = m.alpha_y;
+                // GGX there, whatever the lane's kind: anisotropic Beckmann's functions go one
+                // lane at a time, and the isotropic results would be written over.
                 IsotropicMicrofacet {
                     alpha: m.alpha,
                     beckmann: false,
@@ -376,7 +437,9 @@ impl MicrofacetLanes {
         // Every field taken apart: a field added to `IsotropicMicrofacet` fails to compile
         // until its lanes are set too.
         let IsotropicMicrofacet { alpha, beckmann } = iso;
-        self.anisotropic.set(i, !m.is_isotropic());
+        let ggx = m.kind == NormalDistribution::Ggx;
+        self.ggx_anisotropic.set(i, !m.is_isotropic() && ggx);
+        self.anisotropic.set(i, !m.is_isotropic() && !ggx);
         self.isotropic.alpha.0[i] = alpha;
         self.isotropic.beckmann.set(i, beckmann);
     }
@@ -386,7 +449,28 @@ impl MicrofacetLanes {
     #[inline(always)]
     pub fn only_in(&mut self, lanes: M8) {
         self.isotropic.beckmann = self.isotropic.beckmann & lanes;
+        self.ggx_anisotropic = self.ggx_anisotropic & lanes;
         self.anisotropic = self.anisotropic & lanes;
+    }
+
+    /// The isotropic lanes' `simd` result, with anisotropic GGX's `ggx` in its lanes (computed
+    /// only where some lane has it).
+    #[inline(always)]
+    fn with_ggx<T>(
+        &self,
+        simd: T,
+        ggx: impl FnOnce(AnisotropicGgx<F8>) -> T,
+        select: impl FnOnce(M8, T, T) -> T,
+    ) -> T {
+        if self.ggx_anisotropic.any() {
+            let d = AnisotropicGgx {
+                ax: self.isotropic.alpha,
+                ay: self.alpha_y,
+            };
+            select(self.ggx_anisotropic, ggx(d), simd)
+        } else {
+            simd
+        }
     }
 
     /// `simd`, its anisotropic lanes written over by `one` of their distribution and lane.
@@ -413,25 +497,27 @@ impl MicrofacetLanes {
 impl Distribution<F8> for MicrofacetLanes {
     #[inline(always)]
     fn d(&self, wm: V8) -> F8 {
-        let simd = self.isotropic.d(wm);
+        let simd = self.with_ggx(self.isotropic.d(wm), |g| g.d(wm), M8::select);
         self.with_anisotropic(simd, |r, i, m| r.0[i] = m.d(wm.get(i)))
     }
 
     #[inline(always)]
     fn lambda(&self, w: V8) -> F8 {
-        let simd = self.isotropic.lambda(w);
+        let simd = self.with_ggx(self.isotropic.lambda(w), |g| g.lambda(w), M8::select);
         self.with_anisotropic(simd, |r, i, m| r.0[i] = m.lambda(w.get(i)))
     }
 
     #[inline(always)]
     fn pdf_wm(&self, wo: V8, wm: V8) -> F8 {
-        let simd = self.isotropic.pdf_wm(wo, wm);
+        let iso = self.isotropic.pdf_wm(wo, wm);
+        let simd = self.with_ggx(iso, |g| g.pdf_wm(wo, wm), M8::select);
         self.with_anisotropic(simd, |r, i, m| r.0[i] = m.pdf_wm(wo.get(i), wm.get(i)))
     }
 
     #[inline(always)]
     fn sample_wm(&self, wo: V8, u0: F8, u1: F8) -> V8 {
-        let simd = self.isotropic.sample_wm(wo, u0, u1);
+        let iso = self.isotropic.sample_wm(wo, u0, u1);
+        let simd = self.with_ggx(iso, |g| g.sample_wm(wo, u0, u1), M8::select3);
         self.with_anisotropic(simd, |r, i, m| {
             r.set(i, m.sample_wm(wo.get(i), Vec2::new(u0.0[i], u1.0[i])))
         })
@@ -488,12 +574,7 @@ impl Microfacet {
         if self.is_isotropic() {
             return self.alpha;
         }
-        let r2 = w.x * w.x + w.y * w.y;
-        if r2 == 0.0 {
-            return self.alpha;
-        }
-        ((w.x * w.x * self.alpha * self.alpha + w.y * w.y * self.alpha_y * self.alpha_y) / r2)
-            .sqrt()
+        projected_alpha(self.alpha, self.alpha_y, w)
     }
 
     /// The density of microfacet normals D(wm), normalised so that ∫ D(wm) cos θm dωm = 1.
@@ -503,16 +584,13 @@ impl Microfacet {
         }
         if !self.is_isotropic() {
             let (ax, ay) = (self.alpha, self.alpha_y);
+            if self.kind == NormalDistribution::Ggx {
+                return ggx_d_anisotropic(ax, ay, wm);
+            }
             let cos2 = wm.z * wm.z;
             // tan²θ (cos²φ / αx² + sin²φ / αy²) = (x²/αx² + y²/αy²) / z².
             let e = (wm.x * wm.x / (ax * ax) + wm.y * wm.y / (ay * ay)) / cos2;
-            return match self.kind {
-                NormalDistribution::Beckmann => (-e).exp() / (PI * ax * ay * cos2 * cos2),
-                NormalDistribution::Ggx => {
-                    let t = 1.0 + e;
-                    1.0 / (PI * ax * ay * cos2 * cos2 * t * t)
-                }
-            };
+            return (-e).exp() / (PI * ax * ay * cos2 * cos2);
         }
         match self.kind {
             NormalDistribution::Beckmann => beckmann_d(self.alpha, wm.z),

@@ -6,6 +6,7 @@ use super::*;
 use crate::desc::Rgb;
 use crate::geometry::Frame;
 use glam::{Vec2, Vec3};
+use pathlab_mc::simd::lanes::{Real, Vector3};
 
 /// A sampled direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -60,17 +61,29 @@ pub struct Guard {
     pub alpha2: f32,
 }
 
-impl Guard {
-    /// The shadowing term for light arriving along `wi`.
-    #[inline]
-    fn shadowing(&self, wi: Vec3) -> f32 {
-        if self.alpha2 == 0.0 {
-            return 1.0;
-        }
-        let cos = wi.dot(self.n);
-        let tan2 = (1.0 - cos * cos).max(0.0) / (cos * cos);
-        2.0 / (1.0 + (1.0 + self.alpha2 * tan2).sqrt())
-    }
+/// Whether a guard of the surface's own shading normal `n` admits light arriving along `wi`
+/// at a lobe of normal `lobe_n`: whether `wi` is on the same side of both. For one direction
+/// or lanes.
+#[inline(always)]
+pub fn guard_admits<V: Vector3>(n: V, lobe_n: V, wi: V) -> <V::R as Real>::Mask {
+    (wi.dot(n) * wi.dot(lobe_n)).gt(V::R::splat(0.0))
+}
+
+/// The factor a guard of the surface's own shading normal `n` and shadowing α² `alpha2`
+/// applies to light arriving along `wi` at a lobe of normal `lobe_n`: zero where it does not
+/// admit it ([`guard_admits`]), else the shadowing term (one where α² is zero). For one
+/// direction or lanes.
+#[inline(always)]
+pub fn guard_attenuation<V: Vector3>(n: V, alpha2: V::R, lobe_n: V, wi: V) -> V::R {
+    let (zero, one, two) = (V::R::splat(0.0), V::R::splat(1.0), V::R::splat(2.0));
+    let cos = wi.dot(n);
+    let tan2 = (one - cos * cos).max(zero) / (cos * cos);
+    let shadowing = V::R::select(
+        alpha2.equals(zero),
+        one,
+        two / (one + (one + alpha2 * tan2).sqrt()),
+    );
+    V::R::select(guard_admits(n, lobe_n, wi), shadowing, zero)
 }
 
 impl Lobe {
@@ -78,7 +91,7 @@ impl Lobe {
     #[inline]
     fn admits(&self, wi: Vec3) -> bool {
         self.guard
-            .is_none_or(|g| wi.dot(g.n) * wi.dot(self.frame.n) > 0.0)
+            .is_none_or(|g| guard_admits(g.n, self.frame.n, wi))
     }
 
     /// The factor the guard applies to light arriving along `wi` (one without a guard; zero
@@ -87,8 +100,7 @@ impl Lobe {
     fn attenuation(&self, wi: Vec3) -> f32 {
         match self.guard {
             None => 1.0,
-            Some(g) if wi.dot(g.n) * wi.dot(self.frame.n) > 0.0 => g.shadowing(wi),
-            Some(_) => 0.0,
+            Some(g) => guard_attenuation(g.n, g.alpha2, self.frame.n, wi),
         }
     }
 }

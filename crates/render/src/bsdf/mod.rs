@@ -44,7 +44,7 @@ pub use microfacet::{
     Distribution, IsotropicMicrofacet, Microfacet, MicrofacetLanes, NormalDistribution,
 };
 pub use mirror::Mirror;
-pub use mixture::{Bsdf, BsdfSample, Guard, Lobe, MAX_LOBES};
+pub use mixture::{guard_admits, guard_attenuation, Bsdf, BsdfSample, Guard, Lobe, MAX_LOBES};
 pub use plastic::Plastic;
 pub use principled::{Principled, PrincipledFlags};
 pub use rough_dielectric::RoughDielectric;

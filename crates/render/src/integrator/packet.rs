@@ -11,15 +11,15 @@
 //! for every lane and bounce, except where a lane's material is one lobe of those the lanes
 //! shade ([`Material::lane_bxdf`]: Lambertian, or a blend of two Lambertian materials, which
 //! is one Lambertian lobe; a mirror; smooth conductors and glass; rough GGX or Beckmann
-//! conductors and glass, of one roughness or anisotropic). There the lanes
-//! are shaded together in SIMD registers by the same functions the one-path code calls,
-//! instantiated on eight lanes (the BSDFs: [`Diffuse`], [`RoughConductor`],
-//! [`RoughDielectric`] (an anisotropic lane's distribution by its own functions, one lane at
-//! a time: [`MicrofacetLanes`]), [`Mirror`],
-//! [`SmoothConductor`], [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
+//! conductors and glass, of one roughness or anisotropic; any of those under a normal or
+//! bump map). There the lanes are shaded together in SIMD registers by the same functions
+//! the one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
+//! [`RoughConductor`], [`RoughDielectric`] (their distributions: [`MicrofacetLanes`], whose
+//! anisotropic Beckmann lanes go one lane at a time), [`Mirror`], [`SmoothConductor`],
+//! [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
 //! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`] (or, for an
-//! anisotropic lobe, the frame along the surface's tangent that [`leaf_frame`] gives each
-//! lane), [`offset_ray_origin`],
+//! anisotropic lobe or a mapped normal, the frame [`Material::lane_bxdf`] gives the lane),
+//! a map's guard ([`guard_attenuation`]), [`offset_ray_origin`],
 //! [`power_heuristic_weight`]; see `scatter_lanes`): this module holds only the scheduling
 //! and the masks that stand for the one-path code's early returns. Emitting triangles and
 //! environment maps are sampled in the lanes; any other light (points, spots, directional
@@ -41,8 +41,8 @@ use super::{
 use crate::accel::RayLanes;
 use crate::bsdf::bxdf::DirectionSample;
 use crate::bsdf::{
-    leaf_frame, DielectricLanes, Diffuse, LaneBxdf, Lobes, Material, MicrofacetLanes, Mirror,
-    RoughConductor, RoughDielectric, SmoothConductor,
+    guard_admits, guard_attenuation, DielectricLanes, Diffuse, LaneBxdf, Lobes, Material,
+    MicrofacetLanes, Mirror, RoughConductor, RoughDielectric, SmoothConductor,
 };
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
@@ -71,9 +71,19 @@ struct ScatterIn {
     smooth_metal: SmoothConductor<V8>,
     glass: DielectricLanes,
     two_sided: M8,
-    /// The shading frames of the lanes in `lobes.tangent` ([`leaf_frame`]; the others' frame
+    /// Whether some lane has a frame along the surface's tangent or a guard (`tangent` and
+    /// `guard` are cleared, and looked at, only where one had).
+    mapped: bool,
+    /// Lanes whose frame follows the surface's tangent (anisotropic roughness, a normal or
+    /// bump map), given in `frame` (those [`Material::lane_bxdf`] gives; the others' frame
     /// is made in the lanes, around the shading normal).
+    tangent: M8,
     frame: Frame<V8>,
+    /// Lanes under a normal or bump map, and their guards (the surface's own shading normal
+    /// and the shadowing α², [`crate::bsdf::Guard`]).
+    guard: M8,
+    guard_n: V8,
+    guard_alpha2: F8,
     /// Lanes whose light sample is a point on an emitting triangle.
     light: M8,
     emitter: TriangleEmitter<V8>,
@@ -129,9 +139,6 @@ impl DrawnLights {
 /// Which lanes have which lobe (the rest: Lambertian).
 #[derive(Clone, Copy, Default)]
 struct LobeLanes {
-    /// Lanes whose frame follows the surface's tangent (anisotropic roughness), given in
-    /// [`ScatterIn::frame`].
-    tangent: M8,
     conductor: M8,
     rough_glass: M8,
     smooth_metal: M8,
@@ -190,8 +197,8 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let zero = F8::splat(0.0);
     let flip = a.two_sided & a.wo.dot(a.ns).lt(zero);
     let mut frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
-    let tangent = a.lobes.tangent;
-    if OTHER_LOBES && tangent.any() {
+    let tangent = a.tangent;
+    if OTHER_LOBES && a.mapped {
         frame = Frame {
             s: tangent.select3(a.frame.s, frame.s),
             t: tangent.select3(a.frame.t, frame.t),
@@ -231,7 +238,19 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
             rough_glass.select(pdf_glass, bsdf_pdf),
         );
     }
-    let f = f.scale(wi.dot(frame.n).abs());
+    let cos_i = wi.dot(frame.n).abs();
+    let guard = a.guard;
+    let guarded = OTHER_LOBES && a.mapped && guard.any();
+    let f = if guarded {
+        // `Bsdf::f_cos` of a guarded lobe: f (weight · attenuation · cos), its weight one.
+        // Where the guard does not admit wi this is zero, and the sample ends here (its
+        // density, which `Bsdf::pdf` would make zero too, is not asked for).
+        let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
+        let guarded = F8::splat(1.0) * attenuation * cos_i;
+        guard.select3(f.scale(guarded), f.scale(cos_i))
+    } else {
+        f.scale(cos_i)
+    };
     // `visible_light_sample`'s early returns (`!(x <= 0)` lets NaN through, as there).
     let triangle = a.light
         & ls.dist2.not_equal(zero)
@@ -298,11 +317,19 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     out.delta = lobes.delta;
     out.eta = eta;
     let wi = frame.to_world(bs.wi);
-    let finite = bs.f.x.is_finite() & bs.f.y.is_finite() & bs.f.z.is_finite();
-    out.sampled = bs.valid & bs.pdf.gt(zero) & finite;
+    let (mut f, mut valid) = (bs.f, bs.valid);
+    if guarded {
+        // `Bsdf::sample_f` of a guarded lobe: none where the guard does not admit wi, the
+        // value attenuated where it does.
+        let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
+        f = guard.select3(f.scale(attenuation), f);
+        valid = valid & (guard_admits(a.guard_n, frame.n, wi) | !guard);
+    }
+    let finite = f.x.is_finite() & f.y.is_finite() & f.z.is_finite();
+    out.sampled = valid & bs.pdf.gt(zero) & finite;
     out.wi = wi;
     out.pdf = bs.pdf;
-    out.weight = bs.f.scale(wi.dot(frame.n).abs() / bs.pdf);
+    out.weight = f.scale(wi.dot(frame.n).abs() / bs.pdf);
 }
 
 /// [`scatter_lanes`] compiled for AVX2.
@@ -319,10 +346,10 @@ fn scatter_avx2<const OTHER_LOBES: bool>(
 /// [`scatter_lanes`] on the best vector unit this CPU has, its Lambertian instance where no
 /// lane has another lobe or a light sample drawn one lane at a time.
 #[inline]
-fn scatter(a: &ScatterIn, out: &mut ScatterOut) {
+fn scatter(a: &mut ScatterIn, out: &mut ScatterOut) {
     let lobes = &a.lobes;
     let other =
-        (lobes.conductor | lobes.rough_glass | lobes.delta | lobes.tangent | a.drawn.lanes).any();
+        (lobes.conductor | lobes.rough_glass | lobes.delta | a.drawn.lanes).any() || a.mapped;
     if other {
         return scatter_other_lobes(a, out);
     }
@@ -338,7 +365,17 @@ fn scatter(a: &ScatterIn, out: &mut ScatterOut) {
 /// [`scatter`]'s instance for every lobe and light, out of line so that the Lambertian one
 /// stays small enough to be inlined into the path loop.
 #[inline(never)]
-fn scatter_other_lobes(a: &ScatterIn, out: &mut ScatterOut) {
+fn scatter_other_lobes(a: &mut ScatterIn, out: &mut ScatterOut) {
+    // The distributions' functions computed lane by lane (Beckmann's, anisotropic ones) only
+    // where a lane has the lobe now (a lane keeps its lobe's fields from an earlier bounce;
+    // where no lane has a lobe, its functions are not computed at all).
+    if a.lobes.conductor.any() {
+        a.metal.distribution.only_in(a.lobes.conductor);
+    }
+    if a.lobes.rough_glass.any() {
+        a.rough_glass.distribution.only_in(a.lobes.rough_glass);
+    }
+    let a = &*a;
     #[cfg(target_arch = "x86_64")]
     if let Some(avx2) = crate::simd::Avx2::detect() {
         // SAFETY: as in `scatter`.
@@ -421,6 +458,9 @@ impl PathIntegrator {
             // gather the others' inputs.
             let mut shaded = 0u32;
             a.lobes = LobeLanes::default();
+            if a.mapped {
+                (a.mapped, a.tangent, a.guard) = (false, M8::default(), M8::default());
+            }
             for i in 0..W {
                 let Some(lane) = &mut lanes[i] else { continue };
                 let smp = &mut samplers[i];
@@ -507,12 +547,7 @@ impl PathIntegrator {
             if let Some((_, d)) = &directions {
                 (a.environment, a.environment_wi, a.environment_pdf) = (d.found, d.wi, d.pdf);
             }
-            // The distributions' functions computed lane by lane (Beckmann's, anisotropic
-            // ones) only where a lane has the lobe now (a lane keeps its lobe's fields from an
-            // earlier pass).
-            a.metal.distribution.only_in(a.lobes.conductor);
-            a.rough_glass.distribution.only_in(a.lobes.rough_glass);
-            scatter(&a, &mut b);
+            scatter(&mut a, &mut b);
             for i in 0..W {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
                     continue;
@@ -745,8 +780,8 @@ fn eval_and_pdf_lanes_avx2(
 /// Lane `i`'s lobe at `si` seen from `wo` into `a`, where `material` is one the lanes shade
 /// together other than a plain Lambertian one ([`Material::lane_bxdf`]): returns its
 /// sidedness, or `None` for a material the lanes leave to the one-path code. A lobe whose
-/// frame follows the surface's tangent gets it here, as the one-path BSDF does
-/// ([`Scene::bsdf`]: the tangent ∂p/∂u, [`leaf_frame`]).
+/// frame follows the surface's tangent (or a normal or bump map's) gets it here, with a map's
+/// guard, as [`Scene::bsdf`] makes them.
 #[inline(always)]
 fn gather_lobe(
     scene: &Scene,
@@ -757,10 +792,20 @@ fn gather_lobe(
     a: &mut ScatterIn,
     stats: &mut PathStats,
 ) -> Option<bool> {
-    let lane = material.lane_bxdf(|| scene.tex_point(si))?;
+    let lane = material.lane_bxdf(|| scene.shading_point(si), wo)?;
     let (lobe, two_sided) = (lane.bxdf, lane.two_sided);
-    if lane.tangent_frame {
-        gather_tangent_frame(scene, si, wo, two_sided, i, a);
+    if let Some(frame) = lane.frame {
+        a.frame.s.set(i, frame.s);
+        a.frame.t.set(i, frame.t);
+        a.frame.n.set(i, frame.n);
+        a.tangent.set(i, true);
+        a.mapped = true;
+    }
+    if let Some(guard) = lane.guard {
+        a.guard_n.set(i, guard.n);
+        a.guard_alpha2.0[i] = guard.alpha2;
+        a.guard.set(i, true);
+        a.mapped = true;
     }
     // As `scatter` counts a vertex whose BSDF is not black: every lobe but a black diffuse one.
     let black = matches!(lobe, LaneBxdf::Diffuse(d) if d.reflectance.max_element() <= 0.0);
@@ -792,25 +837,6 @@ fn gather_lobe(
         }
     }
     Some(two_sided)
-}
-
-/// Lane `i`'s frame along the surface's tangent at `si` seen from `wo` into `a`
-/// ([`gather_lobe`]'s rarer case, out of line).
-#[inline(never)]
-fn gather_tangent_frame(
-    scene: &Scene,
-    si: &SurfaceInteraction,
-    wo: glam::Vec3,
-    two_sided: bool,
-    i: usize,
-    a: &mut ScatterIn,
-) {
-    let (dpdu, _) = scene.tangents(si);
-    let frame = leaf_frame(si.ns, dpdu, two_sided, wo, true);
-    a.frame.s.set(i, frame.s);
-    a.frame.t.set(i, frame.t);
-    a.frame.n.set(i, frame.n);
-    a.lobes.tangent.set(i, true);
 }
 
 /// How a lane's light sample is taken.
