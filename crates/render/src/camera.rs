@@ -207,7 +207,7 @@ impl Camera {
         (T::V3::splat(self.origin), d, d.dot(forward))
     }
 
-    /// The film position (pixel units, as [`Camera::film_position`] gives them) where world
+    /// The film position (pixel units, as [`Camera::film_sample`] gives them) where world
     /// point `p` appears: the inverse of [`Camera::generate_ray`] through the lens's centre.
     /// `None` behind a perspective camera or for a non-finite point.
     pub fn raster_position(&self, p: Vec3) -> Option<Vec2> {

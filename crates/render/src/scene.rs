@@ -387,7 +387,7 @@ impl Scene {
     }
 
     /// [`Scene::hit_distance`] of eight rays, which walk the BVH together where the scene
-    /// allows ([`Scene::nearest_of_packet`]; one by one otherwise): the query of a ray-tracing
+    /// allows (one by one otherwise): the query of a ray-tracing
     /// kernel's packets of eight (`rtcIntersect8`). Pays for rays that go the same way.
     pub fn hit_distances(&self, rays: &[Ray; crate::simd::lanes::W]) -> [Option<f32>; 8] {
         if !self.traces_packets() {

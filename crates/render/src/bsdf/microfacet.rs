@@ -547,7 +547,7 @@ impl Microfacet {
     }
 
     /// The anisotropic distribution of roughness (`alpha_x`, `alpha_y`), or `None` where both
-    /// are at most [`super::bxdf::SMOOTH_ALPHA`]: a surface drawn as its smooth limit.
+    /// are at most 1e-4 (the models' smooth limit): a surface drawn as its smooth limit.
     pub fn unless_smooth(kind: NormalDistribution, alpha_x: f32, alpha_y: f32) -> Option<Self> {
         (alpha_x.max(alpha_y) > super::bxdf::SMOOTH_ALPHA)
             .then(|| Microfacet::anisotropic(kind, alpha_x, alpha_y))

@@ -27,7 +27,7 @@ pub struct CoatTable {
 
 /// The directional albedo of microfacet reflection off a dielectric of relative index `eta`
 /// for light arriving at cos θ = `mu`: ∫ D_wi(m) F(wi·m) G1(wo, m) dm over the visible
-/// normals ([`visible_normal_integral`]).
+/// normals (by Gauss–Legendre quadrature over the distribution's sampling of them).
 pub fn rough_reflectance(
     distribution: &Microfacet,
     mu: f32,
@@ -42,7 +42,7 @@ pub fn rough_reflectance(
 
 /// The directional transmittance of a rough dielectric interface of relative index `eta` for
 /// light arriving at cos θ = `mu`: ∫ D_wi(m) (1 - F(wi·m)) G1(wt, m) dm, wt the refraction of
-/// wi through the facet m ([`visible_normal_integral`]).
+/// wi through the facet m (by quadrature, as [`rough_reflectance`]).
 pub fn rough_transmittance(
     distribution: &Microfacet,
     mu: f32,
