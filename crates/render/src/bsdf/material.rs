@@ -332,20 +332,19 @@ fn merged_diffuse(wa: f32, a: Diffuse, wb: f32, b: Diffuse) -> (f32, Diffuse) {
 }
 
 /// A lobe the path tracer's lanes shade together ([`Material::lane_bxdf`]), its sidedness,
-/// its frame where that is not the one around the shading normal, and a normal or bump map's
-/// guard: what [`Material::bsdf`] makes of a material of that one lobe.
+/// and whether its frame is one [`Material::lane_frame`] gives: what [`Material::bsdf`] makes
+/// of a material of that one lobe.
 #[derive(Clone, Copy, Debug)]
 pub struct LaneLobe {
     /// The lobe.
     pub bxdf: LaneBxdf,
     /// Whether the material is two-sided.
     pub two_sided: bool,
-    /// Its frame where that follows the surface's tangent ([`leaf_frame`]: anisotropic
-    /// roughness, or a normal or bump map's frame); `None`: the frame around the shading
-    /// normal, turned towards wo on a two-sided material's back side.
-    pub frame: Option<Frame>,
-    /// A normal or bump map's guard.
-    pub guard: Option<Guard>,
+    /// Whether its frame follows the surface's tangent (anisotropic roughness, or a normal or
+    /// bump map's frame, with the map's guard): [`Material::lane_frame`]. Otherwise its frame
+    /// is the one around the shading normal, turned towards wo on a two-sided material's back
+    /// side.
+    pub mapped: bool,
 }
 
 /// A lobe's model in the path tracer's lanes ([`LaneLobe`]).
@@ -384,25 +383,25 @@ impl LaneBxdf {
 }
 
 impl Leaf {
-    /// [`Material::lane_bxdf`] of this leaf at `p` in the frame `at` (perhaps a normal or bump
-    /// map's), seen from `wo`: the lobe, frame and guard [`Material::collect`] gives it.
-    fn lane_lobe(&self, p: &ShadingPoint, at: &Local, wo: Vec3) -> Option<LaneLobe> {
+    /// [`Material::lane_bxdf`] of this leaf, its textures read at `tex`; `mapped` where it is
+    /// under a normal or bump map. Inlined always: called, it would pass the textured model's
+    /// `Bxdf` (large) through memory.
+    #[inline(always)]
+    fn lane_lobe<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>, mapped: bool) -> Option<LaneLobe> {
         // Borrowed where the model is fixed: a `Bxdf` is large, and only its lobe is taken.
         let textured;
         let (bxdf, anisotropic) = match &self.model {
             Model::Fixed(bxdf) => (bxdf, false),
             Model::Diffuse { .. } | Model::Conductor { .. } | Model::Dielectric { .. } => {
-                textured = self.model.bxdf(&p.tex);
+                textured = self.model.bxdf(&tex());
                 (&textured.0, textured.1)
             }
             _ => return None,
         };
-        let tangent = anisotropic || at.guard.is_some();
         Some(LaneLobe {
             bxdf: LaneBxdf::of(bxdf)?,
             two_sided: self.two_sided,
-            frame: tangent.then(|| leaf_frame(at.n, at.dpdu, self.two_sided, wo, true)),
-            guard: at.guard,
+            mapped: mapped || anisotropic,
         })
     }
 }
@@ -428,59 +427,41 @@ impl Material {
         }
     }
 
-    /// The lobe of a material of one lobe that the path tracer's lanes shade together, at
-    /// the point `point` gives (asked for only where the material reads textures or tangents)
-    /// seen from `wo`: Lambertian, a rough conductor or rough glass of GGX or Beckmann normals
-    /// (of one roughness or anisotropic), a mirror, a smooth conductor, or smooth glass of
-    /// exact Fresnel reflectance; one of those under a normal or bump map; or a blend of two
-    /// Lambertian materials, which is one Lambertian lobe. Textured models are evaluated (as
-    /// [`Material::bsdf`] evaluates them) only where they may give one of those: diffuse,
+    /// The lobe of a material of one lobe that the path tracer's lanes shade together, its
+    /// textures read at `tex`: Lambertian, a rough conductor or rough glass of GGX or Beckmann
+    /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, or smooth glass
+    /// of exact Fresnel reflectance; one of those under a normal or bump map; or a blend of
+    /// two Lambertian materials, which is one Lambertian lobe. Textured models are evaluated
+    /// (as [`Material::bsdf`] evaluates them) only where they may give one of those: diffuse,
     /// conductors and glass.
     #[inline]
-    pub fn lane_bxdf<'a>(
-        &self,
-        point: impl FnOnce() -> ShadingPoint<'a>,
-        wo: Vec3,
-    ) -> Option<LaneLobe> {
+    pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<LaneLobe> {
         match self {
-            Material::Leaf(Leaf {
-                model: Model::Fixed(bxdf),
-                two_sided,
-            }) => Some(LaneLobe {
-                bxdf: LaneBxdf::of(bxdf)?,
-                two_sided: *two_sided,
-                frame: None,
-                guard: None,
-            }),
-            _ => self.lane_bxdf_general(point, wo),
+            Material::Leaf(leaf) => leaf.lane_lobe(tex, false),
+            Material::Blend(..) => self.lane_blend(tex),
+            Material::NormalMap(_, inner) | Material::BumpMap(_, _, inner) => match &**inner {
+                Material::Leaf(leaf) => leaf.lane_lobe(tex, true),
+                _ => None,
+            },
+            _ => None,
         }
     }
 
-    /// [`Material::lane_bxdf`] of a material that reads its shading point (textured, a blend,
-    /// a normal or bump map): out of line, so that the fixed models' case stays small where
-    /// it is inlined.
+    /// The frame (and a normal or bump map's guard) of a lobe [`Material::lane_bxdf`] gives as
+    /// `mapped`, at `p` seen from `wo`: what [`Material::bsdf`] gives its leaf, the frame
+    /// along the tangent ([`leaf_frame`]) of the shading point's or the map's frame.
     #[inline(never)]
-    fn lane_bxdf_general<'a>(
-        &self,
-        point: impl FnOnce() -> ShadingPoint<'a>,
-        wo: Vec3,
-    ) -> Option<LaneLobe> {
-        match self {
-            Material::Leaf(leaf) => {
-                let p = point();
-                leaf.lane_lobe(&p, &Local::at(&p), wo)
-            }
-            Material::Blend(..) => self.lane_blend(|| point().tex),
-            Material::NormalMap(..) | Material::BumpMap(..) => {
-                let p = point();
-                let (at, inner) = self.perturbation(&p, &Local::at(&p), wo)?;
-                match inner {
-                    Material::Leaf(leaf) => leaf.lane_lobe(&p, &at, wo),
-                    _ => None,
-                }
-            }
-            _ => None,
-        }
+    pub fn lane_frame(&self, p: &ShadingPoint, wo: Vec3) -> (Frame, Option<Guard>) {
+        let at = Local::at(p);
+        let (at, two_sided) = match self {
+            Material::Leaf(leaf) => (at, leaf.two_sided),
+            _ => match self.perturbation(p, &at, wo) {
+                Some((perturbed, Material::Leaf(leaf))) => (perturbed, leaf.two_sided),
+                // Not a lobe `lane_bxdf` gives as mapped.
+                _ => (at, false),
+            },
+        };
+        (leaf_frame(at.n, at.dpdu, two_sided, wo, true), at.guard)
     }
 
     /// [`Material::lane_bxdf`] of a blend of two Lambertian materials of one sidedness: the
@@ -513,8 +494,7 @@ impl Material {
         Some(LaneLobe {
             bxdf: LaneBxdf::Diffuse(d),
             two_sided: a.two_sided,
-            frame: None,
-            guard: None,
+            mapped: false,
         })
     }
 

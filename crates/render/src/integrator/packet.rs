@@ -792,20 +792,10 @@ fn gather_lobe(
     a: &mut ScatterIn,
     stats: &mut PathStats,
 ) -> Option<bool> {
-    let lane = material.lane_bxdf(|| scene.shading_point(si), wo)?;
+    let lane = material.lane_bxdf(|| scene.tex_point(si))?;
     let (lobe, two_sided) = (lane.bxdf, lane.two_sided);
-    if let Some(frame) = lane.frame {
-        a.frame.s.set(i, frame.s);
-        a.frame.t.set(i, frame.t);
-        a.frame.n.set(i, frame.n);
-        a.tangent.set(i, true);
-        a.mapped = true;
-    }
-    if let Some(guard) = lane.guard {
-        a.guard_n.set(i, guard.n);
-        a.guard_alpha2.0[i] = guard.alpha2;
-        a.guard.set(i, true);
-        a.mapped = true;
+    if lane.mapped {
+        gather_frame(scene, si, wo, material, i, a);
     }
     // As `scatter` counts a vertex whose BSDF is not black: every lobe but a black diffuse one.
     let black = matches!(lobe, LaneBxdf::Diffuse(d) if d.reflectance.max_element() <= 0.0);
@@ -837,6 +827,30 @@ fn gather_lobe(
         }
     }
     Some(two_sided)
+}
+
+/// Lane `i`'s frame and guard, for a lobe [`Material::lane_bxdf`] gives as mapped
+/// ([`Material::lane_frame`]), into `a`: out of line, the rarer case.
+#[inline(never)]
+fn gather_frame(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    wo: glam::Vec3,
+    material: &Material,
+    i: usize,
+    a: &mut ScatterIn,
+) {
+    let (frame, guard) = material.lane_frame(&scene.shading_point(si), wo);
+    a.frame.s.set(i, frame.s);
+    a.frame.t.set(i, frame.t);
+    a.frame.n.set(i, frame.n);
+    a.tangent.set(i, true);
+    if let Some(guard) = guard {
+        a.guard_n.set(i, guard.n);
+        a.guard_alpha2.0[i] = guard.alpha2;
+        a.guard.set(i, true);
+    }
+    a.mapped = true;
 }
 
 /// How a lane's light sample is taken.
