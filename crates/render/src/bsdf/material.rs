@@ -275,10 +275,11 @@ fn tangent_frame(n: Vec3, dpdu: Vec3) -> Frame {
 /// The shading frame of a leaf's lobe at unit normal `n` seen from `wo`: around `n`, turned
 /// towards `wo` where the leaf is two-sided and `wo` is below; or, where `tangent` (an
 /// anisotropic lobe, or a normal map's), its x axis along `dpdu` projected off `n`, and on a
-/// two-sided leaf's back side only its z mirrored (as Mitsuba does). The one-path BSDF and
-/// the path tracer's lanes both take their frames from here.
+/// two-sided leaf's back side only its z mirrored (as Mitsuba does). The one-path BSDF takes
+/// every leaf's frame from here, and the path tracer's lanes the frames along the tangent
+/// ([`Material::lane_frame`]; the others they make around the normal themselves).
 #[inline]
-pub fn leaf_frame(n: Vec3, dpdu: Vec3, two_sided: bool, wo: Vec3, tangent: bool) -> Frame {
+fn leaf_frame(n: Vec3, dpdu: Vec3, two_sided: bool, wo: Vec3, tangent: bool) -> Frame {
     let side = if two_sided && wo.dot(n) < 0.0 { -n } else { n };
     if tangent {
         let mut f = tangent_frame(n, dpdu);
@@ -449,7 +450,7 @@ impl Material {
 
     /// The frame (and a normal or bump map's guard) of a lobe [`Material::lane_bxdf`] gives as
     /// `mapped`, at `p` seen from `wo`: what [`Material::bsdf`] gives its leaf, the frame
-    /// along the tangent ([`leaf_frame`]) of the shading point's or the map's frame.
+    /// along the tangent of the shading point's or the map's frame.
     #[inline(never)]
     pub fn lane_frame(&self, p: &ShadingPoint, wo: Vec3) -> (Frame, Option<Guard>) {
         let at = Local::at(p);

@@ -229,14 +229,23 @@ impl<R: Real> Distribution<R> for IsotropicGgx<R> {
     }
 }
 
+/// cos²θ of a normal `wm` and the slope term of anisotropic D, for roughness `ax` along x
+/// and `ay` along y: e = tan²θ (cos²φ / αx² + sin²φ / αy²) = (x²/αx² + y²/αy²) / z². Both
+/// distributions' anisotropic D are written on it.
+#[inline(always)]
+fn anisotropic_slope_term<R: Real>(ax: R, ay: R, wm: R::V3) -> (R, R) {
+    let cos2 = wm.z() * wm.z();
+    let e = (wm.x() * wm.x() / (ax * ax) + wm.y() * wm.y() / (ay * ay)) / cos2;
+    (cos2, e)
+}
+
 /// GGX's D(wm) of roughness `ax` along x and `ay` along y:
-/// 1 / (π αx αy cos⁴θ (1 + e)²), e = (x²/αx² + y²/αy²) / z² (zero below the surface).
+/// 1 / (π αx αy cos⁴θ (1 + e)²), e the slope term ([`anisotropic_slope_term`]; zero below
+/// the surface).
 #[inline(always)]
 fn ggx_d_anisotropic<R: Real>(ax: R, ay: R, wm: R::V3) -> R {
     let (zero, one) = (R::splat(0.0), R::splat(1.0));
-    let cos2 = wm.z() * wm.z();
-    // tan²θ (cos²φ / αx² + sin²φ / αy²) = (x²/αx² + y²/αy²) / z².
-    let e = (wm.x() * wm.x() / (ax * ax) + wm.y() * wm.y() / (ay * ay)) / cos2;
+    let (cos2, e) = anisotropic_slope_term(ax, ay, wm);
     let t = one + e;
     let d = one / (R::splat(PI) * ax * ay * cos2 * cos2 * t * t);
     R::select(wm.z().le(zero), zero, d)
@@ -587,9 +596,7 @@ impl Microfacet {
             if self.kind == NormalDistribution::Ggx {
                 return ggx_d_anisotropic(ax, ay, wm);
             }
-            let cos2 = wm.z * wm.z;
-            // tan²θ (cos²φ / αx² + sin²φ / αy²) = (x²/αx² + y²/αy²) / z².
-            let e = (wm.x * wm.x / (ax * ax) + wm.y * wm.y / (ay * ay)) / cos2;
+            let (cos2, e) = anisotropic_slope_term::<f32>(ax, ay, wm);
             return (-e).exp() / (PI * ax * ay * cos2 * cos2);
         }
         match self.kind {

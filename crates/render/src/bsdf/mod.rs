@@ -39,7 +39,7 @@ pub use diffuse::Diffuse;
 pub use diffuse_transmission::DiffuseTransmission;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 pub use layered::{Base, Coat, LayerMedium, LayerStack, Layered};
-pub use material::{leaf_frame, LaneBxdf, LaneLobe, Leaf, Material, Model, ShadingPoint};
+pub use material::{LaneBxdf, LaneLobe, Leaf, Material, Model, ShadingPoint};
 pub use microfacet::{
     Distribution, IsotropicMicrofacet, Microfacet, MicrofacetLanes, NormalDistribution,
 };
