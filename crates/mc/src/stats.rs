@@ -64,7 +64,9 @@ pub fn bonferroni(alpha: f64, m: usize) -> f64 {
 }
 
 /// Chi-square test of 2D samples against the density `pdf(x, y)` (with respect to dx dy) over
-/// the rectangle `domain = [[x0, x1], [y0, y1]]` cut into `res = [nx, ny]` bins.
+/// the rectangle `domain = [[x0, x1], [y0, y1]]` cut into `res = [nx, ny]` bins (closed: a
+/// sample on an upper edge counts in the last bin; samples outside count in a cell of their own
+/// that expects the mass the density leaves out).
 ///
 /// To test directions, map them to a parameterisation whose measure is the density's: for a
 /// solid-angle pdf use `(cos θ, φ)`, since dω = d(cos θ) dφ.
@@ -330,7 +332,9 @@ impl Chi2Grid {
         let mut n = 0u64;
         for [x, y] in samples {
             n += 1;
-            let inside = x >= x0 && x < x1 && y >= y0 && y < y1;
+            // The domain is closed: a sample on its upper edge (cos θ = 1, a direction along
+            // the axis, which rounding does give) falls in the last bin.
+            let inside = x >= x0 && x <= x1 && y >= y0 && y <= y1;
             let cell = if inside {
                 let ix = (((x - x0) / dx) as usize).min(nx - 1);
                 let iy = (((y - y0) / dy) as usize).min(ny - 1);

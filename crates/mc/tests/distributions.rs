@@ -142,6 +142,44 @@ fn piecewise_2d_fits_its_pdf() {
 }
 
 #[test]
+fn piecewise_alias_2d_fits_its_pdf() {
+    let (nu, nv) = (16, 8);
+    let mut f = weights(nu * nv, 5);
+    f[3 * nu..4 * nu].iter_mut().for_each(|v| *v = 0.0);
+    let d = PiecewiseConstantAlias2D::new(&f, nu, nv).unwrap();
+    let pts = draws(N, 16, |s| {
+        let (p, pdf) = d.sample(s.next_2d());
+        assert_eq!(pdf, d.pdf(p));
+        [p.x as f64, p.y as f64]
+    });
+    let pdf = |x: f64, y: f64| d.pdf(Vec2::new(x as f32, y as f32)) as f64;
+    // Bins of a quarter of a cell: the points must also be uniform within their cells.
+    let t = chi2_test_2d(pts.clone(), pdf, [[0.0, 1.0], [0.0, 1.0]], [nu * 2, nv * 2]);
+    assert_fits("piecewise-constant alias 2D", &t);
+    // The same density as the marginal-conditional distribution of the same values.
+    let cdf = PiecewiseConstant2D::new(&f, nu, nv, Vec2::ZERO, Vec2::ONE).unwrap();
+    for (i, j) in (0..nu * 2).flat_map(|i| (0..nv * 2).map(move |j| (i, j))) {
+        let p = Vec2::new(
+            (i as f32 + 0.5) / (nu * 2) as f32,
+            (j as f32 + 0.5) / (nv * 2) as f32,
+        );
+        assert!((d.pdf(p) - cdf.pdf(p)).abs() <= 1e-6 * cdf.pdf(p), "{p:?}");
+    }
+    // One cell's probability moved to its neighbour is rejected.
+    let wrong = |x: f64, y: f64| {
+        let (c, r) = ((x * nu as f64) as usize, (y * nv as f64) as usize);
+        let shift = match (c, r) {
+            (0, 0) => -0.5,
+            (1, 0) => 0.5,
+            _ => 0.0,
+        };
+        pdf(x, y) * (1.0 + shift * (f[0] + f[1]) as f64 / (2.0 * f[c + r * nu].max(1e-9) as f64))
+    };
+    let t = chi2_test_2d(pts, wrong, [[0.0, 1.0], [0.0, 1.0]], [nu * 2, nv * 2]);
+    assert_rejects("piecewise-constant alias 2D vs wrong pdf", &t);
+}
+
+#[test]
 fn piecewise_2d_inverts() {
     let f = weights(12 * 6, 6);
     let d = PiecewiseConstant2D::new(&f, 12, 6, Vec2::ZERO, Vec2::new(3.0, 2.0)).unwrap();

@@ -22,6 +22,32 @@ struct Bin {
     alias: usize,
 }
 
+/// Vose's construction of the bins of an alias table from `scaled`, each outcome's probability
+/// times the number of outcomes (so they average 1): bin `i`'s probability `q` of keeping `i`
+/// and its alias. Bins are filled by pairing an under-full outcome with an over-full one until
+/// every bin holds exactly 1/n of probability; an outcome of zero probability keeps none.
+pub(crate) fn vose_bins(mut scaled: Vec<f64>) -> Vec<(f64, usize)> {
+    let n = scaled.len();
+    let mut bins: Vec<(f64, usize)> = (0..n).map(|i| (1.0, i)).collect();
+    // A bin is "small" below 1 and "large" above.
+    let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+    while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+        small.pop();
+        bins[s] = (scaled[s], l);
+        // The large outcome gives (1 - q_s) of its scaled probability to bin s.
+        scaled[l] -= 1.0 - scaled[s];
+        if scaled[l] < 1.0 {
+            large.pop();
+            small.push(l);
+        }
+    }
+    // What remains in either list holds (up to rounding) exactly one bin's worth.
+    for i in small.into_iter().chain(large) {
+        bins[i] = (1.0, i);
+    }
+    bins
+}
+
 /// Walker's alias method: a discrete distribution over `0..n` sampled in O(1).
 ///
 /// Each of `n` equally likely bins holds its own index with probability `q` and an alias
@@ -55,28 +81,10 @@ impl AliasTable {
         }
         let n = weights.len();
         let pmf: Vec<f64> = weights.iter().map(|w| w / sum).collect();
-        // Scaled probabilities: a bin is "small" below 1 and "large" above.
-        let mut scaled: Vec<f64> = pmf.iter().map(|p| p * n as f64).collect();
-        let mut bins: Vec<Bin> = (0..n).map(|i| Bin { q: 1.0, alias: i }).collect();
-        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
-            (0..n).partition(|&i| scaled[i] < 1.0);
-        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
-            small.pop();
-            bins[s] = Bin {
-                q: scaled[s],
-                alias: l,
-            };
-            // The large index gives (1 - q_s) of its scaled probability to bin s.
-            scaled[l] -= 1.0 - scaled[s];
-            if scaled[l] < 1.0 {
-                large.pop();
-                small.push(l);
-            }
-        }
-        // What remains in either list holds (up to rounding) exactly one bin's worth.
-        for i in small.into_iter().chain(large) {
-            bins[i] = Bin { q: 1.0, alias: i };
-        }
+        let bins = vose_bins(pmf.iter().map(|p| p * n as f64).collect())
+            .into_iter()
+            .map(|(q, alias)| Bin { q, alias })
+            .collect();
         Ok(AliasTable { bins, pmf })
     }
 

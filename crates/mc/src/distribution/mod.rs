@@ -7,6 +7,9 @@
 //! - [`PiecewiseConstant2D`]: a tabulated function on a rectangle, sampled by a marginal
 //!   distribution over rows and a conditional one within the chosen row (what environment-map
 //!   importance sampling uses).
+//! - [`PiecewiseConstantAlias2D`]: the same density on the unit square, the row and the cell
+//!   chosen by alias tables in constant time (environment maps: one cache line of a large
+//!   table per sample).
 //! - [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias method, built by
 //!   Vose's algorithm), e.g. choosing a light in proportion to its power.
 //!
@@ -14,10 +17,12 @@
 //! matching `pdf` so that the two can be checked against each other.
 
 mod alias;
+mod alias2d;
 mod exponential;
 mod piecewise;
 
 pub use alias::{AliasSample, AliasTable};
+pub use alias2d::PiecewiseConstantAlias2D;
 pub use exponential::Exponential;
 pub use piecewise::{DiscreteSample, PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseSample};
 

@@ -247,21 +247,8 @@ impl Pieces<'_> {
         if self.offset_of(x) == o {
             x
         } else {
-            self.step_into_piece(x, o)
+            step_into_piece(x, o, |x| self.offset_of(x))
         }
-    }
-
-    /// [`Pieces::settle_in_piece`] of a point outside piece `o`.
-    #[inline(never)]
-    fn step_into_piece(&self, mut x: f32, o: usize) -> f32 {
-        for _ in 0..8 {
-            match self.offset_of(x).cmp(&o) {
-                std::cmp::Ordering::Less => x = x.next_up(),
-                std::cmp::Ordering::Greater => x = x.next_down(),
-                std::cmp::Ordering::Equal => break,
-            }
-        }
-        x
     }
 
     fn invert_sample(&self, x: f32) -> f32 {
@@ -272,6 +259,21 @@ impl Pieces<'_> {
         let (c0, c1) = (self.entries[o].cdf, self.entries[o + 1].cdf);
         c0 + frac * (c1 - c0)
     }
+}
+
+/// `x`, a point outside piece `o` (by `offset_of`, which does not decrease with x), moved to
+/// the nearest float inside it: rounding puts a point at most a float or two past its piece's
+/// edge. Out of line: it is rare.
+#[inline(never)]
+pub(super) fn step_into_piece(mut x: f32, o: usize, offset_of: impl Fn(f32) -> usize) -> f32 {
+    for _ in 0..8 {
+        match offset_of(x).cmp(&o) {
+            std::cmp::Ordering::Less => x = x.next_up(),
+            std::cmp::Ordering::Greater => x = x.next_down(),
+            std::cmp::Ordering::Equal => break,
+        }
+    }
+    x
 }
 
 /// A piece of a tabulated distribution as sampling reads it, for one value or lanes: the CDF
@@ -330,7 +332,7 @@ fn density_of_piece<R: Real>(func: R, func_int: R, min: f32, max: f32) -> R {
 /// and `a / n` are both the correctly rounded value of the same real number, so they are the
 /// same float (subnormal results included); a division where it is not.
 #[inline(always)]
-fn divide_by_count<R: Real>(a: R, n: usize) -> R {
+pub(super) fn divide_by_count<R: Real>(a: R, n: usize) -> R {
     if n.is_power_of_two() {
         // 2^-k from its exponent bits (k < 64 < 127: a normal float).
         a * R::splat(f32::from_bits((127 - n.trailing_zeros()) << 23))

@@ -18,6 +18,24 @@
 pub mod lanes;
 pub mod trig;
 
+/// Asks the CPU to bring the cache line holding `value` into its caches, ahead of a read that
+/// comes later: a hint, with no effect on any result (and no instruction where the CPU has
+/// none). For reads of large tables at addresses known well before they are read, such as an
+/// environment map's texels, found when a direction is sampled and read after its shadow ray.
+#[inline(always)]
+pub fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: `prefetcht0` belongs to SSE, which every x86-64 CPU has; it changes no register
+    // or memory a program can see and never faults, and the address is that of a live
+    // reference besides.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>((value as *const T).cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}
+
 /// Paths traced together by the eight-lane path and drawn together by the samplers' lane
 /// routines: one lane of [`lanes::F8`] each.
 pub const PATH_LANES: usize = lanes::W;

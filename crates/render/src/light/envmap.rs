@@ -10,13 +10,16 @@
 //! Sampling: the (u, v) square is cut into W × (H - 1) cells between grid points; each cell's
 //! weight is the largest luminance of its four corners (which bounds the interpolated
 //! radiance inside it) times ∫ sin θ over its rows, so the density per solid angle,
-//! p(ω) = p(u, v) / (2π² sin θ), follows the radiance and small bright suns are found.
+//! p(ω) = p(u, v) / (2π² sin θ), follows the radiance and small bright suns are found. A cell
+//! is chosen by alias tables ([`PiecewiseConstantAlias2D`]): a sample reads one bin of the
+//! large table, where a search of the rows' CDFs reads several cache lines one after another.
 
 use crate::color::{luminance, LUMINANCE_WEIGHTS};
 use crate::desc::Rgb;
 use glam::{Mat3, Vec2, Vec3};
-use pathlab_mc::distribution::PiecewiseConstant2D;
+use pathlab_mc::distribution::PiecewiseConstantAlias2D;
 use pathlab_mc::simd::lanes::{Real, Vector3, F8, M8, V8, W};
+use pathlab_mc::simd::prefetch;
 use pathlab_mc::simd::trig::{acos, atan2, sin_cos_turns};
 use std::f32::consts::{PI, TAU};
 
@@ -29,7 +32,7 @@ pub struct EnvironmentMap {
     texels: Vec<Rgb>,
     to_world: Mat3,
     to_local: Mat3,
-    distribution: PiecewiseConstant2D,
+    distribution: PiecewiseConstantAlias2D,
     /// ∫ luminance dω over the sphere.
     luminance_integral: f32,
     /// Half a texel in u, 0.5 / W: grid column i sits at u = (i + ½) / W.
@@ -109,11 +112,10 @@ impl EnvironmentMap {
                 luminance_integral += (mean * band) as f64 * (TAU / nu as f32) as f64;
             }
         }
-        let distribution = PiecewiseConstant2D::new(&weights, nu, nv, Vec2::ZERO, Vec2::ONE)
-            .map_err(|_| {
-                // Only reachable for empty input, excluded above.
-                EnvironmentMapError::TooSmall(width, height)
-            })?;
+        let distribution = PiecewiseConstantAlias2D::new(&weights, nu, nv).map_err(|_| {
+            // Only reachable for empty input, excluded above.
+            EnvironmentMapError::TooSmall(width, height)
+        })?;
         Ok(EnvironmentMap {
             width,
             height,
@@ -302,6 +304,14 @@ impl EnvironmentMap {
         let ([cell_u, v], pdf_uv) = self.distribution.sample_lanes(u, active);
         // The lanes outside `active` have no direction: their density is zero.
         let (wi, pdf, u, found) = self.direction_of_cell(cell_u, v, pdf_uv);
+        // The texels `radiance_at` will read, asked for now: they are read after the shadow
+        // ray, and in a large map they are rarely in cache.
+        let (gx, gy) = self.grid(u, v);
+        for i in (0..W).filter(|&i| found.get(i)) {
+            let (corners, ..) = self.cell_at(gx.0[i], gy.0[i]);
+            prefetch(&self.texels[corners[0]]);
+            prefetch(&self.texels[corners[2]]);
+        }
         DirectionLanes {
             found,
             wi,
