@@ -2,7 +2,7 @@
 //! alias tables in constant time.
 
 use super::alias::vose_bins;
-use super::check_weights;
+use super::check_grid;
 use super::piecewise::{divide_by_count, step_into_piece};
 use crate::error::{Error, Result};
 use crate::simd::lanes::{F8, W};
@@ -43,11 +43,11 @@ struct CellBin {
 /// picks one of the `nv` equal bins of the rows' table and, by where it falls in the bin,
 /// the bin's own row or its alias; the fraction of the bin that chose the row, stretched to
 /// [0, 1), is the point's place within the row. Then `u.x` does the same among the row's cells.
-/// Each cell is reached with its probability, and each number in [0, 1) reaches the same
-/// share of a cell as a CDF's inversion would (a cell of probability P gets a P-wide set of
-/// `u`), but the map from `u` to cells does not keep neighbouring numbers in neighbouring
-/// cells, as the inversion does: stratified numbers stay stratified over the cells' counts,
-/// not over the square.
+/// Each cell is reached with its probability, from a set of numbers of total length P for a
+/// cell of probability P, as under inversion (so the points within a cell are as finely
+/// spaced); but the map from `u` to cells does not keep neighbouring numbers in neighbouring
+/// cells, as inversion does: stratified numbers stay stratified over the cells' counts, not
+/// over the square.
 ///
 /// A sample reads two bins, one of the rows' table (`nv` bins, small, usually in cache) and one
 /// of its row's, which holds the density of both cells it may give: for large tables, such as
@@ -69,17 +69,13 @@ impl PiecewiseConstantAlias2D {
     /// rows) over the unit square.
     pub fn new(func: &[f32], nu: usize, nv: usize) -> Result<Self> {
         const WHAT: &str = "2D piecewise-constant alias distribution";
-        if nu == 0 || nv == 0 || func.len() != nu * nv || nu.max(nv) > u32::MAX as usize {
+        check_grid(WHAT, func, nu, nv)?;
+        if nu.max(nv) > u32::MAX as usize {
             return Err(Error::InvalidParameter {
                 what: WHAT,
-                message: format!(
-                    "expected {nu} x {nv} = {} values, got {}",
-                    nu.saturating_mul(nv),
-                    func.len()
-                ),
+                message: format!("{nu} x {nv} cells: at most 2^32 - 1 across and down"),
             });
         }
-        check_weights(WHAT, func)?;
         let row_sums: Vec<f64> = func
             .chunks_exact(nu)
             .map(|row| row.iter().map(|&f| f as f64).sum())

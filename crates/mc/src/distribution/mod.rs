@@ -28,6 +28,22 @@ pub use piecewise::{DiscreteSample, PiecewiseConstant1D, PiecewiseConstant2D, Pi
 
 use crate::error::{Error, Result};
 
+/// Checks that `func` is a grid of `nu` × `nv` values (both at least 1), each finite and
+/// non-negative.
+pub(crate) fn check_grid(what: &'static str, func: &[f32], nu: usize, nv: usize) -> Result<()> {
+    if nu == 0 || nv == 0 || func.len() != nu.saturating_mul(nv) {
+        return Err(Error::InvalidParameter {
+            what,
+            message: format!(
+                "expected {nu} x {nv} = {} values, got {}",
+                nu.saturating_mul(nv),
+                func.len()
+            ),
+        });
+    }
+    check_weights(what, func)
+}
+
 /// Checks that every value is finite and non-negative.
 pub(crate) fn check_weights<T: Copy + Into<f64>>(what: &'static str, values: &[T]) -> Result<()> {
     if values.is_empty() {

@@ -2,7 +2,7 @@
 //! ([`PiecewiseConstant2D`]), sampled by inverting their tabulated CDFs, continuous or
 //! discrete.
 
-use super::check_weights;
+use super::{check_grid, check_weights};
 use crate::error::{Error, Result};
 use crate::simd::lanes::{Real, F8, M8, W};
 use glam::Vec2;
@@ -581,18 +581,7 @@ impl PiecewiseConstant2D {
     /// The distribution of `func` (row-major, `nu` values per row, `nv` rows) over the
     /// rectangle `[min, max]`.
     pub fn new(func: &[f32], nu: usize, nv: usize, min: Vec2, max: Vec2) -> Result<Self> {
-        const WHAT: &str = "2D piecewise-constant distribution";
-        if nu == 0 || nv == 0 || func.len() != nu * nv {
-            return Err(Error::InvalidParameter {
-                what: WHAT,
-                message: format!(
-                    "expected {nu} x {nv} = {} values, got {}",
-                    nu.saturating_mul(nv),
-                    func.len()
-                ),
-            });
-        }
-        check_weights(WHAT, func)?;
+        check_grid("2D piecewise-constant distribution", func, nu, nv)?;
         let mut entries = Vec::with_capacity((nu + 1) * nv);
         let mut guide = Vec::new();
         let mut guide_len = 0;
