@@ -142,4 +142,22 @@ mod tests {
             assert!(Avx2::detect().is_some());
         }
     }
+
+    #[test]
+    fn prefetching_changes_nothing() {
+        // Elements of a 12 MB table (beyond a core's own caches), its last included, and
+        // values of other sizes: the hint may touch no byte.
+        let table: Vec<[f32; 3]> = (0..1 << 20).map(|i| [i as f32, -(i as f32), 0.5]).collect();
+        for k in (0..table.len()).step_by(97).chain([table.len() - 1]) {
+            prefetch(&table[k]);
+        }
+        let small = (1u8, 2u64);
+        prefetch(&small);
+        prefetch(&table);
+        assert_eq!(small, (1, 2));
+        assert!(table
+            .iter()
+            .enumerate()
+            .all(|(i, v)| *v == [i as f32, -(i as f32), 0.5]));
+    }
 }
