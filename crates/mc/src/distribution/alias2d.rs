@@ -91,16 +91,7 @@ impl PiecewiseConstantAlias2D {
         // The density of a cell of value f: f / ∫∫ f, the division `pdf` users may repeat
         // from the value (an environment map does, from its texels); uniform where all are 0.
         let density = |f: f32| if integral > 0.0 { f / integral } else { 1.0 };
-        // Each bin's share of its table, scaled so that the shares average 1; uniform where
-        // the table's values are all zero.
-        let scaled = |values: &mut dyn Iterator<Item = f64>, n: usize, sum: f64| -> Vec<f64> {
-            if sum > 0.0 {
-                values.map(|v| v / sum * n as f64).collect()
-            } else {
-                vec![1.0; n]
-            }
-        };
-        let rows = vose_bins(scaled(&mut row_sums.iter().copied(), nv, total))
+        let rows = vose_bins(shares(row_sums.iter().copied(), nv, total))
             .into_iter()
             .map(|(q, alias)| RowBin {
                 q: q as f32,
@@ -109,7 +100,7 @@ impl PiecewiseConstantAlias2D {
             .collect();
         let mut cells = Vec::with_capacity(nu * nv);
         for (row, &sum) in func.chunks_exact(nu).zip(&row_sums) {
-            let bins = vose_bins(scaled(&mut row.iter().map(|&f| f as f64), nu, sum));
+            let bins = vose_bins(shares(row.iter().map(|&f| f as f64), nu, sum));
             cells.extend(
                 bins.into_iter()
                     .enumerate()
@@ -222,6 +213,16 @@ struct Located {
     bin: usize,
     up_x: f32,
     cell: usize,
+}
+
+/// The `n` values of a table summing to `sum`, each as its share of the table times `n`, so
+/// that they average 1 ([`vose_bins`]' input); all 1 where the values are all zero.
+fn shares(values: impl Iterator<Item = f64>, n: usize, sum: f64) -> Vec<f64> {
+    if sum > 0.0 {
+        values.map(|v| v / sum * n as f64).collect()
+    } else {
+        vec![1.0; n]
+    }
 }
 
 /// The bin of `n` equal bins over [0, 1) that `u` falls in, and where in it, in [0, 1) (`u`

@@ -4,7 +4,7 @@
 
 use super::{check_grid, check_weights};
 use crate::error::{Error, Result};
-use crate::simd::lanes::{Real, F8, M8, W};
+use crate::simd::lanes::Real;
 use glam::Vec2;
 
 /// A continuous sample of a [`PiecewiseConstant1D`].
@@ -160,29 +160,6 @@ impl Pieces<'_> {
         Some((self.guide[k] as usize, self.guide[k + 1] as usize))
     }
 
-    /// [`Pieces::cdf_entries_at_most`] without a branch on the length of `u`'s bucket where it
-    /// holds at most `WINDOW` entries, as most do: the count is then over a fixed window of
-    /// `WINDOW` entries that holds them. A window start `s` before the bucket's first entry
-    /// `lo` is no harm: the entries from `s` to `lo` are ≤ u and counted, those from the
-    /// bucket's end on are not. For searches one after another that the branch on the
-    /// bucket's length would mispredict (the lanes' searches); a long bucket or a short table
-    /// is counted as there.
-    #[inline(always)]
-    fn cdf_entries_at_most_windowed(&self, u: f32) -> usize {
-        const WINDOW: usize = 16;
-        let Some((lo, hi)) = self.bucket(u) else {
-            return 0;
-        };
-        let len = self.entries.len();
-        if len >= WINDOW && hi - lo <= WINDOW {
-            let start = lo.min(len - WINDOW);
-            if let Some(window) = self.entries.get(start..start + WINDOW) {
-                return start + count_cdf_at_most(window, u);
-            }
-        }
-        lo + count_cdf_at_most(&self.entries[lo..hi], u)
-    }
-
     /// Density of piece `o` with respect to x.
     #[inline]
     fn piece_pdf(&self, o: usize) -> f32 {
@@ -210,15 +187,7 @@ impl Pieces<'_> {
 
     #[inline]
     fn sample(&self, u: f32) -> PiecewiseSample {
-        self.sample_counted(u, self.cdf_entries_at_most(u))
-    }
-
-    /// [`Pieces::sample`] of `u` given `count`, the number of CDF entries `<= u`
-    /// ([`Pieces::cdf_entries_at_most`]): the two halves of a sample, which the lanes' sampling
-    /// runs as passes over the lanes.
-    #[inline]
-    fn sample_counted(&self, u: f32, count: usize) -> PiecewiseSample {
-        let o = self.piece_of_count(count);
+        let o = self.piece_of_count(self.cdf_entries_at_most(u));
         let piece = self.piece(o);
         let x = point_in_piece(u, o as f32, piece, self.len(), self.min, self.max);
         PiecewiseSample {
@@ -516,40 +485,6 @@ impl PiecewiseConstant1D {
     }
 }
 
-/// The pieces that eight searches found, one per lane, as the lanes' inversion reads them.
-#[derive(Default)]
-struct PieceLanes {
-    /// Each lane's piece.
-    o: [usize; W],
-    /// Its index as a number, its CDF at both ends and its value.
-    index: F8,
-    piece: Piece<F8>,
-}
-
-impl PieceLanes {
-    /// Lane `i`'s piece: the one of `pieces` that `count` CDF entries are at most.
-    #[inline(always)]
-    fn set(&mut self, i: usize, pieces: &Pieces<'_>, count: usize) {
-        let o = pieces.piece_of_count(count);
-        let p = pieces.piece(o);
-        self.o[i] = o;
-        self.index.0[i] = o as f32;
-        (self.piece.c0.0[i], self.piece.c1.0[i], self.piece.func.0[i]) = (p.c0, p.c1, p.func);
-    }
-
-    /// The lanes' points for `u` in their pieces, before [`Pieces::settle_in_piece`], and
-    /// their densities, where the pieces are of distributions with the number of pieces and
-    /// the domain of `like` and the integrals `func_int`.
-    #[inline(always)]
-    fn points(&self, like: &Pieces<'_>, u: F8, func_int: F8) -> (F8, F8) {
-        let (n, min, max) = (like.len(), like.min, like.max);
-        (
-            point_in_piece(u, self.index, self.piece, n, min, max),
-            density_of_piece(self.piece.func, func_int, min, max),
-        )
-    }
-}
-
 /// A piecewise-constant density on a rectangle: `nu × nv` cells with values `f[v][u]`.
 ///
 /// Sampled by the marginal-conditional method: first a row `v` from the marginal density
@@ -636,48 +571,6 @@ impl PiecewiseConstant2D {
         (Vec2::new(col.x, row.x), col.pdf * row.pdf)
     }
 
-    /// [`PiecewiseConstant2D::sample`] of the lanes `active` of (`u[0]`, `u[1]`), each lane to
-    /// the bit as one sample at a time (the other lanes give zeros): the points' u and v and
-    /// their densities. The searches go lane by lane (each lane reads its own row), the
-    /// inversions inside the pieces on all lanes at once ([`point_in_piece`],
-    /// [`density_of_piece`]): first the rows, from the marginal, then the points in the rows.
-    pub fn sample_lanes(&self, u: [F8; 2], active: u32) -> ([F8; 2], F8) {
-        let lanes = || (0..W).filter(move |i| active & (1 << i) != 0);
-        let marginal = self.marginal.pieces();
-        let mut rows = PieceLanes::default();
-        for i in lanes() {
-            let u = u[1].0[i];
-            rows.set(i, &marginal, marginal.cdf_entries_at_most_windowed(u));
-        }
-        let (y, pdf_v) = rows.points(&marginal, u[1], F8::splat(marginal.func_int));
-        let mut counts = [0usize; W];
-        for i in lanes() {
-            counts[i] = self.row(rows.o[i]).cdf_entries_at_most_windowed(u[0].0[i]);
-        }
-        let mut cols = PieceLanes::default();
-        let mut row_integrals = F8::splat(0.0);
-        for i in lanes() {
-            let row = self.row(rows.o[i]);
-            cols.set(i, &row, counts[i]);
-            row_integrals.0[i] = row.func_int;
-        }
-        let (x, pdf_u) = cols.points(&self.row(0), u[0], row_integrals);
-        let mut on = M8::default();
-        for i in lanes() {
-            on.set(i, true);
-        }
-        let mut point = [x, y];
-        for i in lanes() {
-            point[0].0[i] = self.row(rows.o[i]).settle_in_piece(x.0[i], cols.o[i]);
-            point[1].0[i] = marginal.settle_in_piece(y.0[i], rows.o[i]);
-        }
-        let zero = F8::splat(0.0);
-        (
-            point.map(|c| on.select(c, zero)),
-            on.select(pdf_u * pdf_v, zero),
-        )
-    }
-
     /// The density at `p` (0 outside the rectangle).
     pub fn pdf(&self, p: Vec2) -> f32 {
         if !(self.min.x..=self.max.x).contains(&p.x) || !(self.min.y..=self.max.y).contains(&p.y) {
@@ -729,11 +622,6 @@ mod tests {
             for u in us {
                 let want = cdf.partition_point(|&c| c <= u);
                 assert_eq!(d.pieces().cdf_entries_at_most(u), want, "n = {n}, u = {u}");
-                assert_eq!(
-                    d.pieces().cdf_entries_at_most_windowed(u),
-                    want,
-                    "windowed, n = {n}, u = {u}"
-                );
             }
         }
     }
@@ -787,53 +675,6 @@ mod tests {
                 let x = min.x + (max.x - min.x) * rng.uniform_f32();
                 assert_eq!(d.row(v).invert_sample(x), alone.invert_sample(x));
                 assert_eq!(d.row(v).piece_pdf(d.row(v).offset_of(x)), alone.pdf(x));
-            }
-        }
-    }
-
-    #[test]
-    fn eight_lanes_sample_what_one_sample_at_a_time_samples() {
-        let mut rng = Pcg32::new(2, 4);
-        let (nu, nv) = (33, 17);
-        let func: Vec<f32> = (0..nu * nv)
-            .map(|_| match rng.uniform_f32() {
-                x if x < 0.2 => 0.0,
-                x if x < 0.22 => 1e3 * x,
-                x => x,
-            })
-            .collect();
-        for (min, max) in [
-            (Vec2::ZERO, Vec2::ONE),
-            (Vec2::new(-1.0, 2.0), Vec2::new(3.0, 2.5)),
-        ] {
-            let d = PiecewiseConstant2D::new(&func, nu, nv, min, max).unwrap();
-            for k in 0..2000u32 {
-                let mut draw = || {
-                    F8(std::array::from_fn(|_| match rng.next_u32() % 50 {
-                        0 => 0.0,
-                        1 => 1.0f32.next_down(),
-                        _ => rng.uniform_f32(),
-                    }))
-                };
-                let u = [draw(), draw()];
-                let active = if k % 3 == 0 {
-                    0xff
-                } else {
-                    rng.next_u32() & 0xff
-                };
-                let ([x, y], pdf) = d.sample_lanes(u, active);
-                for i in 0..W {
-                    let want = if active & (1 << i) != 0 {
-                        d.sample(Vec2::new(u[0].0[i], u[1].0[i]))
-                    } else {
-                        (Vec2::ZERO, 0.0)
-                    };
-                    assert_eq!(
-                        [x.0[i], y.0[i], pdf.0[i]].map(f32::to_bits),
-                        [want.0.x, want.0.y, want.1].map(f32::to_bits),
-                        "lane {i} of {u:?}"
-                    );
-                }
             }
         }
     }
