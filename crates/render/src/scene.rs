@@ -201,6 +201,8 @@ pub struct Scene {
     lights: Vec<Light>,
     light_sampler: LightSampler,
     environment: Option<u32>,
+    /// Whether some light can be met by a ray ([`Light::is_met_by_rays`]).
+    lights_met_by_rays: bool,
     camera: Camera,
     stats: BuildStats,
 }
@@ -354,6 +356,13 @@ impl Scene {
     /// The environment light's index, if there is one.
     pub fn environment(&self) -> Option<u32> {
         self.environment
+    }
+
+    /// Whether a ray can find emission in this scene: some surface emits, or there is an
+    /// environment. Where none can, the last ray of a path of bounded depth, traced only to
+    /// find emission, need not be traced.
+    pub fn lights_met_by_rays(&self) -> bool {
+        self.lights_met_by_rays
     }
 
     /// Radiance from the environment along direction `w` (zero without one).

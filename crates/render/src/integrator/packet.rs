@@ -616,7 +616,7 @@ impl PathIntegrator {
             st.eta_scale *= eta * eta;
             st.beta.max_element() > 0.0
                 && st.beta.is_finite()
-                && self.survive(st, si, b.wi.get(i), b.pdf.0[i], b.delta.get(i), u_rr)
+                && self.survive(scene, st, si, b.wi.get(i), b.pdf.0[i], b.delta.get(i), u_rr)
         }
     }
 }

@@ -273,15 +273,22 @@ impl PathIntegrator {
         if st.beta.max_element() <= 0.0 || !st.beta.is_finite() {
             return false;
         }
-        self.survive(st, si, bs.wi, bs.pdf, bs.delta, sampler.next_1d())
+        self.survive(scene, st, si, bs.wi, bs.pdf, bs.delta, sampler.next_1d())
     }
 
     /// The end of a bounce whose BSDF sample `wi` (of density `pdf`, or from a delta lobe)
     /// left a finite, positive throughput: Russian roulette with `u_rr`, then the ray along
     /// `wi`. Returns whether the path goes on.
+    ///
+    /// A ray whose arrival would be the path's last (bounce `max_depth`) is traced only for
+    /// the emission it may find; in a scene where no ray can find any (delta lights only, no
+    /// environment: [`Scene::lights_met_by_rays`]) the path ends here instead, with the same
+    /// radiance.
+    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub(crate) fn survive(
         &self,
+        scene: &Scene,
         st: &mut PathState,
         si: &SurfaceInteraction,
         wi: Vec3,
@@ -295,6 +302,9 @@ impl PathIntegrator {
             delta,
         });
         st.depth += 1;
+        if st.depth >= self.max_depth && !scene.lights_met_by_rays() {
+            return false;
+        }
         if st.depth >= self.rr_depth {
             let q = (st.beta * st.eta_scale).max_element().min(0.95);
             if u_rr >= q {
@@ -345,7 +355,97 @@ impl Integrator for PathIntegrator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::desc::{CameraDesc, MeshDesc, PointLightDesc, SceneDesc, INVERSE_SQUARE};
     use glam::Vec2;
+    use pathlab_mc::sampler::SamplerKind;
+
+    /// A diffuse floor seen from above, lit by a point light, and by a uniform environment
+    /// of radiance `environment` where one is given.
+    fn floor_lit_by(environment: Option<Rgb>) -> Scene {
+        let desc = SceneDesc {
+            meshes: vec![MeshDesc {
+                name: "floor".into(),
+                positions: vec![
+                    Vec3::new(-4.0, 0.0, -4.0),
+                    Vec3::new(-4.0, 0.0, 4.0),
+                    Vec3::new(4.0, 0.0, 4.0),
+                    Vec3::new(4.0, 0.0, -4.0),
+                ],
+                indices: vec![0, 1, 2, 0, 2, 3],
+                material: 0,
+                ..Default::default()
+            }],
+            materials: vec![crate::scene::diffuse(Vec3::splat(0.5), false)],
+            point_lights: vec![PointLightDesc {
+                position: Vec3::new(0.3, 1.0, 0.2),
+                intensity: Vec3::splat(2.0),
+                attenuation: INVERSE_SQUARE,
+            }],
+            environment,
+            camera: CameraDesc {
+                origin: Vec3::new(0.0, 2.0, 0.5),
+                target: Vec3::ZERO,
+                up: Vec3::Y,
+                fov_degrees: 60.0,
+                ..Default::default()
+            },
+            resolution: [8, 8],
+            ..Default::default()
+        };
+        Scene::build(&desc).unwrap()
+    }
+
+    /// Every pixel's first sample by the one-path code, and the rays traced.
+    fn radiance_and_rays(pt: &PathIntegrator, scene: &Scene) -> (Vec<Rgb>, u64) {
+        let mut sampler = SamplerKind::Independent.build(1, 3);
+        let mut stats = PathStats::default();
+        let mut out = Vec::new();
+        for y in 0..8 {
+            for x in 0..8 {
+                let s = SampleRef {
+                    pixel: [x, y],
+                    index: 0,
+                    tag: 0,
+                };
+                let (ray, weight) = super::super::camera_ray(scene, &mut sampler, s);
+                out.push(pt.li(scene, ray, &mut sampler, &mut stats) * weight);
+            }
+        }
+        (out, stats.rays)
+    }
+
+    #[test]
+    fn the_last_ray_is_traced_only_where_it_can_find_emission() {
+        let lit = |environment| floor_lit_by(environment);
+        let (delta_only, with_sky) = (lit(None), lit(Some(Vec3::splat(0.25))));
+        assert!(!delta_only.lights_met_by_rays());
+        assert!(with_sky.lights_met_by_rays());
+        // Direct lighting, against a path one bounce longer that counts only the first
+        // bounce's light: that one traces the ray that ends at bounce one, and stops there.
+        let direct = PathIntegrator {
+            max_depth: 1,
+            ..Default::default()
+        };
+        let longer = PathIntegrator {
+            max_depth: 2,
+            only_bounce: Some(1),
+            ..Default::default()
+        };
+        // Lit by the point alone, direct lighting traces a camera ray and a shadow ray per
+        // sample (every camera ray meets the floor, every point sees the light) and gives
+        // the same radiance to the bit.
+        let (l, rays) = radiance_and_rays(&direct, &delta_only);
+        let (l_longer, rays_longer) = radiance_and_rays(&longer, &delta_only);
+        assert_eq!(rays, 2 * 64);
+        assert_eq!(rays_longer, 3 * 64);
+        assert_eq!(l.iter().filter(|l| l.max_element() > 0.0).count(), 64);
+        assert_eq!(l, l_longer);
+        // Under a sky the BSDF-sampled ray may find it, and is traced.
+        let (l, rays) = radiance_and_rays(&direct, &with_sky);
+        let (l_longer, rays_longer) = radiance_and_rays(&longer, &with_sky);
+        assert_eq!(rays, rays_longer);
+        assert_eq!(l, l_longer);
+    }
 
     #[test]
     fn russian_roulette_weighs_the_throughput_without_refractions_radiance_scaling() {
@@ -361,6 +461,7 @@ mod tests {
             b: Vec2::ZERO,
         };
         let pt = PathIntegrator::default();
+        let scene = floor_lit_by(Some(Vec3::ONE));
         // Inside glass of index 1.5 after a refraction that kept 90% of the light: β is
         // 0.9 / 1.5² = 0.4, η_scale 1.5². Roulette continues with q = 0.9 (not 0.4), so
         // u = 0.8 goes on and β becomes 0.4 / 0.9.
@@ -368,18 +469,18 @@ mod tests {
         st.depth = pt.rr_depth;
         st.beta = Rgb::splat(0.9 / 2.25);
         st.eta_scale = 2.25;
-        assert!(pt.survive(&mut st, &si, Vec3::Z, 1.0, true, 0.8));
+        assert!(pt.survive(&scene, &mut st, &si, Vec3::Z, 1.0, true, 0.8));
         assert_eq!(st.beta, Rgb::splat(0.9 / 2.25 / 0.9));
         // u = 0.9 ends it.
         st.beta = Rgb::splat(0.9 / 2.25);
-        assert!(!pt.survive(&mut st, &si, Vec3::Z, 1.0, true, 0.9));
+        assert!(!pt.survive(&scene, &mut st, &si, Vec3::Z, 1.0, true, 0.9));
         // Without refractions η_scale is one and q is β itself (at most 0.95).
         let mut st = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
         st.depth = pt.rr_depth;
         st.beta = Rgb::new(0.2, 0.4, 0.1);
-        assert!(!pt.survive(&mut st, &si, Vec3::Z, 1.0, false, 0.4));
+        assert!(!pt.survive(&scene, &mut st, &si, Vec3::Z, 1.0, false, 0.4));
         st.beta = Rgb::new(0.2, 0.4, 0.1);
-        assert!(pt.survive(&mut st, &si, Vec3::Z, 1.0, false, 0.399));
+        assert!(pt.survive(&scene, &mut st, &si, Vec3::Z, 1.0, false, 0.399));
         assert_eq!(st.beta, Rgb::new(0.2, 0.4, 0.1) / 0.4);
     }
 }

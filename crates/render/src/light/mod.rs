@@ -160,6 +160,16 @@ impl Light {
         )
     }
 
+    /// Whether a ray can find this light's emission: an emitting surface or the environment.
+    /// Points, spots, directional lights and projectors are delta distributions, which only
+    /// light sampling reaches.
+    pub fn is_met_by_rays(&self) -> bool {
+        matches!(
+            self,
+            Light::Area { .. } | Light::Environment { .. } | Light::EnvironmentMap { .. }
+        )
+    }
+
     /// Radiance from an environment light arriving along world direction `-w` (`w` points
     /// from the scene into the environment); zero for other lights.
     #[inline]

@@ -58,6 +58,7 @@ impl Scene {
         let leaves = leaf_blocks(&mut bvh, &prims, &triangles.triangles, &prim_visibility);
         let (tri_surface, tri_surfaces, same_surface) =
             surface_table(&triangles.material, &triangles.light, materials.len());
+        let lights_met_by_rays = lights.lights.iter().any(Light::is_met_by_rays);
         let stats = BuildStats {
             bvh_seconds,
             bvh_nodes: bvh.node_count(),
@@ -105,6 +106,7 @@ impl Scene {
             lights: lights.lights,
             light_sampler,
             environment,
+            lights_met_by_rays,
             camera: Camera::new(&desc.camera, desc.resolution).with_filter(desc.filter),
             stats,
         })
