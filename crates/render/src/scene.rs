@@ -201,8 +201,8 @@ pub struct Scene {
     lights: Vec<Light>,
     light_sampler: LightSampler,
     environment: Option<u32>,
-    /// Whether some light can be met by a ray ([`Light::is_met_by_rays`]).
-    lights_met_by_rays: bool,
+    /// A box around every emitting surface, a little larger (none without one).
+    emitter_bounds: Option<Aabb>,
     camera: Camera,
     stats: BuildStats,
 }
@@ -358,11 +358,16 @@ impl Scene {
         self.environment
     }
 
-    /// Whether a ray can find emission in this scene: some surface emits, or there is an
-    /// environment. Where none can, the last ray of a path of bounded depth, traced only to
-    /// find emission, need not be traced.
-    pub fn lights_met_by_rays(&self) -> bool {
-        self.lights_met_by_rays
+    /// Whether `ray` may find emission: the scene has an environment, or the ray meets the
+    /// box around its emitting surfaces (a little larger, so that rounding cannot hide a
+    /// hit). Where it cannot, the ray that ends a path of bounded depth, traced only to find
+    /// emission, need not be traced.
+    #[inline]
+    pub fn may_find_emission(&self, ray: &Ray) -> bool {
+        self.environment.is_some()
+            || self
+                .emitter_bounds
+                .is_some_and(|b| b.hit(ray.o, ray.d.recip(), ray.t_max).is_some())
     }
 
     /// Radiance from the environment along direction `w` (zero without one).

@@ -281,9 +281,9 @@ impl PathIntegrator {
     /// `wi`. Returns whether the path goes on.
     ///
     /// A ray whose arrival would be the path's last (bounce `max_depth`) is traced only for
-    /// the emission it may find; in a scene where no ray can find any (delta lights only, no
-    /// environment: [`Scene::lights_met_by_rays`]) the path ends here instead, with the same
-    /// radiance.
+    /// the emission it may find; where it cannot find any ([`Scene::may_find_emission`]: no
+    /// environment, and it misses the box around the emitting surfaces, or there are none)
+    /// the path ends here instead, with the same radiance.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub(crate) fn survive(
@@ -302,9 +302,6 @@ impl PathIntegrator {
             delta,
         });
         st.depth += 1;
-        if st.depth >= self.max_depth && !scene.lights_met_by_rays() {
-            return false;
-        }
         if st.depth >= self.rr_depth {
             let q = (st.beta * st.eta_scale).max_element().min(0.95);
             if u_rr >= q {
@@ -316,7 +313,7 @@ impl PathIntegrator {
             return false;
         }
         st.ray = spawn_ray(si.p, si.ng, wi);
-        true
+        st.depth < self.max_depth || scene.may_find_emission(&st.ray)
     }
 }
 
@@ -359,22 +356,40 @@ mod tests {
     use glam::Vec2;
     use pathlab_mc::sampler::SamplerKind;
 
-    /// A diffuse floor seen from above, lit by a point light, and by a uniform environment
-    /// of radiance `environment` where one is given.
-    fn floor_lit_by(environment: Option<Rgb>) -> Scene {
+    /// A diffuse floor seen from above, lit by a point light, by a uniform environment of
+    /// radiance `environment` where one is given, and by a small emitting square above it
+    /// where `lamp`.
+    fn floor_lit_by(environment: Option<Rgb>, lamp: bool) -> Scene {
+        let quad = |y: f32, r: f32, emission: Option<crate::desc::Emission>| MeshDesc {
+            name: "quad".into(),
+            positions: vec![
+                Vec3::new(-r, y, -r),
+                Vec3::new(-r, y, r),
+                Vec3::new(r, y, r),
+                Vec3::new(r, y, -r),
+            ],
+            indices: if emission.is_some() {
+                vec![0, 2, 1, 0, 3, 2]
+            } else {
+                vec![0, 1, 2, 0, 2, 3]
+            },
+            material: 0,
+            emission,
+            ..Default::default()
+        };
+        let mut meshes = vec![quad(0.0, 4.0, None)];
+        if lamp {
+            meshes.push(quad(
+                1.5,
+                0.2,
+                Some(crate::desc::Emission {
+                    radiance: Vec3::splat(20.0),
+                    two_sided: false,
+                }),
+            ));
+        }
         let desc = SceneDesc {
-            meshes: vec![MeshDesc {
-                name: "floor".into(),
-                positions: vec![
-                    Vec3::new(-4.0, 0.0, -4.0),
-                    Vec3::new(-4.0, 0.0, 4.0),
-                    Vec3::new(4.0, 0.0, 4.0),
-                    Vec3::new(4.0, 0.0, -4.0),
-                ],
-                indices: vec![0, 1, 2, 0, 2, 3],
-                material: 0,
-                ..Default::default()
-            }],
+            meshes,
             materials: vec![crate::scene::diffuse(Vec3::splat(0.5), false)],
             point_lights: vec![PointLightDesc {
                 position: Vec3::new(0.3, 1.0, 0.2),
@@ -397,18 +412,25 @@ mod tests {
 
     /// Every pixel's first sample by the one-path code, and the rays traced.
     fn radiance_and_rays(pt: &PathIntegrator, scene: &Scene) -> (Vec<Rgb>, u64) {
-        let mut sampler = SamplerKind::Independent.build(1, 3);
+        radiance_and_rays_spp(pt, scene, 1)
+    }
+
+    /// Every pixel's first `spp` samples by the one-path code, and the rays traced.
+    fn radiance_and_rays_spp(pt: &PathIntegrator, scene: &Scene, spp: u32) -> (Vec<Rgb>, u64) {
+        let mut sampler = SamplerKind::Independent.build(spp, 3);
         let mut stats = PathStats::default();
         let mut out = Vec::new();
         for y in 0..8 {
             for x in 0..8 {
-                let s = SampleRef {
-                    pixel: [x, y],
-                    index: 0,
-                    tag: 0,
-                };
-                let (ray, weight) = super::super::camera_ray(scene, &mut sampler, s);
-                out.push(pt.li(scene, ray, &mut sampler, &mut stats) * weight);
+                for index in 0..spp {
+                    let s = SampleRef {
+                        pixel: [x, y],
+                        index,
+                        tag: 0,
+                    };
+                    let (ray, weight) = super::super::camera_ray(scene, &mut sampler, s);
+                    out.push(pt.li(scene, ray, &mut sampler, &mut stats) * weight);
+                }
             }
         }
         (out, stats.rays)
@@ -416,12 +438,8 @@ mod tests {
 
     #[test]
     fn the_last_ray_is_traced_only_where_it_can_find_emission() {
-        let lit = |environment| floor_lit_by(environment);
-        let (delta_only, with_sky) = (lit(None), lit(Some(Vec3::splat(0.25))));
-        assert!(!delta_only.lights_met_by_rays());
-        assert!(with_sky.lights_met_by_rays());
         // Direct lighting, against a path one bounce longer that counts only the first
-        // bounce's light: that one traces the ray that ends at bounce one, and stops there.
+        // bounce's light: that one traces every ray that ends at bounce one, and stops there.
         let direct = PathIntegrator {
             max_depth: 1,
             ..Default::default()
@@ -431,19 +449,58 @@ mod tests {
             only_bounce: Some(1),
             ..Default::default()
         };
-        // Lit by the point alone, direct lighting traces a camera ray and a shadow ray per
-        // sample (every camera ray meets the floor, every point sees the light) and gives
-        // the same radiance to the bit.
-        let (l, rays) = radiance_and_rays(&direct, &delta_only);
-        let (l_longer, rays_longer) = radiance_and_rays(&longer, &delta_only);
+        let up = Ray::new(Vec3::new(0.0, 0.1, 0.0), Vec3::Y);
+        let aside = Ray::new(
+            Vec3::new(0.0, 0.1, 0.0),
+            Vec3::new(1.0, 1.0, 0.0).normalize(),
+        );
+        // Lit by the point alone, no ray can find emission: direct lighting traces a camera
+        // ray and a shadow ray per sample (every camera ray meets the floor, every point
+        // sees the light), and gives the same radiance to the bit.
+        let point = floor_lit_by(None, false);
+        assert!(!point.may_find_emission(&up));
+        let (l, rays) = radiance_and_rays(&direct, &point);
+        let (l_longer, rays_longer) = radiance_and_rays(&longer, &point);
         assert_eq!(rays, 2 * 64);
         assert_eq!(rays_longer, 3 * 64);
         assert_eq!(l.iter().filter(|l| l.max_element() > 0.0).count(), 64);
         assert_eq!(l, l_longer);
-        // Under a sky the BSDF-sampled ray may find it, and is traced.
-        let (l, rays) = radiance_and_rays(&direct, &with_sky);
-        let (l_longer, rays_longer) = radiance_and_rays(&longer, &with_sky);
+        // Under a sky every BSDF-sampled ray may find it, and is traced.
+        let sky = floor_lit_by(Some(Vec3::splat(0.25)), false);
+        assert!(sky.may_find_emission(&aside));
+        let (l, rays) = radiance_and_rays(&direct, &sky);
+        let (l_longer, rays_longer) = radiance_and_rays(&longer, &sky);
         assert_eq!(rays, rays_longer);
+        assert_eq!(l, l_longer);
+        // With a small lamp, only the rays towards its box are.
+        let lamp = floor_lit_by(None, true);
+        assert!(lamp.may_find_emission(&up));
+        assert!(!lamp.may_find_emission(&aside));
+        let (l, rays) = radiance_and_rays(&direct, &lamp);
+        let (l_longer, rays_longer) = radiance_and_rays(&longer, &lamp);
+        assert!(rays < rays_longer - 32, "{rays} rays, {rays_longer} traced");
+        assert_eq!(l, l_longer);
+        // Lit by BSDF sampling alone, the lamp's light is what the traced rays found.
+        let (direct, longer) = (
+            PathIntegrator {
+                lighting: PathLighting::Bsdf,
+                ..direct
+            },
+            PathIntegrator {
+                lighting: PathLighting::Bsdf,
+                ..longer
+            },
+        );
+        let (l, rays) = radiance_and_rays_spp(&direct, &lamp, 16);
+        let (l_longer, rays_longer) = radiance_and_rays_spp(&longer, &lamp, 16);
+        let found = l.iter().filter(|l| l.max_element() > 0.0).count();
+        assert!(found > 10, "{found} samples found the lamp");
+        let camera_rays = 64 * 16;
+        let (last, last_longer) = (rays - camera_rays, rays_longer - camera_rays);
+        assert!(
+            last < last_longer / 4,
+            "{last} last rays, {last_longer} traced"
+        );
         assert_eq!(l, l_longer);
     }
 
@@ -461,7 +518,7 @@ mod tests {
             b: Vec2::ZERO,
         };
         let pt = PathIntegrator::default();
-        let scene = floor_lit_by(Some(Vec3::ONE));
+        let scene = floor_lit_by(Some(Vec3::ONE), false);
         // Inside glass of index 1.5 after a refraction that kept 90% of the light: β is
         // 0.9 / 1.5² = 0.4, η_scale 1.5². Roulette continues with q = 0.9 (not 0.4), so
         // u = 0.8 goes on and β becomes 0.4 / 0.9.

@@ -160,14 +160,19 @@ impl Light {
         )
     }
 
-    /// Whether a ray can find this light's emission: an emitting surface or the environment.
-    /// Points, spots, directional lights and projectors are delta distributions, which only
-    /// light sampling reaches.
-    pub fn is_met_by_rays(&self) -> bool {
-        matches!(
-            self,
-            Light::Area { .. } | Light::Environment { .. } | Light::EnvironmentMap { .. }
-        )
+    /// The box around an emitting surface (none for other lights).
+    pub fn surface_bounds(&self) -> Option<Aabb> {
+        match self {
+            Light::Area {
+                shape: AreaShape::Triangle(t),
+                ..
+            } => Some(t.triangle.bounds()),
+            Light::Area {
+                shape: AreaShape::Sphere(s),
+                ..
+            } => Some(s.bounds()),
+            _ => None,
+        }
     }
 
     /// Radiance from an environment light arriving along world direction `-w` (`w` points

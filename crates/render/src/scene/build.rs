@@ -58,7 +58,7 @@ impl Scene {
         let leaves = leaf_blocks(&mut bvh, &prims, &triangles.triangles, &prim_visibility);
         let (tri_surface, tri_surfaces, same_surface) =
             surface_table(&triangles.material, &triangles.light, materials.len());
-        let lights_met_by_rays = lights.lights.iter().any(Light::is_met_by_rays);
+        let emitter_bounds = emitter_bounds(&lights.lights, &bvh.bounds());
         let stats = BuildStats {
             bvh_seconds,
             bvh_nodes: bvh.node_count(),
@@ -106,11 +106,27 @@ impl Scene {
             lights: lights.lights,
             light_sampler,
             environment,
-            lights_met_by_rays,
+            emitter_bounds,
             camera: Camera::new(&desc.camera, desc.resolution).with_filter(desc.filter),
             stats,
         })
     }
+}
+
+/// The box around every emitting surface among `lights`, grown on every side by a
+/// thousandth of its diagonal and a hundred-thousandth of the scene's (`scene`): far more
+/// than the rounding of a ray's slab test, so that a ray the box turns away cannot meet an
+/// emitter. None without emitting surfaces.
+fn emitter_bounds(lights: &[Light], scene: &Aabb) -> Option<Aabb> {
+    let b = lights
+        .iter()
+        .filter_map(Light::surface_bounds)
+        .reduce(Aabb::union)?;
+    let pad = 1e-3 * b.extent().length() + 1e-5 * scene.extent().length();
+    Some(Aabb {
+        min: b.min - Vec3::splat(pad),
+        max: b.max + Vec3::splat(pad),
+    })
 }
 
 /// The materials, and the names of the mesh attributes they read (a material's attribute
