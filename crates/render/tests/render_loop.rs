@@ -124,6 +124,23 @@ fn crowded(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with no emitting surface, lit by the other lights `with_more_lights` adds (points,
+/// spots, a directional light, projectors) and by a constant environment where `sky`: with
+/// no sky, a path's last ray, which could find no emission, is not traced at all.
+fn without_emitting_surfaces(desc: SceneDesc, sky: bool) -> SceneDesc {
+    let mut desc = with_more_lights(desc);
+    for m in &mut desc.meshes {
+        m.emission = None;
+    }
+    for s in &mut desc.spheres {
+        s.emission = None;
+    }
+    if !sky {
+        desc.environment = None;
+    }
+    desc
+}
+
 /// `desc` under an environment map with a bright spot (the lanes look up the rays that leave
 /// the scene together).
 fn under_a_sky(mut desc: SceneDesc) -> SceneDesc {
@@ -500,6 +517,19 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         (with_maps(mixed_scene()), false),
         (under_a_sky(with_maps(mixed_scene())), false),
         (with_more_lights(with_maps(mixed_scene())), false),
+        (without_emitting_surfaces(mixed_scene(), false), false),
+        (without_emitting_surfaces(mixed_scene(), true), false),
+        (
+            crowded(without_emitting_surfaces(with_metals(mixed_scene()), true)),
+            true,
+        ),
+        (
+            under_a_sky(without_emitting_surfaces(
+                with_smooth_lobes(mixed_scene()),
+                true,
+            )),
+            false,
+        ),
     ] {
         let scene = Scene::build(&desc).unwrap();
         packets_match_one_path_at_a_time(&scene, bvh);
