@@ -361,8 +361,10 @@ impl Scene {
     /// Whether `ray` may find emission: the scene has an environment, or the ray meets the
     /// box around its emitting surfaces (a little larger, so that rounding cannot hide a
     /// hit). Where it cannot, the ray that ends a path of bounded depth, traced only to find
-    /// emission, need not be traced.
-    #[inline]
+    /// emission, need not be traced. Out of line: asked only at a path's last bounce, it
+    /// would otherwise keep the end of every bounce (`PathIntegrator::survive`) from being
+    /// inlined into the path loop.
+    #[inline(never)]
     pub fn may_find_emission(&self, ray: &Ray) -> bool {
         self.environment.is_some()
             || self

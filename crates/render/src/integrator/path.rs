@@ -283,9 +283,10 @@ impl PathIntegrator {
     /// A ray whose arrival would be the path's last (bounce `max_depth`) is traced only for
     /// the emission it may find; where it cannot find any ([`Scene::may_find_emission`]: no
     /// environment, and it misses the box around the emitting surfaces, or there are none)
-    /// the path ends here instead, with the same radiance.
+    /// the path ends here instead, with the same radiance. Inlined always (as it was, by
+    /// itself, before it took the scene): called, it cost the eight-lane path 2–4%.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     pub(crate) fn survive(
         &self,
         scene: &Scene,
