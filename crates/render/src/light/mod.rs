@@ -160,17 +160,15 @@ impl Light {
         )
     }
 
-    /// The box around an emitting surface (none for other lights).
+    /// The box around an emitting surface (none for other lights). Every shape of an area
+    /// light is matched by name, so that a new one cannot be left without a box (which would
+    /// let a path's last ray skip it: [`crate::scene::Scene::may_find_emission`]).
     pub fn surface_bounds(&self) -> Option<Aabb> {
         match self {
-            Light::Area {
-                shape: AreaShape::Triangle(t),
-                ..
-            } => Some(t.triangle.bounds()),
-            Light::Area {
-                shape: AreaShape::Sphere(s),
-                ..
-            } => Some(s.bounds()),
+            Light::Area { shape, .. } => Some(match shape {
+                AreaShape::Triangle(t) => t.triangle.bounds(),
+                AreaShape::Sphere(s) => s.bounds(),
+            }),
             _ => None,
         }
     }
