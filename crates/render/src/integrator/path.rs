@@ -313,8 +313,9 @@ impl PathIntegrator {
         if self.only_bounce.is_some_and(|k| st.depth > k) {
             return false;
         }
-        st.ray = spawn_ray(si.p, si.ng, wi);
-        st.depth < self.max_depth || scene.may_find_emission(&st.ray)
+        let ray = spawn_ray(si.p, si.ng, wi);
+        st.ray = ray;
+        st.depth < self.max_depth || scene.may_find_emission(ray.o, ray.d)
     }
 }
 
@@ -459,7 +460,7 @@ mod tests {
         // ray and a shadow ray per sample (every camera ray meets the floor, every point
         // sees the light), and gives the same radiance to the bit.
         let point = floor_lit_by(None, false);
-        assert!(!point.may_find_emission(&up));
+        assert!(!point.may_find_emission(up.o, up.d));
         let (l, rays) = radiance_and_rays(&direct, &point);
         let (l_longer, rays_longer) = radiance_and_rays(&longer, &point);
         assert_eq!(rays, 2 * 64);
@@ -468,15 +469,15 @@ mod tests {
         assert_eq!(l, l_longer);
         // Under a sky every BSDF-sampled ray may find it, and is traced.
         let sky = floor_lit_by(Some(Vec3::splat(0.25)), false);
-        assert!(sky.may_find_emission(&aside));
+        assert!(sky.may_find_emission(aside.o, aside.d));
         let (l, rays) = radiance_and_rays(&direct, &sky);
         let (l_longer, rays_longer) = radiance_and_rays(&longer, &sky);
         assert_eq!(rays, rays_longer);
         assert_eq!(l, l_longer);
         // With a small lamp, only the rays towards its box are.
         let lamp = floor_lit_by(None, true);
-        assert!(lamp.may_find_emission(&up));
-        assert!(!lamp.may_find_emission(&aside));
+        assert!(lamp.may_find_emission(up.o, up.d));
+        assert!(!lamp.may_find_emission(aside.o, aside.d));
         let (l, rays) = radiance_and_rays(&direct, &lamp);
         let (l_longer, rays_longer) = radiance_and_rays(&longer, &lamp);
         assert!(rays < rays_longer - 32, "{rays} rays, {rays_longer} traced");
