@@ -95,6 +95,7 @@ impl<R: Real> Complex<R> {
     fn norm2(self) -> R {
         self.re * self.re + self.im * self.im
     }
+    #[inline(always)]
     fn div(self, o: Self) -> Self {
         let d = o.norm2();
         Complex::new(
@@ -103,6 +104,7 @@ impl<R: Real> Complex<R> {
         )
     }
     /// The principal square root (non-negative real part; zero at zero).
+    #[inline(always)]
     fn sqrt(self) -> Self {
         let zero = R::splat(0.0);
         let r = self.norm2().sqrt();
