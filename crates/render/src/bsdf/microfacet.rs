@@ -317,20 +317,20 @@ impl<R: Real> IsotropicMicrofacet<R> {
         self.alpha.map2_where(wm.z(), self.beckmann, beckmann_d)
     }
 
-    /// `beckmann()` in the Beckmann lanes, `ggx()` in the others (Beckmann's functions
-    /// skipped where no lane is Beckmann).
+    /// `beckmann()` in the Beckmann lanes, `ggx` in the others (Beckmann's functions
+    /// skipped where no lane is Beckmann). GGX's value comes computed, not as a closure: the
+    /// compiler left such closures out of line, their operands passed through memory.
     #[inline(always)]
     fn either<T>(
         &self,
         beckmann: impl FnOnce() -> T,
-        ggx: impl FnOnce() -> T,
+        ggx: T,
         select: impl FnOnce(R::Mask, T, T) -> T,
     ) -> T {
-        let g = ggx();
         if R::any(self.beckmann) {
-            select(self.beckmann, beckmann(), g)
+            select(self.beckmann, beckmann(), ggx)
         } else {
-            g
+            ggx
         }
     }
 }
@@ -338,7 +338,7 @@ impl<R: Real> IsotropicMicrofacet<R> {
 impl<R: Real> Distribution<R> for IsotropicMicrofacet<R> {
     #[inline(always)]
     fn d(&self, wm: R::V3) -> R {
-        self.either(|| self.beckmann_d(wm), || self.ggx().d(wm), R::select)
+        self.either(|| self.beckmann_d(wm), self.ggx().d(wm), R::select)
     }
 
     #[inline(always)]
@@ -348,7 +348,7 @@ impl<R: Real> Distribution<R> for IsotropicMicrofacet<R> {
                 self.alpha
                     .map2_where(tan2_theta::<R>(w), self.beckmann, beckmann_lambda)
             },
-            || self.ggx().lambda(w),
+            self.ggx().lambda(w),
             R::select,
         )
     }
@@ -357,7 +357,7 @@ impl<R: Real> Distribution<R> for IsotropicMicrofacet<R> {
     fn pdf_wm(&self, wo: R::V3, wm: R::V3) -> R {
         self.either(
             || self.beckmann_d(wm) * wm.z().max(R::splat(0.0)),
-            || self.ggx().pdf_wm(wo, wm),
+            self.ggx().pdf_wm(wo, wm),
             R::select,
         )
     }
@@ -366,7 +366,7 @@ impl<R: Real> Distribution<R> for IsotropicMicrofacet<R> {
     fn sample_wm(&self, wo: R::V3, u0: R, u1: R) -> R::V3 {
         self.either(
             || sample_beckmann(self.alpha, u0, u1, self.beckmann),
-            || self.ggx().sample_wm(wo, u0, u1),
+            self.ggx().sample_wm(wo, u0, u1),
             <R::V3 as Vector3>::select,
         )
     }
