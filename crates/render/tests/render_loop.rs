@@ -260,8 +260,8 @@ fn with_textures(mut desc: SceneDesc) -> SceneDesc {
 }
 
 /// `desc` with smooth lobes: a mirror, a smooth conductor, glass (exact Fresnel reflectance,
-/// shaded in the lanes; and Schlick's, left to the scalar code), each on a sphere, the glass
-/// ones large enough to be entered and left.
+/// shaded in the lanes; and Schlick's, left to the scalar code), a thin sheet of glass (in
+/// the lanes), each on a sphere, the glass ones large enough to be entered and left.
 fn with_smooth_lobes(mut desc: SceneDesc) -> SceneDesc {
     let glass = |fresnel| MaterialDesc::Glass {
         reflectance: Vec3::ONE,
@@ -284,12 +284,18 @@ fn with_smooth_lobes(mut desc: SceneDesc) -> SceneDesc {
         },
         glass(FresnelModel::Exact),
         glass(FresnelModel::Schlick),
+        MaterialDesc::ThinGlass {
+            reflectance: Vec3::new(1.0, 0.9, 0.9),
+            transmittance: Vec3::new(0.8, 1.0, 0.9),
+            ior: 1.5,
+        },
     ]);
     for (k, (x, z, r)) in [
         (-0.6, -0.4, 0.1),
         (0.6, -0.5, 0.12),
         (-0.2, 0.3, 0.25),
         (0.3, 0.6, 0.2),
+        (-0.1, -0.2, 0.22),
     ]
     .into_iter()
     .enumerate()
@@ -475,6 +481,63 @@ fn with_maps(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with plastics, all shaded in the lanes: smooth (linear, on the floor, and
+/// nonlinear, its coat's reflection tinted) and rough (GGX and Beckmann, one of them of a
+/// checkerboard base), on the floor and spheres.
+fn with_plastics(mut desc: SceneDesc) -> SceneDesc {
+    let rough = |diffuse, distribution, alpha, nonlinear| MaterialDesc::RoughPlastic {
+        diffuse,
+        specular: Vec3::new(1.0, 0.9, 0.8),
+        alpha,
+        ior: 1.5,
+        nonlinear,
+        distribution,
+    };
+    desc.materials[0] = MaterialDesc::Plastic {
+        diffuse: Vec3::new(0.6, 0.5, 0.4),
+        specular: Vec3::ONE,
+        ior: 1.5,
+        nonlinear: false,
+    };
+    let first = desc.materials.len();
+    desc.materials.extend([
+        MaterialDesc::Plastic {
+            diffuse: Vec3::new(0.1, 0.3, 0.8),
+            specular: Vec3::new(0.8, 1.0, 0.6),
+            ior: 1.7,
+            nonlinear: true,
+        },
+        rough(
+            TextureDesc::Constant(Vec3::new(0.7, 0.2, 0.2)),
+            NormalDistribution::Ggx,
+            0.2,
+            false,
+        ),
+        rough(
+            TextureDesc::Checkerboard {
+                color0: Vec3::new(0.8, 0.8, 0.1),
+                color1: Vec3::new(0.1, 0.2, 0.6),
+                to_uv: glam::Affine2::from_scale(glam::Vec2::splat(6.0)),
+            },
+            NormalDistribution::Beckmann,
+            0.4,
+            true,
+        ),
+    ]);
+    for (k, (x, z)) in [(-0.5, 0.4), (0.45, -0.3), (0.1, 0.5)]
+        .into_iter()
+        .enumerate()
+    {
+        desc.spheres.push(SphereDesc {
+            center: Vec3::new(x, 0.18, z),
+            radius: 0.18,
+            material: first + k,
+            ..Default::default()
+        });
+    }
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -485,7 +548,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // glass of one roughness, mirrors, smooth conductors and glass go through the lanes too,
     // textured or not, in the scenes `with_metals`, `with_smooth_lobes` and `with_textures`;
     // blends of two diffuse materials in `with_blends`; those lobes under normal and bump
-    // maps in `with_maps`): every sample's radiance
+    // maps in `with_maps`; smooth and rough plastics in `with_plastics`): every sample's
+    // radiance
     // must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
@@ -516,6 +580,9 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         (under_a_sky(with_blends(mixed_scene())), false),
         (with_maps(mixed_scene()), false),
         (under_a_sky(with_maps(mixed_scene())), false),
+        (with_plastics(mixed_scene()), false),
+        (crowded(under_a_sky(with_plastics(mixed_scene()))), true),
+        (with_more_lights(with_plastics(mixed_scene())), false),
         (with_more_lights(with_maps(mixed_scene())), false),
         (without_emitting_surfaces(mixed_scene(), false), false),
         (without_emitting_surfaces(mixed_scene(), true), false),

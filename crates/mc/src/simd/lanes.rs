@@ -427,6 +427,11 @@ pub trait Vector3:
             self.x() * o.y() - o.x() * self.y(),
         )
     }
+    /// Axis-wise quotient (glam's `Vec3 / Vec3`).
+    #[inline(always)]
+    fn div_axes(self, o: Self) -> Self {
+        Self::new(self.x() / o.x(), self.y() / o.y(), self.z() / o.z())
+    }
     /// glam's `normalize`: the vector times the reciprocal of its length (the same bits as
     /// glam's for `Vec3`, without its debug check of a finite result).
     #[inline(always)]

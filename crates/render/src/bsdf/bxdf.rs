@@ -4,7 +4,7 @@
 use super::*;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
-use pathlab_mc::simd::lanes::{Real, Vector3, M8, V8};
+use pathlab_mc::simd::lanes::{Real, Vector3};
 
 /// A lobe's sample in the local frame, for one direction (`V = Vec3`) or for eight lanes
 /// ([`crate::simd::lanes::V8`]): it exists where `valid`. Whether the lobe is a delta is the
@@ -45,14 +45,14 @@ impl DirectionSample<Vec3> {
     }
 }
 
-impl DirectionSample<V8> {
-    /// `a` in the lanes `m`, `b` in the others.
+impl<V: Vector3> DirectionSample<V> {
+    /// `a` in the lanes `m`, `b` in the others (for one direction: `a` where `m`).
     #[inline(always)]
-    pub fn select(m: M8, a: Self, b: Self) -> Self {
+    pub fn select(m: <V::R as Real>::Mask, a: Self, b: Self) -> Self {
         DirectionSample {
-            wi: m.select3(a.wi, b.wi),
-            pdf: m.select(a.pdf, b.pdf),
-            f: m.select3(a.f, b.f),
+            wi: V::select(m, a.wi, b.wi),
+            pdf: V::R::select(m, a.pdf, b.pdf),
+            f: V::select(m, a.f, b.f),
             valid: (m & a.valid) | (!m & b.valid),
         }
     }

@@ -363,6 +363,12 @@ pub enum LaneBxdf {
     SmoothConductor(SmoothConductor<Rgb>),
     /// Smooth glass of exact Fresnel reflectance.
     Dielectric(SmoothDielectric),
+    /// Diffuse under a smooth coat.
+    Plastic(Plastic),
+    /// Diffuse under a rough coat.
+    RoughPlastic(RoughPlastic),
+    /// A thin dielectric sheet.
+    ThinDielectric(ThinDielectric),
 }
 
 impl LaneBxdf {
@@ -378,6 +384,9 @@ impl LaneBxdf {
             Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(*d),
             Bxdf::Mirror(m) => LaneBxdf::Mirror(*m),
             Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(*d),
+            Bxdf::Plastic(p) => LaneBxdf::Plastic(*p),
+            Bxdf::RoughPlastic(p) => LaneBxdf::RoughPlastic(*p),
+            Bxdf::ThinDielectric(d) => LaneBxdf::ThinDielectric(*d),
             _ => return None,
         })
     }
@@ -393,7 +402,10 @@ impl Leaf {
         let textured;
         let (bxdf, anisotropic) = match &self.model {
             Model::Fixed(bxdf) => (bxdf, false),
-            Model::Diffuse { .. } | Model::Conductor { .. } | Model::Dielectric { .. } => {
+            Model::Diffuse { .. }
+            | Model::Conductor { .. }
+            | Model::Dielectric { .. }
+            | Model::RoughPlastic { .. } => {
                 textured = self.model.bxdf(&tex());
                 (&textured.0, textured.1)
             }
@@ -430,11 +442,12 @@ impl Material {
 
     /// The lobe of a material of one lobe that the path tracer's lanes shade together, its
     /// textures read at `tex`: Lambertian, a rough conductor or rough glass of GGX or Beckmann
-    /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, or smooth glass
-    /// of exact Fresnel reflectance; one of those under a normal or bump map; or a blend of
-    /// two Lambertian materials, which is one Lambertian lobe. Textured models are evaluated
-    /// (as [`Material::bsdf`] evaluates them) only where they may give one of those: diffuse,
-    /// conductors and glass.
+    /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, smooth glass
+    /// of exact Fresnel reflectance, a thin sheet of glass, smooth or rough plastic; one of
+    /// those under a normal or
+    /// bump map; or a blend of two Lambertian materials, which is one Lambertian lobe.
+    /// Textured models are evaluated (as [`Material::bsdf`] evaluates them) only where they
+    /// may give one of those: diffuse, conductors, glass and rough plastic.
     #[inline]
     pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<LaneLobe> {
         match self {

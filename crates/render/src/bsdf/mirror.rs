@@ -40,13 +40,8 @@ impl Mirror<V8> {
 }
 
 /// A delta reflection lobe chosen with probability `pdf` whose throughput f |cos| / pdf is
-/// `weight / pdf`.
-pub(super) fn specular_reflection(wo: Vec3, weight: Rgb, pdf: f32) -> Option<LocalSample> {
-    specular_reflection_real(wo, weight, pdf).delta()
-}
-
-/// [`specular_reflection`] for one direction or lanes: it exists where `wo` is off the
-/// surface and `pdf` is positive.
+/// `weight / pdf`, for one direction or lanes: it exists where `wo` is off the surface and
+/// `pdf` is positive.
 #[inline(always)]
 pub(super) fn specular_reflection_real<V: Vector3>(
     wo: V,

@@ -48,7 +48,7 @@ pub use mixture::{guard_admits, guard_attenuation, Bsdf, BsdfSample, Guard, Lobe
 pub use plastic::Plastic;
 pub use principled::{Principled, PrincipledFlags};
 pub use rough_dielectric::RoughDielectric;
-pub use rough_plastic::RoughPlastic;
+pub use rough_plastic::{CoatLanes, RoughPlastic};
 pub use scattering::{reflect, refract, refract_about};
 pub use thin_dielectric::ThinDielectric;
 

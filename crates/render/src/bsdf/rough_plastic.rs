@@ -1,12 +1,15 @@
 //! A diffuse base under a rough dielectric coat (Mitsuba's `roughplastic`).
 
-use super::fresnel::fresnel_dielectric;
-use super::microfacet::{Microfacet, NormalDistribution};
+use super::bxdf::DirectionSample;
+use super::fresnel::{fresnel_dielectric, fresnel_dielectric_real};
+use super::microfacet::{Distribution, Microfacet, MicrofacetLanes, NormalDistribution};
+use super::plastic::{coated_base, mean};
 use super::scattering::{reflect, refract_about};
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
-use pathlab_mc::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use pathlab_mc::simd::lanes::{Real, Vector3, F8, M8, V8, W};
+use pathlab_mc::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use std::collections::HashMap;
 use std::f32::consts::FRAC_1_PI;
 use std::sync::{Mutex, OnceLock};
@@ -151,25 +154,78 @@ impl CoatTable {
     }
 }
 
+/// A coat's [`CoatTable`] for one material (`&'static CoatTable`, `R = f32`) or each lane's
+/// ([`CoatLanes`], `R = F8`).
+pub trait Coat<R: Real> {
+    /// T(cos θ), interpolated.
+    fn transmittance_at(&self, cos: R) -> R;
+    /// The coat's internal diffuse reflectance.
+    fn internal_reflectance(&self) -> R;
+}
+
+impl Coat<f32> for &'static CoatTable {
+    #[inline(always)]
+    fn transmittance_at(&self, cos: f32) -> f32 {
+        self.transmittance(cos)
+    }
+
+    #[inline(always)]
+    fn internal_reflectance(&self) -> f32 {
+        self.internal
+    }
+}
+
+/// Eight lanes' coat tables, each read lane by lane by [`CoatTable::transmittance`].
+#[derive(Clone, Copy, Debug)]
+pub struct CoatLanes([&'static CoatTable; W]);
+
+/// The table of lanes without a rough plastic (whose values are discarded).
+static NO_COAT: CoatTable = CoatTable {
+    transmittance: [0.0; TABLE],
+    internal: 0.0,
+};
+
+impl Default for CoatLanes {
+    fn default() -> Self {
+        CoatLanes([&NO_COAT; W])
+    }
+}
+
+impl Coat<F8> for CoatLanes {
+    #[inline(always)]
+    fn transmittance_at(&self, cos: F8) -> F8 {
+        F8(std::array::from_fn(|i| self.0[i].transmittance(cos.0[i])))
+    }
+
+    #[inline(always)]
+    fn internal_reflectance(&self) -> F8 {
+        F8(std::array::from_fn(|i| self.0[i].internal))
+    }
+}
+
 /// Rough plastic: microfacet reflection off the coat,
 /// f_s = F(wo·wm) D(wm) G(wo, wi, wm) / (4 cos θo cos θi) × `specular`,
 /// plus light that crosses the coat, scatters diffusely off the base and crosses back,
 /// f_d = ρ' T(θo) T(θi) / (η² π), with ρ' = ρ / (1 - R_int) (or ρ / (1 - ρ R_int) when
 /// `nonlinear`), T and R_int from the [`CoatTable`]: Mitsuba's model.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoughPlastic {
+///
+/// Written once for one material (the defaults: [`Rgb`], `f32`, [`Microfacet`], `bool` and
+/// its table) and for eight lanes' materials ([`V8`], [`F8`], [`MicrofacetLanes`], [`M8`],
+/// [`CoatLanes`]): the path tracer's lanes shade with these same functions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RoughPlastic<V = Rgb, R = f32, D = Microfacet, M = bool, T = &'static CoatTable> {
     /// Diffuse reflectance of the base.
-    pub diffuse: Rgb,
+    pub diffuse: V,
     /// Scale of the coat's reflection.
-    pub specular: Rgb,
+    pub specular: V,
     /// Index of the coat relative to outside.
-    pub eta: f32,
+    pub eta: R,
     /// The coat's roughness.
-    pub distribution: Microfacet,
+    pub distribution: D,
     /// Whether internal reflections tint by the base colour.
-    pub nonlinear: bool,
+    pub nonlinear: M,
     /// The coat's precomputed transmittance.
-    pub table: &'static CoatTable,
+    pub table: T,
 }
 
 impl RoughPlastic {
@@ -192,79 +248,122 @@ impl RoughPlastic {
         }
     }
 
-    fn base(&self) -> Rgb {
-        let r = self.table.internal;
-        if self.nonlinear {
-            self.diffuse / (Rgb::ONE - self.diffuse * r)
-        } else {
-            self.diffuse / (1.0 - r)
-        }
-    }
-
-    /// Probability of sampling the coat's reflection (Mitsuba's choice: the coat's share of
-    /// light arriving from `wo`, weighted by the mean specular and diffuse reflectances).
-    fn specular_probability(&self, cos_o: f32) -> f32 {
-        let s = (self.specular.x + self.specular.y + self.specular.z) / 3.0;
-        let d = (self.diffuse.x + self.diffuse.y + self.diffuse.z) / 3.0;
-        let weight = if s + d > 0.0 { s / (s + d) } else { 0.5 };
-        let t = self.table.transmittance(cos_o);
-        let ps = (1.0 - t) * weight;
-        let pd = t * (1.0 - weight);
-        if ps + pd > 0.0 {
-            ps / (ps + pd)
-        } else {
-            0.5
-        }
-    }
-
     /// f(wo, wi).
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let m = &self.distribution;
-        let mut f = Rgb::ZERO;
-        let wm = (wo + wi).normalize_or_zero();
-        if wm != Vec3::ZERO {
-            let spec = fresnel_dielectric(wo.dot(wm), self.eta) * m.d(wm) * m.g(wo, wi, wm)
-                / (4.0 * wo.z * wi.z);
-            f += self.specular * spec;
-        }
-        let t = self.table.transmittance(wo.z) * self.table.transmittance(wi.z);
-        f + self.base() * (FRAC_1_PI * t / (self.eta * self.eta))
+        self.f_and_pdf(wo, wi).0
     }
 
     /// A sample: the reflection about a sampled microfacet normal, or a cosine-weighted
     /// direction.
     pub fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<LocalSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let wi = if uc < self.specular_probability(wo.z) {
-            reflect(wo, self.distribution.sample_wm(wo, u))
-        } else {
-            sample_cosine_hemisphere(u)
-        };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        LocalSample::evaluated(wi, self.pdf(wo, wi), || self.f(wo, wi))
+        self.sample_real(wo, uc, u.x, u.y).local()
     }
 
     /// Density of [`RoughPlastic::sample`].
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        let ps = self.specular_probability(wo.z);
-        let wm = (wo + wi).normalize_or_zero();
+        self.f_and_pdf(wo, wi).1
+    }
+}
+
+impl<V, D, T> RoughPlastic<V, V::R, D, <V::R as Real>::Mask, T>
+where
+    V: Vector3,
+    D: Distribution<V::R>,
+    T: Coat<V::R>,
+{
+    /// Probability of sampling the coat's reflection (Mitsuba's choice: the coat's share of
+    /// light arriving from `wo`, weighted by the mean specular and diffuse reflectances).
+    #[inline(always)]
+    fn specular_probability(&self, cos_o: V::R) -> V::R {
+        let (zero, one, half) = (V::R::splat(0.0), V::R::splat(1.0), V::R::splat(0.5));
+        let (s, d) = (mean(self.specular), mean(self.diffuse));
+        let weight = V::R::select((s + d).gt(zero), s / (s + d), half);
+        let t = self.table.transmittance_at(cos_o);
+        let ps = (one - t) * weight;
+        let pd = t * (one - weight);
+        V::R::select((ps + pd).gt(zero), ps / (ps + pd), half)
+    }
+
+    /// f(wo, wi) and its density as a sample from `wo` (zero where either direction is below
+    /// the surface; without the coat's reflection where they are opposite).
+    #[inline(always)]
+    pub fn f_and_pdf(&self, wo: V, wi: V) -> (V, V::R) {
+        let (zero, one, four) = (V::R::splat(0.0), V::R::splat(1.0), V::R::splat(4.0));
+        let m = &self.distribution;
+        // The half vector, where it exists (glam's `normalize_or_zero` is not zero).
+        let sum = wo + wi;
+        let rcp = one / sum.dot(sum).sqrt();
+        let half = rcp.is_finite() & rcp.gt(zero);
+        let wm = sum.scale(rcp);
         let cos_om = wo.dot(wm);
-        let spec = if wm != Vec3::ZERO && cos_om > 0.0 {
-            self.distribution.pdf_wm(wo, wm) / (4.0 * cos_om)
-        } else {
-            0.0
-        };
-        ps * spec + (1.0 - ps) * cosine_hemisphere_pdf(wi.z)
+        let spec = fresnel_dielectric_real(cos_om, self.eta) * m.d(wm) * m.g(wo, wi, wm)
+            / (four * wo.z() * wi.z());
+        let spec = V::select(half, self.specular.scale(spec), V::splat(Vec3::ZERO));
+        let t = self.table.transmittance_at(wo.z()) * self.table.transmittance_at(wi.z());
+        let base = coated_base(
+            self.diffuse,
+            self.table.internal_reflectance(),
+            self.nonlinear,
+        );
+        let f = spec + base.scale(V::R::splat(FRAC_1_PI) * t / (self.eta * self.eta));
+        let ps = self.specular_probability(wo.z());
+        let spec_pdf = V::R::select(
+            half & cos_om.gt(zero),
+            m.pdf_wm(wo, wm) / (four * cos_om),
+            zero,
+        );
+        let pdf = ps * spec_pdf + (one - ps) * cosine_hemisphere_pdf(wi.z());
+        // `z <= 0`: a NaN goes on, as it did through the early return of the one-direction
+        // code this was written from.
+        let none = wo.z().le(zero) | wi.z().le(zero);
+        (
+            V::select(none, V::splat(Vec3::ZERO), f),
+            V::R::select(none, zero, pdf),
+        )
+    }
+
+    /// The reflection of `wo` about a microfacet normal drawn from (`u0`, `u1`), with the
+    /// probability [`Self::specular_probability`], or a cosine-weighted direction from them;
+    /// `uc` chooses. It exists where `wo` and it are above the surface and its density is
+    /// positive.
+    #[inline(always)]
+    pub fn sample_real(&self, wo: V, uc: V::R, u0: V::R, u1: V::R) -> DirectionSample<V> {
+        let zero = V::R::splat(0.0);
+        let specular = uc.lt(self.specular_probability(wo.z()));
+        let mut wi: V = cosine_hemisphere(u0, u1);
+        if V::R::any(specular) {
+            let reflected = reflect(wo, self.distribution.sample_wm(wo, u0, u1));
+            wi = V::select(specular, reflected, wi);
+        }
+        let (f, pdf) = self.f_and_pdf(wo, wi);
+        DirectionSample {
+            wi,
+            pdf,
+            f,
+            valid: !wo.z().le(zero) & !wi.z().le(zero) & pdf.gt(zero),
+        }
+    }
+}
+
+impl RoughPlastic<V8, F8, MicrofacetLanes, M8, CoatLanes> {
+    /// Sets lane `i` to `p`. Every field is taken apart here: a field added to
+    /// [`RoughPlastic`] fails to compile until its lanes are set too.
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, p: RoughPlastic) {
+        let RoughPlastic {
+            diffuse,
+            specular,
+            eta,
+            distribution,
+            nonlinear,
+            table,
+        } = p;
+        self.diffuse.set(i, diffuse);
+        self.specular.set(i, specular);
+        self.eta.0[i] = eta;
+        self.distribution.set_lane(i, distribution);
+        self.nonlinear.set(i, nonlinear);
+        self.table.0[i] = table;
     }
 }
 
@@ -325,5 +424,68 @@ mod tests {
             b,
             CoatTable::get(Microfacet::new(NormalDistribution::Beckmann, 0.01), 1.5)
         ));
+    }
+}
+
+#[cfg(test)]
+mod lane_tests {
+    use super::*;
+    use crate::bsdf::conductor::tests::lane_kind;
+    use crate::bsdf::plastic::tests::{bits, direction};
+    use pathlab_mc::rng::Pcg32;
+
+    /// Eight lanes of rough plastic compute, lane by lane, what one rough plastic computes,
+    /// to the bit: f, pdf and the sample, linear and not, GGX and Beckmann lanes (mixed in
+    /// some rounds) of several roughnesses and coat indices (each lane its own table), for
+    /// directions on both sides, on the horizon, opposite and equal.
+    #[test]
+    fn lanes_compute_what_one_rough_plastic_computes() {
+        let mut rng = Pcg32::new(13, 1);
+        let (mut seen, mut valid) = (0, 0);
+        for round in 0..300 {
+            let mut lanes = RoughPlastic::<V8, F8, MicrofacetLanes, M8, CoatLanes>::default();
+            let (mut wo, mut wi) = (V8::default(), V8::default());
+            let (mut uc, mut u0, mut u1) = (F8::default(), F8::default(), F8::default());
+            let mut one = Vec::new();
+            for i in 0..8 {
+                let alpha = [0.01, 0.1, 0.3, 0.7][(round + i) % 4];
+                let eta = [1.5, 1.33, 1.9][(round + i) % 3];
+                let rho = Vec3::new(rng.uniform_f32(), 0.3, rng.uniform_f32());
+                let specular = Vec3::new(1.0, rng.uniform_f32(), 0.5);
+                let m = Microfacet::new(lane_kind(round, i), alpha);
+                let p = RoughPlastic::new(rho, specular, eta, m, i % 2 == 1);
+                lanes.set_lane(i, p);
+                let (o, mut w) = (direction(&mut rng), direction(&mut rng));
+                match round % 6 {
+                    0 => w = -o,
+                    1 => w = o,
+                    2 => w.z = 0.0,
+                    _ => {}
+                }
+                wo.set(i, o);
+                wi.set(i, w);
+                (uc.0[i], u0.0[i], u1.0[i]) =
+                    (rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+                one.push(p);
+            }
+            let (f, pdf) = lanes.f_and_pdf(wo, wi);
+            let s = lanes.sample_real(wo, uc, u0, u1);
+            for (i, p) in one.iter().enumerate() {
+                let (o, w) = (wo.get(i), wi.get(i));
+                assert_eq!(bits(f.get(i)), bits(p.f(o, w)), "f, lane {i}: {o} {w}");
+                assert_eq!(pdf.0[i].to_bits(), p.pdf(o, w).to_bits(), "pdf, lane {i}");
+                let scalar = p.sample(o, uc.0[i], Vec2::new(u0.0[i], u1.0[i]));
+                assert_eq!(s.valid.get(i), scalar.is_some(), "sample, lane {i}: {o}");
+                if let Some(scalar) = scalar {
+                    assert!(!scalar.delta);
+                    assert_eq!(bits(s.wi.get(i)), bits(scalar.wi));
+                    assert_eq!(bits(s.f.get(i)), bits(scalar.f));
+                    assert_eq!(s.pdf.0[i].to_bits(), scalar.pdf.to_bits());
+                    valid += 1;
+                }
+                seen += 1;
+            }
+        }
+        assert!(valid * 3 > seen, "{valid} of {seen} samples valid");
     }
 }

@@ -11,12 +11,14 @@
 //! for every lane and bounce, except where a lane's material is one lobe of those the lanes
 //! shade ([`Material::lane_bxdf`]: Lambertian, or a blend of two Lambertian materials, which
 //! is one Lambertian lobe; a mirror; smooth conductors and glass; rough GGX or Beckmann
-//! conductors and glass, of one roughness or anisotropic; any of those under a normal or
-//! bump map). There the lanes are shaded together in SIMD registers by the same functions
-//! the one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
-//! [`RoughConductor`], [`RoughDielectric`] (their distributions: [`MicrofacetLanes`], whose
-//! anisotropic Beckmann lanes go one lane at a time), [`Mirror`], [`SmoothConductor`],
-//! [`DielectricLanes`]; [`TriangleEmitter::sample_li`],
+//! conductors and glass, of one roughness or anisotropic; thin sheets of glass; smooth and
+//! rough plastic; any of
+//! those under a normal or bump map). There the lanes are shaded together in SIMD registers
+//! by the same functions the one-path code calls, instantiated on eight lanes (the BSDFs:
+//! [`Diffuse`], [`RoughConductor`], [`RoughDielectric`] (their distributions:
+//! [`MicrofacetLanes`], whose anisotropic Beckmann lanes go one lane at a time), [`Mirror`],
+//! [`SmoothConductor`], [`DielectricLanes`], [`ThinDielectric`], [`Plastic`], [`RoughPlastic`] (its coat's
+//! table read lane by lane); [`TriangleEmitter::sample_li`],
 //! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`] (or, for an
 //! anisotropic lobe or a mapped normal, the frame [`Material::lane_bxdf`] gives the lane),
 //! a map's guard ([`guard_attenuation`]), [`offset_ray_origin`],
@@ -41,8 +43,9 @@ use super::{
 use crate::accel::RayLanes;
 use crate::bsdf::bxdf::DirectionSample;
 use crate::bsdf::{
-    guard_admits, guard_attenuation, DielectricLanes, Diffuse, LaneBxdf, Lobes, Material,
-    MicrofacetLanes, Mirror, RoughConductor, RoughDielectric, SmoothConductor,
+    guard_admits, guard_attenuation, CoatLanes, DielectricLanes, Diffuse, LaneBxdf, Lobes,
+    Material, MicrofacetLanes, Mirror, Plastic, RoughConductor, RoughDielectric, RoughPlastic,
+    SmoothConductor, ThinDielectric,
 };
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
@@ -62,7 +65,8 @@ struct ScatterIn {
     ns: V8,
     wo: V8,
     /// Which lanes have which lobe ([`LobeLanes`]): `metal`, a rough conductor; `rough_glass`;
-    /// `mirror`; `smooth_metal`, a smooth conductor; `glass`; the others' is `diffuse`.
+    /// `mirror`; `smooth_metal`, a smooth conductor; `glass`; `thin_glass`; `plastic`;
+    /// `rough_plastic`; the others' is `diffuse`.
     lobes: LobeLanes,
     diffuse: Diffuse<V8>,
     metal: RoughConductor<V8, MicrofacetLanes>,
@@ -70,6 +74,9 @@ struct ScatterIn {
     mirror: Mirror<V8>,
     smooth_metal: SmoothConductor<V8>,
     glass: DielectricLanes,
+    thin_glass: ThinDielectric<V8, F8>,
+    plastic: Plastic<V8, F8, M8>,
+    rough_plastic: RoughPlastic<V8, F8, MicrofacetLanes, M8, CoatLanes>,
     two_sided: M8,
     /// Whether some lane has a frame along the surface's tangent or a guard (`tangent` and
     /// `guard` are cleared, and looked at, only where one had).
@@ -143,9 +150,13 @@ struct LobeLanes {
     rough_glass: M8,
     smooth_metal: M8,
     glass: M8,
-    /// The delta lobes (mirrors, smooth conductors and glass): no light sample. Those in
-    /// neither `smooth_metal` nor `glass` are mirrors.
+    thin_glass: M8,
+    /// The delta lobes (mirrors, smooth conductors, glass and thin sheets of it): no light
+    /// sample. Those in none of `smooth_metal`, `glass` and `thin_glass` are mirrors.
     delta: M8,
+    /// Smooth plastic: a delta lobe (the coat's reflection) and a diffuse one.
+    plastic: M8,
+    rough_plastic: M8,
 }
 
 /// What the lanes' scattering yields.
@@ -182,13 +193,15 @@ struct ScatterOut {
 /// [`super::sample_light`] for a point on an emitting triangle, an environment map's
 /// direction (drawn before, by [`EnvironmentMap::sample_direction_lanes`]) or a sample of
 /// another light (drawn before, one lane at a time, into [`ScatterIn::drawn`]) up to the
-/// shadow ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`]
-/// or [`RoughDielectric::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`]
+/// shadow ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`],
+/// [`RoughDielectric::f_and_pdf`], [`Plastic::f_and_pdf`] or [`RoughPlastic::f_and_pdf`],
+/// [`offset_ray_origin`], [`power_heuristic_weight`]
 /// against the lobe's density, weight one for a delta light; the map's radiance is read after
 /// the shadow ray, as there), and [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe
 /// ([`Diffuse::sample_z`], [`RoughConductor::sample`], [`RoughDielectric::sample_real`],
-/// [`Mirror::sample_real`], [`SmoothConductor::sample`], [`DielectricLanes::sample`]; smooth
-/// lobes have no light sample). Only the control flow is the lanes' own: masks where the
+/// [`Mirror::sample_real`], [`SmoothConductor::sample`], [`DielectricLanes::sample`],
+/// [`ThinDielectric::sample_real`], [`Plastic::sample_real`], whose coat's reflection is a delta sample,
+/// [`RoughPlastic::sample_real`]; smooth lobes have no light sample). Only the control flow is the lanes' own: masks where the
 /// one-path code returns early, and each lobe's functions skipped where no lane has it (all
 /// but the Lambertian ones and the triangles' and maps' light samples without
 /// `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes alone).
@@ -213,6 +226,10 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let any_metal = OTHER_LOBES && metal.any();
     let rough_glass = a.lobes.rough_glass;
     let any_rough_glass = OTHER_LOBES && rough_glass.any();
+    let plastic = a.lobes.plastic;
+    let any_plastic = OTHER_LOBES && plastic.any();
+    let rough_plastic = a.lobes.rough_plastic;
+    let any_rough_plastic = OTHER_LOBES && rough_plastic.any();
 
     // Light sampling: a point on a triangle, an environment map's direction, or a sample
     // drawn one lane at a time.
@@ -236,6 +253,20 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
         (f, bsdf_pdf) = (
             rough_glass.select3(f_glass, f),
             rough_glass.select(pdf_glass, bsdf_pdf),
+        );
+    }
+    if any_plastic {
+        let (f_plastic, pdf_plastic) = a.plastic.f_and_pdf(wo_local, wi_local);
+        (f, bsdf_pdf) = (
+            plastic.select3(f_plastic, f),
+            plastic.select(pdf_plastic, bsdf_pdf),
+        );
+    }
+    if any_rough_plastic {
+        let (f_plastic, pdf_plastic) = a.rough_plastic.f_and_pdf(wo_local, wi_local);
+        (f, bsdf_pdf) = (
+            rough_plastic.select3(f_plastic, f),
+            rough_plastic.select(pdf_plastic, bsdf_pdf),
         );
     }
     let cos_i = wi.dot(frame.n).abs();
@@ -301,6 +332,16 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
         bs = DirectionSample::select(rough_glass, g, bs);
     }
     let lobes = &a.lobes;
+    let mut delta = lobes.delta;
+    if any_plastic {
+        let (p, specular) = a.plastic.sample_real(wo_local, a.u_lobe, u0, u1);
+        bs = DirectionSample::select(plastic, p, bs);
+        delta = delta | (plastic & specular);
+    }
+    if any_rough_plastic {
+        let p = a.rough_plastic.sample_real(wo_local, a.u_lobe, u0, u1);
+        bs = DirectionSample::select(rough_plastic, p, bs);
+    }
     if OTHER_LOBES && lobes.delta.any() {
         let wo = wo_local;
         let mut d = a.mirror.sample_real(wo);
@@ -312,9 +353,13 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
             d = DirectionSample::select(lobes.glass, g, d);
             eta = lobes.glass.select(g_eta, eta);
         }
+        if lobes.thin_glass.any() {
+            let g = a.thin_glass.sample_real(wo, a.u_lobe);
+            d = DirectionSample::select(lobes.thin_glass, g, d);
+        }
         bs = DirectionSample::select(lobes.delta, d, bs);
     }
-    out.delta = lobes.delta;
+    out.delta = delta;
     out.eta = eta;
     let wi = frame.to_world(bs.wi);
     let (mut f, mut valid) = (bs.f, bs.valid);
@@ -348,8 +393,14 @@ fn scatter_avx2<const OTHER_LOBES: bool>(
 #[inline]
 fn scatter(a: &mut ScatterIn, out: &mut ScatterOut) {
     let lobes = &a.lobes;
-    let other =
-        (lobes.conductor | lobes.rough_glass | lobes.delta | a.drawn.lanes).any() || a.mapped;
+    let other = (lobes.conductor
+        | lobes.rough_glass
+        | lobes.delta
+        | lobes.plastic
+        | lobes.rough_plastic
+        | a.drawn.lanes)
+        .any()
+        || a.mapped;
     if other {
         return scatter_other_lobes(a, out);
     }
@@ -374,6 +425,9 @@ fn scatter_other_lobes(a: &mut ScatterIn, out: &mut ScatterOut) {
     }
     if a.lobes.rough_glass.any() {
         a.rough_glass.distribution.only_in(a.lobes.rough_glass);
+    }
+    if a.lobes.rough_plastic.any() {
+        a.rough_plastic.distribution.only_in(a.lobes.rough_plastic);
     }
     let a = &*a;
     #[cfg(target_arch = "x86_64")]
@@ -824,6 +878,19 @@ fn gather_lobe(
             a.glass.set_lane(i, glass);
             lobes.glass.set(i, true);
             lobes.delta.set(i, true);
+        }
+        LaneBxdf::ThinDielectric(glass) => {
+            a.thin_glass.set_lane(i, glass);
+            lobes.thin_glass.set(i, true);
+            lobes.delta.set(i, true);
+        }
+        LaneBxdf::Plastic(plastic) => {
+            a.plastic.set_lane(i, plastic);
+            lobes.plastic.set(i, true);
+        }
+        LaneBxdf::RoughPlastic(plastic) => {
+            a.rough_plastic.set_lane(i, plastic);
+            lobes.rough_plastic.set(i, true);
         }
     }
     Some(two_sided)
