@@ -481,9 +481,11 @@ fn with_maps(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
-/// `desc` with plastics, all shaded in the lanes: smooth (linear, on the floor, and
-/// nonlinear, its coat's reflection tinted) and rough (GGX and Beckmann, one of them of a
-/// checkerboard base), on the floor and spheres.
+/// `desc` with plastics and diffuse transmission, all shaded in the lanes: smooth plastic
+/// (linear, on the floor, and nonlinear, its coat's reflection tinted), rough plastic (GGX
+/// and Beckmann, one of them of a checkerboard base), on the floor and spheres; diffuse
+/// reflection and transmission on the wall (lit through from behind too) and, textured, on a
+/// sphere.
 fn with_plastics(mut desc: SceneDesc) -> SceneDesc {
     let rough = |diffuse, distribution, alpha, nonlinear| MaterialDesc::RoughPlastic {
         diffuse,
@@ -523,8 +525,20 @@ fn with_plastics(mut desc: SceneDesc) -> SceneDesc {
             0.4,
             true,
         ),
+        MaterialDesc::DiffuseTransmission {
+            reflectance: TextureDesc::Checkerboard {
+                color0: Vec3::new(0.2, 0.6, 0.2),
+                color1: Vec3::new(0.7, 0.1, 0.1),
+                to_uv: glam::Affine2::from_scale(glam::Vec2::splat(5.0)),
+            },
+            transmittance: TextureDesc::Constant(Vec3::new(0.5, 0.4, 0.2)),
+        },
     ]);
-    for (k, (x, z)) in [(-0.5, 0.4), (0.45, -0.3), (0.1, 0.5)]
+    desc.materials[1] = MaterialDesc::DiffuseTransmission {
+        reflectance: TextureDesc::Constant(Vec3::new(0.3, 0.5, 0.4)),
+        transmittance: TextureDesc::Constant(Vec3::new(0.4, 0.3, 0.5)),
+    };
+    for (k, (x, z)) in [(-0.5, 0.4), (0.45, -0.3), (0.1, 0.5), (-0.1, -0.3)]
         .into_iter()
         .enumerate()
     {

@@ -6,72 +6,179 @@
 //! choice), then a cosine-weighted direction on the chosen side: pdf = p_r cos θ / π on `wo`'s
 //! side, (1 - p_r) |cos θ| / π on the other.
 
+use super::bxdf::DirectionSample;
 use super::LocalSample;
 use crate::desc::Rgb;
 use glam::{Vec2, Vec3};
+use pathlab_mc::simd::lanes::{Real, Vector3, V8};
 use pathlab_mc::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use std::f32::consts::FRAC_1_PI;
 
-/// Diffuse reflection `reflectance` and diffuse transmission `transmittance`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DiffuseTransmission {
+/// Diffuse reflection `reflectance` and diffuse transmission `transmittance`, written once
+/// for one material (`V = Rgb`) and for eight lanes' materials ([`V8`]): the path tracer's
+/// lanes shade with these same functions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DiffuseTransmission<V = Rgb> {
     /// Albedo of the reflection, per channel.
-    pub reflectance: Rgb,
+    pub reflectance: V,
     /// Albedo of the transmission, per channel.
-    pub transmittance: Rgb,
+    pub transmittance: V,
 }
 
 impl DiffuseTransmission {
-    /// Probability that sampling chooses reflection (½ when both are black).
-    fn reflect_probability(&self) -> f32 {
-        let (r, t) = (
-            self.reflectance.max_element(),
-            self.transmittance.max_element(),
-        );
-        if r + t > 0.0 {
-            r / (r + t)
-        } else {
-            0.5
-        }
-    }
-
     /// f(wo, wi).
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        let side = wo.z * wi.z;
-        if side > 0.0 {
-            self.reflectance * FRAC_1_PI
-        } else if side < 0.0 {
-            self.transmittance * FRAC_1_PI
-        } else {
-            Rgb::ZERO
-        }
+        self.f_and_pdf(wo, wi).0
     }
 
     /// A cosine-weighted direction on the side `uc` chooses (reflection below p_r).
     pub fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<LocalSample> {
-        if wo.z == 0.0 || wo.z.is_nan() {
-            return None;
-        }
-        let p_r = self.reflect_probability();
-        let reflect = uc < p_r;
-        let mut wi: Vec3 = cosine_hemisphere(u.x, u.y);
-        // Reflection leaves on wo's side, transmission on the other.
-        if reflect != (wo.z > 0.0) {
-            wi.z = -wi.z;
-        }
-        let choice = if reflect { p_r } else { 1.0 - p_r };
-        let pdf = choice * cosine_hemisphere_pdf(wi.z.abs());
-        LocalSample::evaluated(wi, pdf, || self.f(wo, wi))
+        self.sample_real(wo, uc, u.x, u.y).local()
     }
 
     /// Density of [`DiffuseTransmission::sample`] choosing `wi`.
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let side = wo.z * wi.z;
-        if side == 0.0 || side.is_nan() {
-            return 0.0;
-        }
+        self.f_and_pdf(wo, wi).1
+    }
+}
+
+impl<V: Vector3> DiffuseTransmission<V> {
+    /// Probability that sampling chooses reflection (½ when both are black).
+    #[inline(always)]
+    fn reflect_probability(&self) -> V::R {
+        let (r, t) = (
+            self.reflectance.max_element(),
+            self.transmittance.max_element(),
+        );
+        V::R::select((r + t).gt(V::R::splat(0.0)), r / (r + t), V::R::splat(0.5))
+    }
+
+    /// f(wo, wi) and its density as a sample from `wo`: reflection where the two are on one
+    /// side, transmission where they are on opposite sides, nothing on the surface.
+    #[inline(always)]
+    pub fn f_and_pdf(&self, wo: V, wi: V) -> (V, V::R) {
+        let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
+        let side = wo.z() * wi.z();
+        let (reflected, transmitted) = (side.gt(zero), side.lt(zero));
+        let inv_pi = V::R::splat(FRAC_1_PI);
+        let f = V::select(
+            reflected,
+            self.reflectance.scale(inv_pi),
+            V::select(
+                transmitted,
+                self.transmittance.scale(inv_pi),
+                V::splat(Vec3::ZERO),
+            ),
+        );
         let p_r = self.reflect_probability();
-        let choice = if side > 0.0 { p_r } else { 1.0 - p_r };
-        choice * cosine_hemisphere_pdf(wi.z.abs())
+        let choice = V::R::select(reflected, p_r, one - p_r);
+        let pdf = V::R::select(
+            reflected | transmitted,
+            choice * cosine_hemisphere_pdf(wi.z().abs()),
+            zero,
+        );
+        (f, pdf)
+    }
+
+    /// A cosine-weighted direction from (`u0`, `u1`) on the side `uc` chooses: `wo`'s side
+    /// (reflection) below p_r, the other above. It exists where `wo` is off the surface (and
+    /// not NaN) and its density is positive.
+    #[inline(always)]
+    pub fn sample_real(&self, wo: V, uc: V::R, u0: V::R, u1: V::R) -> DirectionSample<V> {
+        let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
+        let p_r = self.reflect_probability();
+        let reflect = uc.lt(p_r);
+        let up: V = cosine_hemisphere(u0, u1);
+        // Reflection leaves on wo's side, transmission on the other.
+        let above = wo.z().gt(zero);
+        let flip = (reflect & !above) | (!reflect & above);
+        let wi = V::new(up.x(), up.y(), V::R::select(flip, -up.z(), up.z()));
+        let choice = V::R::select(reflect, p_r, one - p_r);
+        let pdf = choice * cosine_hemisphere_pdf(wi.z().abs());
+        DirectionSample {
+            wi,
+            pdf,
+            f: self.f_and_pdf(wo, wi).0,
+            valid: !wo.z().equals(zero) & wo.z().equals(wo.z()) & pdf.gt(zero),
+        }
+    }
+}
+
+impl DiffuseTransmission<V8> {
+    /// Sets lane `i` to `d`. Every field is taken apart here: a field added to
+    /// [`DiffuseTransmission`] fails to compile until its lanes are set too.
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, d: DiffuseTransmission) {
+        let DiffuseTransmission {
+            reflectance,
+            transmittance,
+        } = d;
+        self.reflectance.set(i, reflectance);
+        self.transmittance.set(i, transmittance);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::plastic::tests::{bits, direction};
+    use pathlab_mc::rng::Pcg32;
+    use pathlab_mc::simd::lanes::F8;
+
+    /// Eight lanes compute, lane by lane, what one material computes, to the bit: f, pdf and
+    /// the sample, both lobes, from both sides and on the surface, black lobes included.
+    #[test]
+    fn lanes_compute_what_one_material_computes() {
+        let mut rng = Pcg32::new(17, 4);
+        let (mut reflected, mut transmitted, mut seen) = (0, 0, 0);
+        for round in 0..300 {
+            let mut lanes = DiffuseTransmission::<V8>::default();
+            let (mut wo, mut wi) = (V8::default(), V8::default());
+            let (mut uc, mut u0, mut u1) = (F8::default(), F8::default(), F8::default());
+            let mut one = Vec::new();
+            for i in 0..8 {
+                let black = [1.0, 1.0, 1.0, 0.0][(round + i) % 4];
+                let d = DiffuseTransmission {
+                    reflectance: Vec3::new(rng.uniform_f32(), 0.4, 0.1) * black,
+                    transmittance: Vec3::new(0.3, rng.uniform_f32(), 0.6) * [1.0, 0.0][i % 2],
+                };
+                lanes.set_lane(i, d);
+                let (mut o, mut w) = (direction(&mut rng), direction(&mut rng));
+                match round % 7 {
+                    2 => w.z = 0.0,
+                    5 => o.z = 0.0,
+                    _ => {}
+                }
+                wo.set(i, o);
+                wi.set(i, w);
+                (uc.0[i], u0.0[i], u1.0[i]) =
+                    (rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+                one.push(d);
+            }
+            let (f, pdf) = lanes.f_and_pdf(wo, wi);
+            let s = lanes.sample_real(wo, uc, u0, u1);
+            for (i, d) in one.iter().enumerate() {
+                let (o, w) = (wo.get(i), wi.get(i));
+                assert_eq!(bits(f.get(i)), bits(d.f(o, w)), "f, lane {i}: {o} {w}");
+                assert_eq!(pdf.0[i].to_bits(), d.pdf(o, w).to_bits(), "pdf, lane {i}");
+                let scalar = d.sample(o, uc.0[i], Vec2::new(u0.0[i], u1.0[i]));
+                assert_eq!(s.valid.get(i), scalar.is_some(), "sample, lane {i}: {o}");
+                if let Some(scalar) = scalar {
+                    assert_eq!(bits(s.wi.get(i)), bits(scalar.wi));
+                    assert_eq!(bits(s.f.get(i)), bits(scalar.f));
+                    assert_eq!(s.pdf.0[i].to_bits(), scalar.pdf.to_bits());
+                    if scalar.wi.z * o.z > 0.0 {
+                        reflected += 1;
+                    } else {
+                        transmitted += 1;
+                    }
+                }
+                seen += 1;
+            }
+        }
+        assert!(
+            reflected * 5 > seen && transmitted * 5 > seen,
+            "{reflected} reflected, {transmitted} transmitted of {seen}"
+        );
     }
 }

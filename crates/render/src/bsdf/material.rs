@@ -369,6 +369,8 @@ pub enum LaneBxdf {
     RoughPlastic(RoughPlastic),
     /// A thin dielectric sheet.
     ThinDielectric(ThinDielectric),
+    /// Lambertian reflection and transmission.
+    DiffuseTransmission(DiffuseTransmission),
 }
 
 impl LaneBxdf {
@@ -387,6 +389,7 @@ impl LaneBxdf {
             Bxdf::Plastic(p) => LaneBxdf::Plastic(*p),
             Bxdf::RoughPlastic(p) => LaneBxdf::RoughPlastic(*p),
             Bxdf::ThinDielectric(d) => LaneBxdf::ThinDielectric(*d),
+            Bxdf::DiffuseTransmission(d) => LaneBxdf::DiffuseTransmission(*d),
             _ => return None,
         })
     }
@@ -403,6 +406,7 @@ impl Leaf {
         let (bxdf, anisotropic) = match &self.model {
             Model::Fixed(bxdf) => (bxdf, false),
             Model::Diffuse { .. }
+            | Model::DiffuseTransmission { .. }
             | Model::Conductor { .. }
             | Model::Dielectric { .. }
             | Model::RoughPlastic { .. } => {
@@ -443,11 +447,12 @@ impl Material {
     /// The lobe of a material of one lobe that the path tracer's lanes shade together, its
     /// textures read at `tex`: Lambertian, a rough conductor or rough glass of GGX or Beckmann
     /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, smooth glass
-    /// of exact Fresnel reflectance, a thin sheet of glass, smooth or rough plastic; one of
-    /// those under a normal or
+    /// of exact Fresnel reflectance, a thin sheet of glass, smooth or rough plastic, diffuse
+    /// reflection and transmission; one of those under a normal or
     /// bump map; or a blend of two Lambertian materials, which is one Lambertian lobe.
     /// Textured models are evaluated (as [`Material::bsdf`] evaluates them) only where they
-    /// may give one of those: diffuse, conductors, glass and rough plastic.
+    /// may give one of those: diffuse (and diffuse transmission), conductors, glass and rough
+    /// plastic.
     #[inline]
     pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<LaneLobe> {
         match self {

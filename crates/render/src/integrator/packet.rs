@@ -12,13 +12,13 @@
 //! shade ([`Material::lane_bxdf`]: Lambertian, or a blend of two Lambertian materials, which
 //! is one Lambertian lobe; a mirror; smooth conductors and glass; rough GGX or Beckmann
 //! conductors and glass, of one roughness or anisotropic; thin sheets of glass; smooth and
-//! rough plastic; any of
+//! rough plastic; diffuse reflection and transmission; any of
 //! those under a normal or bump map). There the lanes are shaded together in SIMD registers
 //! by the same functions the one-path code calls, instantiated on eight lanes (the BSDFs:
 //! [`Diffuse`], [`RoughConductor`], [`RoughDielectric`] (their distributions:
 //! [`MicrofacetLanes`], whose anisotropic Beckmann lanes go one lane at a time), [`Mirror`],
 //! [`SmoothConductor`], [`DielectricLanes`], [`ThinDielectric`], [`Plastic`], [`RoughPlastic`] (its coat's
-//! table read lane by lane); [`TriangleEmitter::sample_li`],
+//! table read lane by lane), [`DiffuseTransmission`]; [`TriangleEmitter::sample_li`],
 //! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`] (or, for an
 //! anisotropic lobe or a mapped normal, the frame [`Material::lane_bxdf`] gives the lane),
 //! a map's guard ([`guard_attenuation`]), [`offset_ray_origin`],
@@ -43,9 +43,9 @@ use super::{
 use crate::accel::RayLanes;
 use crate::bsdf::bxdf::DirectionSample;
 use crate::bsdf::{
-    guard_admits, guard_attenuation, CoatLanes, DielectricLanes, Diffuse, LaneBxdf, Lobes,
-    Material, MicrofacetLanes, Mirror, Plastic, RoughConductor, RoughDielectric, RoughPlastic,
-    SmoothConductor, ThinDielectric,
+    guard_admits, guard_attenuation, CoatLanes, DielectricLanes, Diffuse, DiffuseTransmission,
+    LaneBxdf, Lobes, Material, MicrofacetLanes, Mirror, Plastic, RoughConductor, RoughDielectric,
+    RoughPlastic, SmoothConductor, ThinDielectric,
 };
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
@@ -66,7 +66,8 @@ struct ScatterIn {
     wo: V8,
     /// Which lanes have which lobe ([`LobeLanes`]): `metal`, a rough conductor; `rough_glass`;
     /// `mirror`; `smooth_metal`, a smooth conductor; `glass`; `thin_glass`; `plastic`;
-    /// `rough_plastic`; the others' is `diffuse`.
+    /// `rough_plastic`; `translucent`, diffuse reflection and transmission; the others' is
+    /// `diffuse`.
     lobes: LobeLanes,
     diffuse: Diffuse<V8>,
     metal: RoughConductor<V8, MicrofacetLanes>,
@@ -77,6 +78,7 @@ struct ScatterIn {
     thin_glass: ThinDielectric<V8, F8>,
     plastic: Plastic<V8, F8, M8>,
     rough_plastic: RoughPlastic<V8, F8, MicrofacetLanes, M8, CoatLanes>,
+    translucent: DiffuseTransmission<V8>,
     two_sided: M8,
     /// Whether some lane has a frame along the surface's tangent or a guard (`tangent` and
     /// `guard` are cleared, and looked at, only where one had).
@@ -157,6 +159,7 @@ struct LobeLanes {
     /// Smooth plastic: a delta lobe (the coat's reflection) and a diffuse one.
     plastic: M8,
     rough_plastic: M8,
+    translucent: M8,
 }
 
 /// What the lanes' scattering yields.
@@ -194,14 +197,16 @@ struct ScatterOut {
 /// direction (drawn before, by [`EnvironmentMap::sample_direction_lanes`]) or a sample of
 /// another light (drawn before, one lane at a time, into [`ScatterIn::drawn`]) up to the
 /// shadow ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`],
-/// [`RoughDielectric::f_and_pdf`], [`Plastic::f_and_pdf`] or [`RoughPlastic::f_and_pdf`],
+/// [`RoughDielectric::f_and_pdf`], [`Plastic::f_and_pdf`], [`RoughPlastic::f_and_pdf`] or
+/// [`DiffuseTransmission::f_and_pdf`],
 /// [`offset_ray_origin`], [`power_heuristic_weight`]
 /// against the lobe's density, weight one for a delta light; the map's radiance is read after
 /// the shadow ray, as there), and [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe
 /// ([`Diffuse::sample_z`], [`RoughConductor::sample`], [`RoughDielectric::sample_real`],
 /// [`Mirror::sample_real`], [`SmoothConductor::sample`], [`DielectricLanes::sample`],
 /// [`ThinDielectric::sample_real`], [`Plastic::sample_real`], whose coat's reflection is a delta sample,
-/// [`RoughPlastic::sample_real`]; smooth lobes have no light sample). Only the control flow is the lanes' own: masks where the
+/// [`RoughPlastic::sample_real`], [`DiffuseTransmission::sample_real`]; smooth lobes have no
+/// light sample). Only the control flow is the lanes' own: masks where the
 /// one-path code returns early, and each lobe's functions skipped where no lane has it (all
 /// but the Lambertian ones and the triangles' and maps' light samples without
 /// `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes alone).
@@ -230,6 +235,8 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let any_plastic = OTHER_LOBES && plastic.any();
     let rough_plastic = a.lobes.rough_plastic;
     let any_rough_plastic = OTHER_LOBES && rough_plastic.any();
+    let translucent = a.lobes.translucent;
+    let any_translucent = OTHER_LOBES && translucent.any();
 
     // Light sampling: a point on a triangle, an environment map's direction, or a sample
     // drawn one lane at a time.
@@ -267,6 +274,13 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
         (f, bsdf_pdf) = (
             rough_plastic.select3(f_plastic, f),
             rough_plastic.select(pdf_plastic, bsdf_pdf),
+        );
+    }
+    if any_translucent {
+        let (f_t, pdf_t) = a.translucent.f_and_pdf(wo_local, wi_local);
+        (f, bsdf_pdf) = (
+            translucent.select3(f_t, f),
+            translucent.select(pdf_t, bsdf_pdf),
         );
     }
     let cos_i = wi.dot(frame.n).abs();
@@ -342,6 +356,10 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
         let p = a.rough_plastic.sample_real(wo_local, a.u_lobe, u0, u1);
         bs = DirectionSample::select(rough_plastic, p, bs);
     }
+    if any_translucent {
+        let t = a.translucent.sample_real(wo_local, a.u_lobe, u0, u1);
+        bs = DirectionSample::select(translucent, t, bs);
+    }
     if OTHER_LOBES && lobes.delta.any() {
         let wo = wo_local;
         let mut d = a.mirror.sample_real(wo);
@@ -398,6 +416,7 @@ fn scatter(a: &mut ScatterIn, out: &mut ScatterOut) {
         | lobes.delta
         | lobes.plastic
         | lobes.rough_plastic
+        | lobes.translucent
         | a.drawn.lanes)
         .any()
         || a.mapped;
@@ -883,6 +902,10 @@ fn gather_lobe(
             a.thin_glass.set_lane(i, glass);
             lobes.thin_glass.set(i, true);
             lobes.delta.set(i, true);
+        }
+        LaneBxdf::DiffuseTransmission(d) => {
+            a.translucent.set_lane(i, d);
+            lobes.translucent.set(i, true);
         }
         LaneBxdf::Plastic(plastic) => {
             a.plastic.set_lane(i, plastic);
