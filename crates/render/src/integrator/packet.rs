@@ -80,6 +80,10 @@ struct ScatterIn {
     rough_plastic: RoughPlastic<V8, F8, MicrofacetLanes, M8, CoatLanes>,
     translucent: DiffuseTransmission<V8>,
     two_sided: M8,
+    /// Whether some lane has one of the lobes of `coated` (cleared, and looked at, only
+    /// where one had).
+    coated: bool,
+    coated_lobes: CoatedLanes,
     /// Whether some lane has a frame along the surface's tangent or a guard (`tangent` and
     /// `guard` are cleared, and looked at, only where one had).
     mapped: bool,
@@ -145,18 +149,26 @@ impl DrawnLights {
     }
 }
 
-/// Which lanes have which lobe (the rest: Lambertian).
+/// Which lanes have which lobe (the rest: Lambertian, or one of [`CoatedLanes`]).
 #[derive(Clone, Copy, Default)]
 struct LobeLanes {
     conductor: M8,
     rough_glass: M8,
     smooth_metal: M8,
     glass: M8,
-    thin_glass: M8,
     /// The delta lobes (mirrors, smooth conductors, glass and thin sheets of it): no light
-    /// sample. Those in none of `smooth_metal`, `glass` and `thin_glass` are mirrors.
+    /// sample. Those in none of `smooth_metal`, `glass` and [`CoatedLanes::thin_glass`] are
+    /// mirrors.
     delta: M8,
-    /// Smooth plastic: a delta lobe (the coat's reflection) and a diffuse one.
+}
+
+/// Which lanes have the rarer lobes (cleared, and looked at, only where some lane had one:
+/// [`ScatterIn::coated`]): thin sheets of glass (in [`LobeLanes::delta`] too), smooth
+/// plastic (a delta lobe, the coat's reflection, and a diffuse one), rough plastic, diffuse
+/// reflection and transmission.
+#[derive(Clone, Copy, Default)]
+struct CoatedLanes {
+    thin_glass: M8,
     plastic: M8,
     rough_plastic: M8,
     translucent: M8,
@@ -209,9 +221,11 @@ struct ScatterOut {
 /// light sample). Only the control flow is the lanes' own: masks where the
 /// one-path code returns early, and each lobe's functions skipped where no lane has it (all
 /// but the Lambertian ones and the triangles' and maps' light samples without
-/// `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes alone).
+/// `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes alone; the
+/// plastics, thin glass and diffuse transmission only with `COATED`: the instance for the
+/// other lobes stays as small as it was without them).
 #[inline(always)]
-fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
+fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let zero = F8::splat(0.0);
     let flip = a.two_sided & a.wo.dot(a.ns).lt(zero);
     let mut frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
@@ -231,12 +245,12 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
     let any_metal = OTHER_LOBES && metal.any();
     let rough_glass = a.lobes.rough_glass;
     let any_rough_glass = OTHER_LOBES && rough_glass.any();
-    let plastic = a.lobes.plastic;
-    let any_plastic = OTHER_LOBES && plastic.any();
-    let rough_plastic = a.lobes.rough_plastic;
-    let any_rough_plastic = OTHER_LOBES && rough_plastic.any();
-    let translucent = a.lobes.translucent;
-    let any_translucent = OTHER_LOBES && translucent.any();
+    let plastic = a.coated_lobes.plastic;
+    let any_plastic = COATED && plastic.any();
+    let rough_plastic = a.coated_lobes.rough_plastic;
+    let any_rough_plastic = COATED && rough_plastic.any();
+    let translucent = a.coated_lobes.translucent;
+    let any_translucent = COATED && translucent.any();
 
     // Light sampling: a point on a triangle, an environment map's direction, or a sample
     // drawn one lane at a time.
@@ -371,9 +385,10 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
             d = DirectionSample::select(lobes.glass, g, d);
             eta = lobes.glass.select(g_eta, eta);
         }
-        if lobes.thin_glass.any() {
+        let thin_glass = a.coated_lobes.thin_glass;
+        if COATED && thin_glass.any() {
             let g = a.thin_glass.sample_real(wo, a.u_lobe);
-            d = DirectionSample::select(lobes.thin_glass, g, d);
+            d = DirectionSample::select(thin_glass, g, d);
         }
         bs = DirectionSample::select(lobes.delta, d, bs);
     }
@@ -398,12 +413,12 @@ fn scatter_lanes<const OTHER_LOBES: bool>(a: &ScatterIn, out: &mut ScatterOut) {
 /// [`scatter_lanes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn scatter_avx2<const OTHER_LOBES: bool>(
+fn scatter_avx2<const OTHER_LOBES: bool, const COATED: bool>(
     _: crate::simd::Avx2,
     a: &ScatterIn,
     out: &mut ScatterOut,
 ) {
-    scatter_lanes::<OTHER_LOBES>(a, out)
+    scatter_lanes::<OTHER_LOBES, COATED>(a, out)
 }
 
 /// [`scatter_lanes`] on the best vector unit this CPU has, its Lambertian instance where no
@@ -411,15 +426,9 @@ fn scatter_avx2<const OTHER_LOBES: bool>(
 #[inline]
 fn scatter(a: &mut ScatterIn, out: &mut ScatterOut) {
     let lobes = &a.lobes;
-    let other = (lobes.conductor
-        | lobes.rough_glass
-        | lobes.delta
-        | lobes.plastic
-        | lobes.rough_plastic
-        | lobes.translucent
-        | a.drawn.lanes)
-        .any()
-        || a.mapped;
+    let other = (lobes.conductor | lobes.rough_glass | lobes.delta | a.drawn.lanes).any()
+        || a.mapped
+        || a.coated;
     if other {
         return scatter_other_lobes(a, out);
     }
@@ -427,9 +436,9 @@ fn scatter(a: &mut ScatterIn, out: &mut ScatterOut) {
     if let Some(avx2) = crate::simd::Avx2::detect() {
         // SAFETY: `scatter_avx2` requires AVX2 and FMA, which `avx2` proves this CPU has. Its
         // body is safe code.
-        return unsafe { scatter_avx2::<false>(avx2, a, out) };
+        return unsafe { scatter_avx2::<false, false>(avx2, a, out) };
     }
-    scatter_lanes::<false>(a, out)
+    scatter_lanes::<false, false>(a, out)
 }
 
 /// [`scatter`]'s instance for every lobe and light, out of line so that the Lambertian one
@@ -445,16 +454,32 @@ fn scatter_other_lobes(a: &mut ScatterIn, out: &mut ScatterOut) {
     if a.lobes.rough_glass.any() {
         a.rough_glass.distribution.only_in(a.lobes.rough_glass);
     }
-    if a.lobes.rough_plastic.any() {
-        a.rough_plastic.distribution.only_in(a.lobes.rough_plastic);
+    let rough_plastic = a.coated_lobes.rough_plastic;
+    if a.coated && rough_plastic.any() {
+        a.rough_plastic.distribution.only_in(rough_plastic);
     }
     let a = &*a;
+    if a.coated {
+        return scatter_coated(a, out);
+    }
     #[cfg(target_arch = "x86_64")]
     if let Some(avx2) = crate::simd::Avx2::detect() {
         // SAFETY: as in `scatter`.
-        return unsafe { scatter_avx2::<true>(avx2, a, out) };
+        return unsafe { scatter_avx2::<true, false>(avx2, a, out) };
     }
-    scatter_lanes::<true>(a, out)
+    scatter_lanes::<true, false>(a, out)
+}
+
+/// [`scatter_other_lobes`]' instance where some lane has a plastic, a thin sheet of glass or
+/// diffuse transmission.
+#[inline(never)]
+fn scatter_coated(a: &ScatterIn, out: &mut ScatterOut) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx2) = crate::simd::Avx2::detect() {
+        // SAFETY: as in `scatter`.
+        return unsafe { scatter_avx2::<true, true>(avx2, a, out) };
+    }
+    scatter_lanes::<true, true>(a, out)
 }
 
 /// One lane's path: its sample's tag and where the path stands.
@@ -531,6 +556,9 @@ impl PathIntegrator {
             // gather the others' inputs.
             let mut shaded = 0u32;
             a.lobes = LobeLanes::default();
+            if a.coated {
+                (a.coated, a.coated_lobes) = (false, CoatedLanes::default());
+            }
             if a.mapped {
                 (a.mapped, a.tangent, a.guard) = (false, M8::default(), M8::default());
             }
@@ -874,6 +902,7 @@ fn gather_lobe(
     let black = matches!(lobe, LaneBxdf::Diffuse(d) if d.reflectance.max_element() <= 0.0);
     stats.random_vertices += u64::from(!black);
     let lobes = &mut a.lobes;
+    let coated = &mut a.coated_lobes;
     match lobe {
         LaneBxdf::Diffuse(diffuse) => a.diffuse.set_lane(i, diffuse),
         LaneBxdf::Conductor(metal) => {
@@ -900,20 +929,24 @@ fn gather_lobe(
         }
         LaneBxdf::ThinDielectric(glass) => {
             a.thin_glass.set_lane(i, glass);
-            lobes.thin_glass.set(i, true);
+            coated.thin_glass.set(i, true);
             lobes.delta.set(i, true);
+            a.coated = true;
         }
         LaneBxdf::DiffuseTransmission(d) => {
             a.translucent.set_lane(i, d);
-            lobes.translucent.set(i, true);
+            coated.translucent.set(i, true);
+            a.coated = true;
         }
         LaneBxdf::Plastic(plastic) => {
             a.plastic.set_lane(i, plastic);
-            lobes.plastic.set(i, true);
+            coated.plastic.set(i, true);
+            a.coated = true;
         }
         LaneBxdf::RoughPlastic(plastic) => {
             a.rough_plastic.set_lane(i, plastic);
-            lobes.rough_plastic.set(i, true);
+            coated.rough_plastic.set(i, true);
+            a.coated = true;
         }
     }
     Some(two_sided)
