@@ -121,7 +121,7 @@ impl DiffuseTransmission<V8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::plastic::tests::{bits, direction};
+    use crate::bsdf::plastic::tests::{assert_lane_f_pdf, assert_lane_sample, direction};
     use pathlab_mc::rng::Pcg32;
     use pathlab_mc::simd::lanes::F8;
 
@@ -159,14 +159,10 @@ mod tests {
             let s = lanes.sample_real(wo, uc, u0, u1);
             for (i, d) in one.iter().enumerate() {
                 let (o, w) = (wo.get(i), wi.get(i));
-                assert_eq!(bits(f.get(i)), bits(d.f(o, w)), "f, lane {i}: {o} {w}");
-                assert_eq!(pdf.0[i].to_bits(), d.pdf(o, w).to_bits(), "pdf, lane {i}");
+                let what = format!("{o} {w}");
+                assert_lane_f_pdf(f, pdf, i, (d.f(o, w), d.pdf(o, w)), &what);
                 let scalar = d.sample(o, uc.0[i], Vec2::new(u0.0[i], u1.0[i]));
-                assert_eq!(s.valid.get(i), scalar.is_some(), "sample, lane {i}: {o}");
-                if let Some(scalar) = scalar {
-                    assert_eq!(bits(s.wi.get(i)), bits(scalar.wi));
-                    assert_eq!(bits(s.f.get(i)), bits(scalar.f));
-                    assert_eq!(s.pdf.0[i].to_bits(), scalar.pdf.to_bits());
+                if let Some(scalar) = assert_lane_sample(&s, i, scalar, &what) {
                     if scalar.wi.z * o.z > 0.0 {
                         reflected += 1;
                     } else {

@@ -200,6 +200,33 @@ pub(crate) mod tests {
         v.to_array().map(f32::to_bits)
     }
 
+    /// Asserts that lane `i` of `f` and `pdf` are `one`'s (f, pdf), to the bit.
+    pub(crate) fn assert_lane_f_pdf(f: V8, pdf: F8, i: usize, one: (Vec3, f32), what: &str) {
+        assert_eq!(bits(f.get(i)), bits(one.0), "f, lane {i}: {what}");
+        assert_eq!(pdf.0[i].to_bits(), one.1.to_bits(), "pdf, lane {i}: {what}");
+    }
+
+    /// Asserts that lane `i` of `s` is the one-direction sample `one`, to the bit: there
+    /// where it is, of the same direction, value and density. Returns `one`.
+    pub(crate) fn assert_lane_sample(
+        s: &DirectionSample<V8>,
+        i: usize,
+        one: Option<LocalSample>,
+        what: &str,
+    ) -> Option<LocalSample> {
+        assert_eq!(s.valid.get(i), one.is_some(), "sample, lane {i}: {what}");
+        if let Some(one) = one {
+            assert_eq!(bits(s.wi.get(i)), bits(one.wi), "wi, lane {i}: {what}");
+            assert_eq!(bits(s.f.get(i)), bits(one.f), "f, lane {i}: {what}");
+            assert_eq!(
+                s.pdf.0[i].to_bits(),
+                one.pdf.to_bits(),
+                "pdf, lane {i}: {what}"
+            );
+        }
+        one
+    }
+
     /// Eight lanes of smooth plastic compute, lane by lane, what one plastic computes, to the
     /// bit: f, pdf and the sample (which lobe included), linear and not, for directions on
     /// both sides and on the horizon, of coats that reflect and of a black one.
@@ -232,16 +259,11 @@ pub(crate) mod tests {
             let (s, delta) = lanes.sample_real(wo, uc, u0, u1);
             for (i, p) in one.iter().enumerate() {
                 let (o, w) = (wo.get(i), wi.get(i));
-                assert_eq!(bits(f.get(i)), bits(p.f(o, w)), "f, lane {i}: {o} {w}");
-                assert_eq!(pdf.0[i].to_bits(), p.pdf(o, w).to_bits(), "pdf, lane {i}");
+                let what = format!("{o} {w}");
+                assert_lane_f_pdf(f, pdf, i, (p.f(o, w), p.pdf(o, w)), &what);
                 let u = Vec2::new(u0.0[i], u1.0[i]);
-                let scalar = p.sample(o, uc.0[i], u);
-                assert_eq!(s.valid.get(i), scalar.is_some(), "sample, lane {i}: {o}");
-                if let Some(scalar) = scalar {
+                if let Some(scalar) = assert_lane_sample(&s, i, p.sample(o, uc.0[i], u), &what) {
                     assert_eq!(delta.get(i), scalar.delta, "lane {i}");
-                    assert_eq!(bits(s.wi.get(i)), bits(scalar.wi));
-                    assert_eq!(bits(s.f.get(i)), bits(scalar.f));
-                    assert_eq!(s.pdf.0[i].to_bits(), scalar.pdf.to_bits());
                     if scalar.delta {
                         specular += 1;
                     } else {

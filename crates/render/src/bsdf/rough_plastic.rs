@@ -431,7 +431,7 @@ mod tests {
 mod lane_tests {
     use super::*;
     use crate::bsdf::conductor::tests::lane_kind;
-    use crate::bsdf::plastic::tests::{bits, direction};
+    use crate::bsdf::plastic::tests::{assert_lane_f_pdf, assert_lane_sample, direction};
     use pathlab_mc::rng::Pcg32;
 
     /// Eight lanes of rough plastic compute, lane by lane, what one rough plastic computes,
@@ -472,15 +472,11 @@ mod lane_tests {
             let s = lanes.sample_real(wo, uc, u0, u1);
             for (i, p) in one.iter().enumerate() {
                 let (o, w) = (wo.get(i), wi.get(i));
-                assert_eq!(bits(f.get(i)), bits(p.f(o, w)), "f, lane {i}: {o} {w}");
-                assert_eq!(pdf.0[i].to_bits(), p.pdf(o, w).to_bits(), "pdf, lane {i}");
+                let what = format!("{o} {w}");
+                assert_lane_f_pdf(f, pdf, i, (p.f(o, w), p.pdf(o, w)), &what);
                 let scalar = p.sample(o, uc.0[i], Vec2::new(u0.0[i], u1.0[i]));
-                assert_eq!(s.valid.get(i), scalar.is_some(), "sample, lane {i}: {o}");
-                if let Some(scalar) = scalar {
+                if let Some(scalar) = assert_lane_sample(&s, i, scalar, &what) {
                     assert!(!scalar.delta);
-                    assert_eq!(bits(s.wi.get(i)), bits(scalar.wi));
-                    assert_eq!(bits(s.f.get(i)), bits(scalar.f));
-                    assert_eq!(s.pdf.0[i].to_bits(), scalar.pdf.to_bits());
                     valid += 1;
                 }
                 seen += 1;

@@ -84,7 +84,7 @@ impl ThinDielectric<V8, F8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::plastic::tests::{bits, direction};
+    use crate::bsdf::plastic::tests::{assert_lane_sample, direction};
     use pathlab_mc::rng::Pcg32;
 
     /// Eight lanes of thin sheets sample, lane by lane, what one sheet samples, to the bit,
@@ -117,12 +117,8 @@ mod tests {
             for (i, d) in one.iter().enumerate() {
                 let o = wo.get(i);
                 let scalar = d.sample(o, uc.0[i]);
-                assert_eq!(s.valid.get(i), scalar.is_some(), "lane {i}: {o}");
-                if let Some(scalar) = scalar {
+                if let Some(scalar) = assert_lane_sample(&s, i, scalar, &format!("{o}")) {
                     assert!(scalar.delta);
-                    assert_eq!(bits(s.wi.get(i)), bits(scalar.wi));
-                    assert_eq!(bits(s.f.get(i)), bits(scalar.f));
-                    assert_eq!(s.pdf.0[i].to_bits(), scalar.pdf.to_bits());
                     if scalar.wi.z * o.z > 0.0 {
                         reflected += 1;
                     } else {
