@@ -12,13 +12,13 @@
 //! shade ([`Material::lane_bxdf`]: Lambertian, or a blend of two Lambertian materials, which
 //! is one Lambertian lobe; a mirror; smooth conductors and glass; rough GGX or Beckmann
 //! conductors and glass, of one roughness or anisotropic; thin sheets of glass; smooth and
-//! rough plastic; diffuse reflection and transmission; any of
-//! those under a normal or bump map). There the lanes are shaded together in SIMD registers
-//! by the same functions the one-path code calls, instantiated on eight lanes (the BSDFs:
-//! [`Diffuse`], [`RoughConductor`], [`RoughDielectric`] (their distributions:
-//! [`MicrofacetLanes`], whose anisotropic Beckmann lanes go one lane at a time), [`Mirror`],
-//! [`SmoothConductor`], [`DielectricLanes`], [`ThinDielectric`], [`Plastic`], [`RoughPlastic`] (its coat's
-//! table read lane by lane), [`DiffuseTransmission`]; [`TriangleEmitter::sample_li`],
+//! rough plastic; diffuse reflection and transmission; any of those under a normal or bump
+//! map). There the lanes are shaded together in SIMD registers by the same functions the
+//! one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
+//! [`RoughConductor`], [`RoughDielectric`] (their distributions: [`MicrofacetLanes`], whose
+//! anisotropic Beckmann lanes go one lane at a time), [`Mirror`], [`SmoothConductor`],
+//! [`DielectricLanes`], [`ThinDielectric`], [`Plastic`], [`RoughPlastic`] (its coat's table
+//! read lane by lane), [`DiffuseTransmission`]; [`TriangleEmitter::sample_li`],
 //! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`] (or, for an
 //! anisotropic lobe or a mapped normal, the frame [`Material::lane_bxdf`] gives the lane),
 //! a map's guard ([`guard_attenuation`]), [`offset_ray_origin`],
@@ -64,10 +64,10 @@ struct ScatterIn {
     ng: V8,
     ns: V8,
     wo: V8,
-    /// Which lanes have which lobe ([`LobeLanes`]): `metal`, a rough conductor; `rough_glass`;
-    /// `mirror`; `smooth_metal`, a smooth conductor; `glass`; `thin_glass`; `plastic`;
-    /// `rough_plastic`; `translucent`, diffuse reflection and transmission; the others' is
-    /// `diffuse`.
+    /// Which lanes have which lobe ([`LobeLanes`], and the rarer ones in `coated_lobes`):
+    /// `metal`, a rough conductor; `rough_glass`; `mirror`; `smooth_metal`, a smooth
+    /// conductor; `glass`; `thin_glass`; `plastic`; `rough_plastic`; `translucent`, diffuse
+    /// reflection and transmission; the others' is `diffuse`.
     lobes: LobeLanes,
     diffuse: Diffuse<V8>,
     metal: RoughConductor<V8, MicrofacetLanes>,
@@ -210,15 +210,14 @@ struct ScatterOut {
 /// another light (drawn before, one lane at a time, into [`ScatterIn::drawn`]) up to the
 /// shadow ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`],
 /// [`RoughDielectric::f_and_pdf`], [`Plastic::f_and_pdf`], [`RoughPlastic::f_and_pdf`] or
-/// [`DiffuseTransmission::f_and_pdf`],
-/// [`offset_ray_origin`], [`power_heuristic_weight`]
+/// [`DiffuseTransmission::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`]
 /// against the lobe's density, weight one for a delta light; the map's radiance is read after
 /// the shadow ray, as there), and [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe
 /// ([`Diffuse::sample_z`], [`RoughConductor::sample`], [`RoughDielectric::sample_real`],
 /// [`Mirror::sample_real`], [`SmoothConductor::sample`], [`DielectricLanes::sample`],
-/// [`ThinDielectric::sample_real`], [`Plastic::sample_real`], whose coat's reflection is a delta sample,
-/// [`RoughPlastic::sample_real`], [`DiffuseTransmission::sample_real`]; smooth lobes have no
-/// light sample). Only the control flow is the lanes' own: masks where the
+/// [`ThinDielectric::sample_real`], [`Plastic::sample_real`] (whose coat's reflection is a
+/// delta sample), [`RoughPlastic::sample_real`], [`DiffuseTransmission::sample_real`]; smooth
+/// lobes have no light sample). Only the control flow is the lanes' own: masks where the
 /// one-path code returns early, and each lobe's functions skipped where no lane has it (all
 /// but the Lambertian ones and the triangles' and maps' light samples without
 /// `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes alone; the
