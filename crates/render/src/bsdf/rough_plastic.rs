@@ -272,13 +272,13 @@ where
     T: Coat<V::R>,
 {
     /// Probability of sampling the coat's reflection (Mitsuba's choice: the coat's share of
-    /// light arriving from `wo`, weighted by the mean specular and diffuse reflectances).
+    /// light arriving from `wo`, weighted by the mean specular and diffuse reflectances), `t`
+    /// the coat's transmittance towards `wo`.
     #[inline(always)]
-    fn specular_probability(&self, cos_o: V::R) -> V::R {
+    fn specular_probability(&self, t: V::R) -> V::R {
         let (zero, one, half) = (V::R::splat(0.0), V::R::splat(1.0), V::R::splat(0.5));
         let (s, d) = (mean(self.specular), mean(self.diffuse));
         let weight = V::R::select((s + d).gt(zero), s / (s + d), half);
-        let t = self.table.transmittance_at(cos_o);
         let ps = (one - t) * weight;
         let pd = t * (one - weight);
         V::R::select((ps + pd).gt(zero), ps / (ps + pd), half)
@@ -288,6 +288,13 @@ where
     /// the surface; without the coat's reflection where they are opposite).
     #[inline(always)]
     pub fn f_and_pdf(&self, wo: V, wi: V) -> (V, V::R) {
+        self.f_and_pdf_from(wo, wi, self.table.transmittance_at(wo.z()))
+    }
+
+    /// [`Self::f_and_pdf`] given `t_o`, the coat's transmittance towards `wo` (read from the
+    /// table once per sample: in the lanes, one lookup per lane).
+    #[inline(always)]
+    fn f_and_pdf_from(&self, wo: V, wi: V, t_o: V::R) -> (V, V::R) {
         let (zero, one, four) = (V::R::splat(0.0), V::R::splat(1.0), V::R::splat(4.0));
         let m = &self.distribution;
         // The half vector, where it exists (glam's `normalize_or_zero` is not zero).
@@ -299,14 +306,14 @@ where
         let spec = fresnel_dielectric_real(cos_om, self.eta) * m.d(wm) * m.g(wo, wi, wm)
             / (four * wo.z() * wi.z());
         let spec = V::select(half, self.specular.scale(spec), V::splat(Vec3::ZERO));
-        let t = self.table.transmittance_at(wo.z()) * self.table.transmittance_at(wi.z());
+        let t = t_o * self.table.transmittance_at(wi.z());
         let base = coated_base(
             self.diffuse,
             self.table.internal_reflectance(),
             self.nonlinear,
         );
         let f = spec + base.scale(V::R::splat(FRAC_1_PI) * t / (self.eta * self.eta));
-        let ps = self.specular_probability(wo.z());
+        let ps = self.specular_probability(t_o);
         let spec_pdf = V::R::select(
             half & cos_om.gt(zero),
             m.pdf_wm(wo, wm) / (four * cos_om),
@@ -329,13 +336,14 @@ where
     #[inline(always)]
     pub fn sample_real(&self, wo: V, uc: V::R, u0: V::R, u1: V::R) -> DirectionSample<V> {
         let zero = V::R::splat(0.0);
-        let specular = uc.lt(self.specular_probability(wo.z()));
+        let t_o = self.table.transmittance_at(wo.z());
+        let specular = uc.lt(self.specular_probability(t_o));
         let mut wi: V = cosine_hemisphere(u0, u1);
         if V::R::any(specular) {
             let reflected = reflect(wo, self.distribution.sample_wm(wo, u0, u1));
             wi = V::select(specular, reflected, wi);
         }
-        let (f, pdf) = self.f_and_pdf(wo, wi);
+        let (f, pdf) = self.f_and_pdf_from(wo, wi, t_o);
         DirectionSample {
             wi,
             pdf,
