@@ -30,5 +30,12 @@ pub fn luminance_f64(c: glam::DVec3) -> f64 {
 /// statistics) uses [`luminance`].
 #[inline]
 pub fn mitsuba_luminance(c: Rgb) -> f32 {
-    0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
+    mitsuba_luminance_real(c)
+}
+
+/// [`mitsuba_luminance`] of one colour or of lanes' colours.
+#[inline(always)]
+pub fn mitsuba_luminance_real<V: crate::simd::lanes::Vector3>(c: V) -> V::R {
+    use crate::simd::lanes::Real;
+    V::R::splat(0.212671) * c.x() + V::R::splat(0.715160) * c.y() + V::R::splat(0.072169) * c.z()
 }

@@ -8,8 +8,8 @@ use common::*;
 use glam::{DVec3, Vec3};
 use pathlab_mc::sampler::SamplerKind;
 use pathlab_render::desc::{
-    EnvironmentMapDesc, FresnelModel, MaterialDesc, MeshDesc, NormalDistribution, SceneDesc,
-    SphereDesc, TextureDesc,
+    EnvironmentMapDesc, FresnelModel, MaterialDesc, MeshDesc, NormalDistribution, PrincipledDesc,
+    SceneDesc, SphereDesc, TextureDesc,
 };
 use pathlab_render::film::Film;
 use pathlab_render::integrator::{BdptIntegrator, IntegratorKind};
@@ -552,6 +552,78 @@ fn with_plastics(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with principled materials, all shaded in the lanes: a solid on the floor with
+/// every lobe (metallic and clear coat of checkerboards, anisotropic, so that its frame follows
+/// the tangent), a solid sphere that refracts (textured transmission, flatness), a thin sheet
+/// on the wall (diffuse transmission, lit through from behind) and a thin sphere (specular
+/// transmission); one of the solids with the lobes its parameters leave off.
+fn with_principled(mut desc: SceneDesc) -> SceneDesc {
+    let checker = |a: f32, b: f32, scale: f32| TextureDesc::Checkerboard {
+        color0: Vec3::splat(a),
+        color1: Vec3::splat(b),
+        to_uv: glam::Affine2::from_scale(glam::Vec2::splat(scale)),
+    };
+    let constant = |x: f32| TextureDesc::Constant(Vec3::splat(x));
+    let principled = |base: Vec3, thin: bool| PrincipledDesc {
+        base_color: TextureDesc::Constant(base),
+        roughness: constant(0.3),
+        anisotropic: None,
+        spec_trans: None,
+        metallic: None,
+        clearcoat: None,
+        clearcoat_gloss: constant(0.5),
+        sheen: None,
+        sheen_tint: None,
+        spec_tint: None,
+        flatness: None,
+        diff_trans: None,
+        eta: constant(1.5),
+        thin,
+    };
+    desc.materials[0] = MaterialDesc::Principled(Box::new(PrincipledDesc {
+        anisotropic: Some(checker(0.1, 0.7, 5.0)),
+        metallic: Some(checker(0.8, 0.1, 5.0)),
+        clearcoat: Some(checker(0.9, 0.2, 3.0)),
+        sheen: Some(constant(0.5)),
+        sheen_tint: Some(constant(0.4)),
+        spec_tint: Some(constant(0.6)),
+        ..principled(Vec3::new(0.6, 0.5, 0.3), false)
+    }));
+    desc.materials[1] = MaterialDesc::Principled(Box::new(PrincipledDesc {
+        diff_trans: Some(constant(1.2)),
+        sheen: Some(constant(0.3)),
+        ..principled(Vec3::new(0.3, 0.6, 0.4), true)
+    }));
+    let first = desc.materials.len();
+    desc.materials.extend([
+        MaterialDesc::Principled(Box::new(PrincipledDesc {
+            spec_trans: Some(checker(0.8, 0.3, 6.0)),
+            flatness: Some(constant(0.5)),
+            roughness: constant(0.15),
+            ..principled(Vec3::new(0.8, 0.7, 0.9), false)
+        })),
+        MaterialDesc::Principled(Box::new(PrincipledDesc {
+            spec_trans: Some(constant(0.7)),
+            anisotropic: Some(constant(0.5)),
+            spec_tint: Some(constant(0.3)),
+            ..principled(Vec3::new(0.7, 0.2, 0.2), true)
+        })),
+        MaterialDesc::Principled(Box::new(principled(Vec3::new(0.2, 0.3, 0.8), false))),
+    ]);
+    for (k, (x, z)) in [(-0.5, 0.4), (0.45, -0.3), (0.1, 0.5)]
+        .into_iter()
+        .enumerate()
+    {
+        desc.spheres.push(SphereDesc {
+            center: Vec3::new(x, 0.18, z),
+            radius: 0.18,
+            material: first + k,
+            ..Default::default()
+        });
+    }
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -562,10 +634,9 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // glass of one roughness, mirrors, smooth conductors and glass go through the lanes too,
     // textured or not, in the scenes `with_metals`, `with_smooth_lobes` and `with_textures`;
     // blends of two diffuse materials in `with_blends`; those lobes under normal and bump
-    // maps in `with_maps`; smooth and rough plastics in `with_plastics`): every sample's
-    // radiance
-    // must be the scalar `li`'s to the
-    // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
+    // maps in `with_maps`; smooth and rough plastics in `with_plastics`; the principled model
+    // in `with_principled`): every sample's radiance must be the scalar `li`'s to the bit, and
+    // the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these
     // rays do not meet), and no nodes are counted; with a hundred triangles more, the lanes
@@ -597,6 +668,9 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         (with_plastics(mixed_scene()), false),
         (crowded(under_a_sky(with_plastics(mixed_scene()))), true),
         (with_more_lights(with_plastics(mixed_scene())), false),
+        (with_principled(mixed_scene()), false),
+        (crowded(under_a_sky(with_principled(mixed_scene()))), true),
+        (with_more_lights(with_principled(mixed_scene())), false),
         (with_more_lights(with_maps(mixed_scene())), false),
         (without_emitting_surfaces(mixed_scene(), false), false),
         (without_emitting_surfaces(mixed_scene(), true), false),

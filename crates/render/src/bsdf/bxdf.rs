@@ -71,20 +71,6 @@ pub struct LocalSample {
     pub delta: bool,
 }
 
-impl LocalSample {
-    /// A non-delta sample of direction `wi` with density `pdf`, whose f is evaluated only when
-    /// the density is positive (`None` otherwise: a direction the strategy cannot produce).
-    #[inline]
-    pub(crate) fn evaluated(wi: Vec3, pdf: f32, f: impl FnOnce() -> Rgb) -> Option<LocalSample> {
-        (pdf > 0.0).then(|| LocalSample {
-            f: f(),
-            wi,
-            pdf,
-            delta: false,
-        })
-    }
-}
-
 /// Which of a BSDF's lobes a sample may come from (pbrt-v4's `BxDFReflTransFlags`): layered
 /// models walk inside their layers by sampling reflection or transmission alone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

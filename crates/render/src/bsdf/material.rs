@@ -371,6 +371,8 @@ pub enum LaneBxdf {
     ThinDielectric(ThinDielectric),
     /// Lambertian reflection and transmission.
     DiffuseTransmission(DiffuseTransmission),
+    /// Disney's principled BSDF, solid or thin.
+    Principled(Principled),
 }
 
 impl LaneBxdf {
@@ -390,6 +392,7 @@ impl LaneBxdf {
             Bxdf::RoughPlastic(p) => LaneBxdf::RoughPlastic(*p),
             Bxdf::ThinDielectric(d) => LaneBxdf::ThinDielectric(*d),
             Bxdf::DiffuseTransmission(d) => LaneBxdf::DiffuseTransmission(*d),
+            Bxdf::Principled(p) => LaneBxdf::Principled(*p),
             _ => return None,
         })
     }
@@ -409,7 +412,8 @@ impl Leaf {
             | Model::DiffuseTransmission { .. }
             | Model::Conductor { .. }
             | Model::Dielectric { .. }
-            | Model::RoughPlastic { .. } => {
+            | Model::RoughPlastic { .. }
+            | Model::Principled(_) => {
                 textured = self.model.bxdf(&tex());
                 (&textured.0, textured.1)
             }
@@ -448,11 +452,11 @@ impl Material {
     /// textures read at `tex`: Lambertian, a rough conductor or rough glass of GGX or Beckmann
     /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, smooth glass
     /// of exact Fresnel reflectance, a thin sheet of glass, smooth or rough plastic, diffuse
-    /// reflection and transmission; one of those under a normal or
+    /// reflection and transmission, the principled model; one of those under a normal or
     /// bump map; or a blend of two Lambertian materials, which is one Lambertian lobe.
     /// Textured models are evaluated (as [`Material::bsdf`] evaluates them) only where they
-    /// may give one of those: diffuse (and diffuse transmission), conductors, glass and rough
-    /// plastic.
+    /// may give one of those: diffuse (and diffuse transmission), conductors, glass, rough
+    /// plastic and the principled model.
     #[inline]
     pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<LaneLobe> {
         match self {

@@ -46,7 +46,7 @@ pub use microfacet::{
 pub use mirror::Mirror;
 pub use mixture::{guard_admits, guard_attenuation, Bsdf, BsdfSample, Guard, Lobe, MAX_LOBES};
 pub use plastic::Plastic;
-pub use principled::{Principled, PrincipledFlags};
+pub use principled::{Principled, PrincipledFlags, PrincipledLobes};
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::{CoatLanes, RoughPlastic};
 pub use scattering::{reflect, refract, refract_about};

@@ -131,7 +131,7 @@ impl<V: Vector3> Plastic<V, V::R, <V::R as Real>::Mask> {
         )
     }
 
-    /// The coat's mirror reflection, with probability [`Self::specular_probability`], or a
+    /// The coat's mirror reflection, with probability `specular_probability`, or a
     /// cosine-weighted direction from (`u0`, `u1`); `uc` chooses. Returns the sample (it
     /// exists where `wo` is above the surface and its density is positive) and where it is
     /// the mirror reflection (a delta lobe).

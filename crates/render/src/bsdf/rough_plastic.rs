@@ -330,7 +330,7 @@ where
     }
 
     /// The reflection of `wo` about a microfacet normal drawn from (`u0`, `u1`), with the
-    /// probability [`Self::specular_probability`], or a cosine-weighted direction from them;
+    /// probability `specular_probability`, or a cosine-weighted direction from them;
     /// `uc` chooses. It exists where `wo` and it are above the surface and its density is
     /// positive.
     #[inline(always)]

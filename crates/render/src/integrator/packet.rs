@@ -12,13 +12,14 @@
 //! shade ([`Material::lane_bxdf`]: Lambertian, or a blend of two Lambertian materials, which
 //! is one Lambertian lobe; a mirror; smooth conductors and glass; rough GGX or Beckmann
 //! conductors and glass, of one roughness or anisotropic; thin sheets of glass; smooth and
-//! rough plastic; diffuse reflection and transmission; any of those under a normal or bump
+//! rough plastic; diffuse reflection and transmission; the principled model, solid or thin;
+//! any of those under a normal or bump
 //! map). There the lanes are shaded together in SIMD registers by the same functions the
 //! one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
 //! [`RoughConductor`], [`RoughDielectric`] (their distributions: [`MicrofacetLanes`], whose
 //! anisotropic Beckmann lanes go one lane at a time), [`Mirror`], [`SmoothConductor`],
 //! [`DielectricLanes`], [`ThinDielectric`], [`Plastic`], [`RoughPlastic`] (its coat's table
-//! read lane by lane), [`DiffuseTransmission`]; [`TriangleEmitter::sample_li`],
+//! read lane by lane), [`DiffuseTransmission`], [`PrincipledLobes`]; [`TriangleEmitter::sample_li`],
 //! [`EnvironmentMap::sample_direction_lanes`], the shading [`Frame`] (or, for an
 //! anisotropic lobe or a mapped normal, the frame [`Material::lane_bxdf`] gives the lane),
 //! a map's guard ([`guard_attenuation`]), [`offset_ray_origin`],
@@ -44,8 +45,8 @@ use crate::accel::RayLanes;
 use crate::bsdf::bxdf::DirectionSample;
 use crate::bsdf::{
     guard_admits, guard_attenuation, CoatLanes, DielectricLanes, Diffuse, DiffuseTransmission,
-    LaneBxdf, Lobes, Material, MicrofacetLanes, Mirror, Plastic, RoughConductor, RoughDielectric,
-    RoughPlastic, SmoothConductor, ThinDielectric,
+    LaneBxdf, Lobes, Material, MicrofacetLanes, Mirror, Plastic, PrincipledLobes, RoughConductor,
+    RoughDielectric, RoughPlastic, SmoothConductor, ThinDielectric,
 };
 use crate::desc::{RayKind, Rgb};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SHADOW_RAY_END};
@@ -67,7 +68,7 @@ struct ScatterIn {
     /// Which lanes have which lobe ([`LobeLanes`], and the rarer ones in `coated_lobes`):
     /// `metal`, a rough conductor; `rough_glass`; `mirror`; `smooth_metal`, a smooth
     /// conductor; `glass`; `thin_glass`; `plastic`; `rough_plastic`; `translucent`, diffuse
-    /// reflection and transmission; the others' is `diffuse`.
+    /// reflection and transmission; `principled`; the others' is `diffuse`.
     lobes: LobeLanes,
     diffuse: Diffuse<V8>,
     metal: RoughConductor<V8, MicrofacetLanes>,
@@ -79,6 +80,7 @@ struct ScatterIn {
     plastic: Plastic<V8, F8, M8>,
     rough_plastic: RoughPlastic<V8, F8, MicrofacetLanes, M8, CoatLanes>,
     translucent: DiffuseTransmission<V8>,
+    principled: PrincipledLobes<V8, F8, M8, MicrofacetLanes>,
     two_sided: M8,
     /// Whether some lane has one of the lobes of `coated` (cleared, and looked at, only
     /// where one had).
@@ -165,13 +167,14 @@ struct LobeLanes {
 /// Which lanes have the rarer lobes (cleared, and looked at, only where some lane had one:
 /// [`ScatterIn::coated`]): thin sheets of glass (in [`LobeLanes::delta`] too), smooth
 /// plastic (a delta lobe, the coat's reflection, and a diffuse one), rough plastic, diffuse
-/// reflection and transmission.
+/// reflection and transmission, the principled model.
 #[derive(Clone, Copy, Default)]
 struct CoatedLanes {
     thin_glass: M8,
     plastic: M8,
     rough_plastic: M8,
     translucent: M8,
+    principled: M8,
 }
 
 /// What the lanes' scattering yields.
@@ -210,18 +213,19 @@ struct ScatterOut {
 /// another light (drawn before, one lane at a time, into [`ScatterIn::drawn`]) up to the
 /// shadow ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`],
 /// [`RoughDielectric::f_and_pdf`], [`Plastic::f_and_pdf`], [`RoughPlastic::f_and_pdf`] or
-/// [`DiffuseTransmission::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`]
+/// [`DiffuseTransmission::f_and_pdf`] or [`PrincipledLobes::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`]
 /// against the lobe's density, weight one for a delta light; the map's radiance is read after
 /// the shadow ray, as there), and [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe
 /// ([`Diffuse::sample_z`], [`RoughConductor::sample`], [`RoughDielectric::sample_real`],
 /// [`Mirror::sample_real`], [`SmoothConductor::sample`], [`DielectricLanes::sample`],
 /// [`ThinDielectric::sample_real`], [`Plastic::sample_real`] (whose coat's reflection is a
-/// delta sample), [`RoughPlastic::sample_real`], [`DiffuseTransmission::sample_real`]; smooth
+/// delta sample), [`RoughPlastic::sample_real`], [`DiffuseTransmission::sample_real`],
+/// [`PrincipledLobes::sample_real`]; smooth
 /// lobes have no light sample). Only the control flow is the lanes' own: masks where the
 /// one-path code returns early, and each lobe's functions skipped where no lane has it (all
 /// but the Lambertian ones and the triangles' and maps' light samples without
 /// `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes alone; the
-/// plastics, thin glass and diffuse transmission only with `COATED`: the instance for the
+/// plastics, thin glass, diffuse transmission and the principled model only with `COATED`: the instance for the
 /// other lobes stays as small as it was without them).
 #[inline(always)]
 fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool>(a: &ScatterIn, out: &mut ScatterOut) {
@@ -250,6 +254,8 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool>(a: &ScatterIn, out
     let any_rough_plastic = COATED && rough_plastic.any();
     let translucent = a.coated_lobes.translucent;
     let any_translucent = COATED && translucent.any();
+    let principled = a.coated_lobes.principled;
+    let any_principled = COATED && principled.any();
 
     // Light sampling: a point on a triangle, an environment map's direction, or a sample
     // drawn one lane at a time.
@@ -294,6 +300,13 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool>(a: &ScatterIn, out
         (f, bsdf_pdf) = (
             translucent.select3(f_t, f),
             translucent.select(pdf_t, bsdf_pdf),
+        );
+    }
+    if any_principled {
+        let (f_p, pdf_p) = a.principled.f_and_pdf(wo_local, wi_local);
+        (f, bsdf_pdf) = (
+            principled.select3(f_p, f),
+            principled.select(pdf_p, bsdf_pdf),
         );
     }
     let cos_i = wi.dot(frame.n).abs();
@@ -372,6 +385,11 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool>(a: &ScatterIn, out
     if any_translucent {
         let t = a.translucent.sample_real(wo_local, a.u_lobe, u0, u1);
         bs = DirectionSample::select(translucent, t, bs);
+    }
+    if any_principled {
+        let p = a.principled.sample_real(wo_local, a.u_lobe, u0, u1);
+        eta = principled.select(a.principled.relative_ior(wo_local, p.wi), eta);
+        bs = DirectionSample::select(principled, p, bs);
     }
     if OTHER_LOBES && lobes.delta.any() {
         let wo = wo_local;
@@ -456,6 +474,10 @@ fn scatter_other_lobes(a: &mut ScatterIn, out: &mut ScatterOut) {
     let rough_plastic = a.coated_lobes.rough_plastic;
     if a.coated && rough_plastic.any() {
         a.rough_plastic.distribution.only_in(rough_plastic);
+    }
+    let principled = a.coated_lobes.principled;
+    if a.coated && principled.any() {
+        a.principled.only_in(principled);
     }
     let a = &*a;
     if a.coated {
@@ -945,6 +967,11 @@ fn gather_lobe(
         LaneBxdf::RoughPlastic(plastic) => {
             a.rough_plastic.set_lane(i, plastic);
             coated.rough_plastic.set(i, true);
+            a.coated = true;
+        }
+        LaneBxdf::Principled(p) => {
+            a.principled.set_lane(i, p.lobes());
+            coated.principled.set(i, true);
             a.coated = true;
         }
     }
