@@ -148,6 +148,10 @@ fn malformed_xml_gives_located_errors() {
             r#"<scene><shape type="rectangle"><bsdf type="roughplastic"><float name="alpha" value="-0.1"/></bsdf></shape></scene>"#,
             "alpha must be a number >= 0, got -0.1",
         ),
+        (
+            r#"<scene><shape type="sphere"><bsdf type="principled"><float name="roughness" value="-3"/></bsdf></shape></scene>"#,
+            "<bsdf type=\"principled\">: roughness must be a number >= 0, got -3",
+        ),
         // A negative emission has no meaning; rendered, its samples would carry no light
         // and the image would come out black without a word.
         (

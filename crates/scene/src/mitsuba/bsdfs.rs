@@ -112,8 +112,9 @@ fn alphas(ctx: &mut Ctx, b: Obj) -> Result<(TextureDesc, TextureDesc), Error> {
     Ok((a.clone(), a))
 }
 
-/// An error at property `name` of `b` unless the roughness `a` is a number ≥ 0 (Mitsuba
-/// gives no meaning to a negative α; it is not taken as smooth).
+/// An error at property `name` of `b` unless the roughness `a` (an α, or the principled
+/// model's roughness) is a number ≥ 0 (Mitsuba gives no meaning to a negative one; it is not
+/// taken as smooth).
 fn non_negative_alpha(ctx: &Ctx, b: Obj, name: &str, a: f32) -> Result<(), Error> {
     if a >= 0.0 && a.is_finite() {
         return Ok(());
@@ -444,9 +445,13 @@ fn principled(ctx: &mut Ctx, b: Obj) -> Result<MaterialDesc, Error> {
         }
         TextureDesc::value(2.0 / (1.0 - (0.08 * specular).sqrt()) - 1.0)
     };
+    let roughness = ctx.texture(b, "roughness", Vec3::splat(0.5), SpectrumKind::Unbounded)?;
+    if let Some(r) = roughness.as_constant() {
+        non_negative_alpha(ctx, b, "roughness", r.x)?;
+    }
     Ok(MaterialDesc::Principled(Box::new(PrincipledDesc {
         base_color: ctx.texture(b, "base_color", Vec3::splat(0.5), SpectrumKind::Reflectance)?,
-        roughness: ctx.texture(b, "roughness", Vec3::splat(0.5), SpectrumKind::Unbounded)?,
+        roughness,
         anisotropic,
         spec_trans,
         metallic,
