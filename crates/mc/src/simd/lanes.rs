@@ -379,6 +379,17 @@ pub trait Real:
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
     /// Whether `m` is true in some lane.
     fn any(m: Self::Mask) -> bool;
+    /// True in every lane.
+    #[inline(always)]
+    fn every_lane() -> Self::Mask {
+        let zero = Self::splat(0.0);
+        zero.equals(zero)
+    }
+    /// True in no lane.
+    #[inline(always)]
+    fn no_lane() -> Self::Mask {
+        !Self::every_lane()
+    }
     /// `f` of each lane in the lanes `m` (zero in the others, where `f` is not called): for
     /// functions that have no lane form, such as `exp`, whose lanes' values are then those of
     /// `f`, to the bit.
@@ -736,6 +747,8 @@ mod tests {
             assert_eq!(a.equals(b).get(i), x == y);
             assert_eq!(a.is_finite().get(i), x.is_finite());
             assert_eq!(a.is_infinite().get(i), x.is_infinite());
+            assert!(F8::every_lane().get(i) && !F8::no_lane().get(i));
+            assert!(<f32 as Real>::every_lane() && !<f32 as Real>::no_lane());
             assert!(same(a.lt(b).select(a, b).0[i], if x < y { x } else { y }));
             let v = V8 {
                 x: a,

@@ -98,8 +98,7 @@ impl Lobes {
     pub(crate) fn choose_real<R: Real>(self, r: R, t: R) -> (R, R, R::Mask) {
         let zero = R::splat(0.0);
         let (r, t) = match self {
-            // (0 == 0: every lane.)
-            Lobes::All => return (r, t, zero.equals(zero)),
+            Lobes::All => return (r, t, R::every_lane()),
             Lobes::Reflection => (r, zero),
             Lobes::Transmission => (zero, t),
         };

@@ -89,13 +89,6 @@ fn grey<V: Vector3>(s: V::R) -> V {
     V::new(s, s, s)
 }
 
-/// Every lane true.
-#[inline(always)]
-fn all<R: Real>() -> R::Mask {
-    let zero = R::splat(0.0);
-    zero.equals(zero)
-}
-
 /// `value + term()` where `m`, `value` elsewhere; `term` is computed only where some lane
 /// has `m` (for one material: only where `m` holds).
 #[inline(always)]
@@ -436,23 +429,39 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
     /// f(wo, wi).
     #[inline(always)]
     pub fn f(&self, wo: V, wi: V) -> V {
-        let zero = V::R::splat(0.0);
-        let solid = !self.thin;
-        let mut value = grey(zero);
-        if V::R::any(solid) {
-            value = self.solid_value(wo, wi);
+        self.value(wo, wi, &self.halves(wo, wi))
+    }
+
+    /// f(wo, wi) and [`PrincipledLobes::pdf`], which share their half vectors.
+    #[inline(always)]
+    pub fn f_and_pdf(&self, wo: V, wi: V) -> (V, V::R) {
+        let h = self.halves(wo, wi);
+        (self.value(wo, wi, &h), self.density(wo, wi, &h))
+    }
+
+    /// The half vectors between `wo` and `wi` that a solid's and a thin sheet's value and
+    /// density both start from, each found where some lane is of that kind.
+    #[inline(always)]
+    fn halves(&self, wo: V, wi: V) -> Halves<V> {
+        Halves {
+            solid: V::R::any(!self.thin).then(|| self.solid_half(wo, wi)),
+            thin: V::R::any(self.thin).then(|| ThinHalf::new(wo, wi)),
         }
-        if V::R::any(self.thin) {
-            value = V::select(self.thin, self.thin_value(wo, wi), value);
+    }
+
+    /// f(wo, wi) from its half vectors.
+    #[inline(always)]
+    fn value(&self, wo: V, wi: V, h: &Halves<V>) -> V {
+        let zero = V::R::splat(0.0);
+        let mut value = grey(zero);
+        if let Some(h) = &h.solid {
+            value = self.solid_value(wo, wi, h);
+        }
+        if let Some(h) = &h.thin {
+            value = V::select(self.thin, self.thin_value(h), value);
         }
         let none = wo.z().equals(zero) | wi.z().equals(zero);
         V::select(none, grey(zero), value.div_by(wi.z().abs()))
-    }
-
-    /// f(wo, wi) and [`PrincipledLobes::pdf`].
-    #[inline(always)]
-    pub fn f_and_pdf(&self, wo: V, wi: V) -> (V, V::R) {
-        (self.f(wo, wi), self.pdf(wo, wi))
     }
 
     /// The relative index η' of a sample from `wo` to `wi` (a solid's refraction: see
@@ -462,24 +471,49 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
         V::R::select(self.thin, V::R::splat(1.0), relative_eta(wo, wi, self.eta))
     }
 
+    /// What a solid's value and density at (`v`, `l`) share: the side `v` is on, whether
+    /// `l` is a reflection, the half vector of the reflection or refraction and its dielectric
+    /// Fresnel term, and which facets may serve it.
+    #[inline(always)]
+    fn solid_half(&self, v: V, l: V) -> SolidHalf<V> {
+        let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
+        let front = v.z().gt(zero);
+        let reflect = (v.z() * l.z()).gt(zero);
+        let eta_path = V::R::select(front, self.eta, one / self.eta);
+        let (wh, found) = try_normalize(v + l.scale(V::R::select(reflect, one, eta_path)));
+        let wh = V::select(wh.z().lt(zero), -wh, wh);
+        SolidHalf {
+            front,
+            reflect,
+            eta_path,
+            wh,
+            found,
+            f_diel: fresnel_dielectric_real(v.dot(wh), self.eta),
+            refl_ok: compatible(wh, v, l, v.z(), true),
+            refr_ok: compatible(wh, v, l, v.z(), false),
+        }
+    }
+
     /// Mitsuba's `principled` eval: f · |cos θi|.
     #[inline(always)]
-    fn solid_value(&self, v: V, l: V) -> V {
+    fn solid_value(&self, v: V, l: V, h: &SolidHalf<V>) -> V {
         let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
         let (cos_i, cos_o) = (v.z(), l.z());
         let brdf = (one - self.metallic) * (one - self.spec_trans);
         let bsdf = (one - self.metallic) * self.spec_trans;
-        let reflect = (cos_i * cos_o).gt(zero);
         let refract = (cos_i * cos_o).lt(zero);
-        let front = cos_i.gt(zero);
-        let eta_path = V::R::select(front, self.eta, one / self.eta);
+        let SolidHalf {
+            front,
+            reflect,
+            eta_path,
+            wh,
+            found,
+            f_diel,
+            refl_ok,
+            refr_ok,
+        } = *h;
         let inv_eta_path = one / eta_path;
         let spec = &self.specular;
-        let (wh, found) = try_normalize(v + l.scale(V::R::select(reflect, one, eta_path)));
-        let wh = V::select(wh.z().lt(zero), -wh, wh);
-        let f_diel = fresnel_dielectric_real(v.dot(wh), self.eta);
-        let refl_ok = compatible(wh, v, l, cos_i, true);
-        let refr_ok = compatible(wh, v, l, cos_i, false);
         let d = spec.d(wh);
         let g = spec.g(v, l, wh);
         let mut value = grey(zero);
@@ -592,21 +626,26 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
 
     /// Mitsuba's `principledthin` eval: f · |cos θi|.
     #[inline(always)]
-    fn thin_value(&self, v: V, l: V) -> V {
+    fn thin_value(&self, h: &ThinHalf<V>) -> V {
         let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
         let (spec_trans, diff_trans) = self.thin_shares();
-        let sign = v.z().sign_one();
-        let (v, lt) = (v.scale(sign), l.scale(sign));
+        let ThinHalf {
+            v,
+            lt,
+            reflect,
+            wh,
+            found,
+            refl_ok,
+            refr_ok,
+            ..
+        } = *h;
         let cos_i = v.z();
         let cos_o = lt.z();
-        let reflect = cos_o.gt(zero);
         let refract = cos_o.lt(zero);
-        let lr = V::new(lt.x(), lt.y(), lt.z().abs());
-        let (wh, found) = try_normalize(v + lr);
         let mut value = grey(zero);
         let specular = self.has_spec_trans & spec_trans.gt(zero);
-        let spec_r = specular & reflect & compatible(wh, v, lt, v.z(), true);
-        let spec_t = specular & refract & compatible(wh, v, lt, v.z(), false);
+        let spec_r = specular & reflect & refl_ok;
+        let spec_t = specular & refract & refr_ok;
         if V::R::any(spec_r | spec_t) {
             let f_diel = fresnel_dielectric_real(v.dot(wh), self.eta);
             value = add_where(value, spec_r, || {
@@ -707,7 +746,7 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
     pub fn sample_real(&self, wo: V, uc: V::R, u0: V::R, u1: V::R) -> DirectionSample<V> {
         let zero = V::R::splat(0.0);
         let solid = !self.thin;
-        let (mut wi, mut found) = (wo, solid & !solid);
+        let (mut wi, mut found) = (wo, V::R::no_lane());
         if V::R::any(solid) {
             (wi, found) = self.sample_solid(wo, uc, u0, u1);
         }
@@ -788,7 +827,7 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
         let spec_t = !spec_r & uc.lt(p_sr + p_st);
         let diff_r = !spec_r & !spec_t & uc.lt(p_sr + p_st + p_dr);
         let diffuse = !spec_r & !spec_t;
-        let mut found = all::<V::R>();
+        let mut found = V::R::every_lane();
         let mut w = v;
         if V::R::any(diffuse) {
             let c: V = cosine_hemisphere(u0, u1);
@@ -813,35 +852,43 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
     /// Density of [`PrincipledLobes::sample_real`] choosing `wi`.
     #[inline(always)]
     pub fn pdf(&self, wo: V, wi: V) -> V::R {
+        self.density(wo, wi, &self.halves(wo, wi))
+    }
+
+    /// [`PrincipledLobes::pdf`] from its half vectors.
+    #[inline(always)]
+    fn density(&self, wo: V, wi: V, h: &Halves<V>) -> V::R {
         let zero = V::R::splat(0.0);
-        let solid = !self.thin;
         let mut pdf = zero;
-        if V::R::any(solid) {
-            pdf = self.pdf_solid(wo, wi);
+        if let Some(h) = &h.solid {
+            pdf = self.pdf_solid(wo, wi, h);
         }
-        if V::R::any(self.thin) {
-            pdf = V::R::select(self.thin, self.pdf_thin(wo, wi), pdf);
+        if let Some(h) = &h.thin {
+            pdf = V::R::select(self.thin, self.pdf_thin(h), pdf);
         }
         let none = wo.z().equals(zero) | wi.z().equals(zero);
         V::R::select(none, zero, pdf)
     }
 
     #[inline(always)]
-    fn pdf_solid(&self, v: V, l: V) -> V::R {
+    fn pdf_solid(&self, v: V, l: V, h: &SolidHalf<V>) -> V::R {
         let (zero, one) = (V::R::splat(0.0), V::R::splat(1.0));
-        let front = v.z().gt(zero);
-        let reflect = (v.z() * l.z()).gt(zero);
-        let eta_path = V::R::select(front, self.eta, one / self.eta);
-        let (wh, found) = try_normalize(v + l.scale(V::R::select(reflect, one, eta_path)));
-        let wh = V::select(wh.z().lt(zero), -wh, wh);
-        let f = fresnel_dielectric_real(v.dot(wh), self.eta);
+        let SolidHalf {
+            front,
+            reflect,
+            eta_path,
+            wh,
+            found,
+            f_diel: f,
+            refl_ok,
+            refr_ok,
+        } = *h;
         let [p_diff, p_coat, p_trans, p_refl] = self.solid_probabilities(front, f);
         let up = V::select(front, v, -v);
         let spec = &self.specular;
         let visible = spec.pdf_wm(up, wh);
         // Reflection: the specular lobe's and the clear coat's facets, and the diffuse lobe.
         let jacobian = one / (V::R::splat(4.0) * l.dot(wh)).abs();
-        let refl_ok = compatible(wh, v, l, v.z(), true);
         let mut reflected = add_real_where(zero, refl_ok, || p_refl * visible * jacobian);
         let coated = refl_ok & self.has_clearcoat;
         reflected = add_real_where(reflected, coated, || {
@@ -849,7 +896,7 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
         });
         reflected = reflected + p_diff * cosine_hemisphere_pdf(l.z().abs());
         // Transmission.
-        let transmits = self.has_spec_trans & compatible(wh, v, l, v.z(), false);
+        let transmits = self.has_spec_trans & refr_ok;
         let transmitted = add_real_where(zero, transmits, || {
             let (vh, lh) = (v.dot(wh), l.dot(wh));
             let denom = vh + eta_path * lh;
@@ -861,17 +908,22 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
     }
 
     #[inline(always)]
-    fn pdf_thin(&self, wo: V, wi: V) -> V::R {
+    fn pdf_thin(&self, h: &ThinHalf<V>) -> V::R {
         let zero = V::R::splat(0.0);
-        let sign = wo.z().sign_one();
-        let (v, lt) = (wo.scale(sign), wi.scale(sign));
+        let ThinHalf {
+            v,
+            lt,
+            lr,
+            reflect,
+            wh,
+            found,
+            refl_ok,
+            refr_ok,
+        } = *h;
         let [p_sr, p_st, p_dr, p_dt] = self.thin_probabilities();
-        let reflect = lt.z().gt(zero);
-        let lr = V::new(lt.x(), lt.y(), lt.z().abs());
-        let (wh, found) = try_normalize(v + lr);
         let jacobian = V::R::splat(1.0) / (V::R::splat(4.0) * lr.dot(wh)).abs();
-        let spec_r = found & reflect & compatible(wh, v, lt, v.z(), true);
-        let spec_t = found & !reflect & compatible(wh, v, lt, v.z(), false);
+        let spec_r = found & reflect & refl_ok;
+        let spec_t = found & !reflect & refr_ok;
         let mut pdf = add_real_where(zero, spec_r, || {
             p_sr * self.specular.pdf_wm(v, wh) * jacobian
         });
@@ -884,6 +936,72 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
             p_dt * cosine_hemisphere_pdf(-lt.z()),
         );
         pdf + diffuse
+    }
+}
+
+/// The half vectors a principled value and density share ([`PrincipledLobes::f_and_pdf`]):
+/// a solid's where some lane is a solid, a thin sheet's where some lane is thin.
+struct Halves<V: Vector3> {
+    solid: Option<SolidHalf<V>>,
+    thin: Option<ThinHalf<V>>,
+}
+
+/// A solid's half vector at (v, l) and what goes with it ([`PrincipledLobes::solid_half`]).
+#[derive(Clone, Copy)]
+struct SolidHalf<V: Vector3> {
+    /// v on the outside.
+    front: Mask<V>,
+    /// v and l on the same side.
+    reflect: Mask<V>,
+    /// The relative index along the path, η from the front, 1/η from inside.
+    eta_path: V::R,
+    /// The half vector of the reflection, or of the refraction, turned up.
+    wh: V,
+    /// Where `wh` exists.
+    found: Mask<V>,
+    /// The dielectric Fresnel term of v at `wh`.
+    f_diel: V::R,
+    /// Where `wh` may serve a reflection, and a refraction.
+    refl_ok: Mask<V>,
+    refr_ok: Mask<V>,
+}
+
+/// A thin sheet's half vector at (v, l), both mirrored to v's side of the sheet.
+#[derive(Clone, Copy)]
+struct ThinHalf<V: Vector3> {
+    /// v and l, mirrored so that v is above the sheet.
+    v: V,
+    lt: V,
+    /// `lt` reflected to v's side.
+    lr: V,
+    /// `lt` above the sheet.
+    reflect: Mask<V>,
+    /// The half vector of v and `lr`, and where it exists.
+    wh: V,
+    found: Mask<V>,
+    /// Where `wh` may serve a reflection, and a transmission.
+    refl_ok: Mask<V>,
+    refr_ok: Mask<V>,
+}
+
+impl<V: Vector3> ThinHalf<V> {
+    /// The half vector of `wo` and `wi` at a thin sheet.
+    #[inline(always)]
+    fn new(wo: V, wi: V) -> Self {
+        let sign = wo.z().sign_one();
+        let (v, lt) = (wo.scale(sign), wi.scale(sign));
+        let lr = V::new(lt.x(), lt.y(), lt.z().abs());
+        let (wh, found) = try_normalize(v + lr);
+        ThinHalf {
+            v,
+            lt,
+            lr,
+            reflect: lt.z().gt(V::R::splat(0.0)),
+            wh,
+            found,
+            refl_ok: compatible(wh, v, lt, v.z(), true),
+            refr_ok: compatible(wh, v, lt, v.z(), false),
+        }
     }
 }
 
