@@ -162,6 +162,19 @@ fn under_a_sky(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// Spheres resting on the floor at (x, z) of radius r, of the materials `first`, `first + 1`…
+/// in turn.
+fn push_spheres(desc: &mut SceneDesc, first: usize, spheres: &[(f32, f32, f32)]) {
+    for (k, &(x, z, r)) in spheres.iter().enumerate() {
+        desc.spheres.push(SphereDesc {
+            center: Vec3::new(x, r, z),
+            radius: r,
+            material: first + k,
+            ..Default::default()
+        });
+    }
+}
+
 /// `desc` with rough conductors: GGX of one roughness on the wall and the mirror sphere, a
 /// Beckmann sphere and an anisotropic GGX one (its frame along the sphere's tangent), all
 /// shaded in the lanes; and rough glass spheres, GGX and Beckmann.
@@ -194,19 +207,16 @@ fn with_metals(mut desc: SceneDesc) -> SceneDesc {
     desc.materials.push(rough_glass(NormalDistribution::Ggx));
     desc.materials
         .push(rough_glass(NormalDistribution::Beckmann));
-    for (x, z, r, material) in [
-        (-0.1, 0.5, 0.12, 3),
-        (0.7, 0.5, 0.12, 4),
-        (-0.6, 0.0, 0.2, 5),
-        (0.1, -0.5, 0.15, 6),
-    ] {
-        desc.spheres.push(SphereDesc {
-            center: Vec3::new(x, r, z),
-            radius: r,
-            material,
-            ..Default::default()
-        });
-    }
+    push_spheres(
+        &mut desc,
+        3,
+        &[
+            (-0.1, 0.5, 0.12),
+            (0.7, 0.5, 0.12),
+            (-0.6, 0.0, 0.2),
+            (0.1, -0.5, 0.15),
+        ],
+    );
     desc
 }
 
@@ -245,17 +255,11 @@ fn with_textures(mut desc: SceneDesc) -> SceneDesc {
         reflectance: Vec3::ONE,
         transmittance: Vec3::new(0.9, 1.0, 0.95),
     });
-    for (k, (x, z)) in [(-0.4, 0.4), (0.4, -0.3), (0.0, 0.0)]
-        .into_iter()
-        .enumerate()
-    {
-        desc.spheres.push(SphereDesc {
-            center: Vec3::new(x, 0.2, z),
-            radius: 0.2,
-            material: first + k,
-            ..Default::default()
-        });
-    }
+    push_spheres(
+        &mut desc,
+        first,
+        &[(-0.4, 0.4, 0.2), (0.4, -0.3, 0.2), (0.0, 0.0, 0.2)],
+    );
     desc
 }
 
@@ -290,23 +294,17 @@ fn with_smooth_lobes(mut desc: SceneDesc) -> SceneDesc {
             ior: 1.5,
         },
     ]);
-    for (k, (x, z, r)) in [
-        (-0.6, -0.4, 0.1),
-        (0.6, -0.5, 0.12),
-        (-0.2, 0.3, 0.25),
-        (0.3, 0.6, 0.2),
-        (-0.1, -0.2, 0.22),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        desc.spheres.push(SphereDesc {
-            center: Vec3::new(x, r, z),
-            radius: r,
-            material: first + k,
-            ..Default::default()
-        });
-    }
+    push_spheres(
+        &mut desc,
+        first,
+        &[
+            (-0.6, -0.4, 0.1),
+            (0.6, -0.5, 0.12),
+            (-0.2, 0.3, 0.25),
+            (0.3, 0.6, 0.2),
+            (-0.1, -0.2, 0.22),
+        ],
+    );
     desc
 }
 
@@ -392,17 +390,11 @@ fn with_blends(mut desc: SceneDesc) -> SceneDesc {
             diffuse(Vec3::new(0.9, 0.9, 0.9), true),
         ),
     ]);
-    for (k, (x, z)) in [(-0.5, 0.4), (0.45, -0.3), (0.1, 0.5)]
-        .into_iter()
-        .enumerate()
-    {
-        desc.spheres.push(SphereDesc {
-            center: Vec3::new(x, 0.18, z),
-            radius: 0.18,
-            material: first + k,
-            ..Default::default()
-        });
-    }
+    push_spheres(
+        &mut desc,
+        first,
+        &[(-0.5, 0.4, 0.18), (0.45, -0.3, 0.18), (0.1, 0.5, 0.18)],
+    );
     desc
 }
 
@@ -461,23 +453,17 @@ fn with_maps(mut desc: SceneDesc) -> SceneDesc {
             2.0,
         ),
     ]);
-    for (k, (x, z)) in [
-        (-0.5, 0.4),
-        (0.45, -0.3),
-        (0.1, 0.5),
-        (-0.3, -0.4),
-        (0.6, 0.4),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        desc.spheres.push(SphereDesc {
-            center: Vec3::new(x, 0.16, z),
-            radius: 0.16,
-            material: first + k,
-            ..Default::default()
-        });
-    }
+    push_spheres(
+        &mut desc,
+        first,
+        &[
+            (-0.5, 0.4, 0.16),
+            (0.45, -0.3, 0.16),
+            (0.1, 0.5, 0.16),
+            (-0.3, -0.4, 0.16),
+            (0.6, 0.4, 0.16),
+        ],
+    );
     desc
 }
 
@@ -538,17 +524,16 @@ fn with_plastics(mut desc: SceneDesc) -> SceneDesc {
         reflectance: TextureDesc::Constant(Vec3::new(0.3, 0.5, 0.4)),
         transmittance: TextureDesc::Constant(Vec3::new(0.4, 0.3, 0.5)),
     };
-    for (k, (x, z)) in [(-0.5, 0.4), (0.45, -0.3), (0.1, 0.5), (-0.1, -0.3)]
-        .into_iter()
-        .enumerate()
-    {
-        desc.spheres.push(SphereDesc {
-            center: Vec3::new(x, 0.18, z),
-            radius: 0.18,
-            material: first + k,
-            ..Default::default()
-        });
-    }
+    push_spheres(
+        &mut desc,
+        first,
+        &[
+            (-0.5, 0.4, 0.18),
+            (0.45, -0.3, 0.18),
+            (0.1, 0.5, 0.18),
+            (-0.1, -0.3, 0.18),
+        ],
+    );
     desc
 }
 
@@ -610,17 +595,11 @@ fn with_principled(mut desc: SceneDesc) -> SceneDesc {
         })),
         MaterialDesc::Principled(Box::new(principled(Vec3::new(0.2, 0.3, 0.8), false))),
     ]);
-    for (k, (x, z)) in [(-0.5, 0.4), (0.45, -0.3), (0.1, 0.5)]
-        .into_iter()
-        .enumerate()
-    {
-        desc.spheres.push(SphereDesc {
-            center: Vec3::new(x, 0.18, z),
-            radius: 0.18,
-            material: first + k,
-            ..Default::default()
-        });
-    }
+    push_spheres(
+        &mut desc,
+        first,
+        &[(-0.5, 0.4, 0.18), (0.45, -0.3, 0.18), (0.1, 0.5, 0.18)],
+    );
     desc
 }
 

@@ -121,9 +121,10 @@ impl DiffuseTransmission<V8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::plastic::tests::{assert_lane_f_pdf, assert_lane_sample, direction};
+    use crate::bsdf::plastic::tests::{
+        assert_lane_f_pdf, assert_lane_sample, direction, LaneInputs,
+    };
     use pathlab_mc::rng::Pcg32;
-    use pathlab_mc::simd::lanes::F8;
 
     /// Eight lanes compute, lane by lane, what one material computes, to the bit: f, pdf and
     /// the sample, both lobes, from both sides and on the surface, black lobes included.
@@ -132,37 +133,31 @@ mod tests {
         let mut rng = Pcg32::new(17, 4);
         let (mut reflected, mut transmitted, mut seen) = (0, 0, 0);
         for round in 0..300 {
-            let mut lanes = DiffuseTransmission::<V8>::default();
-            let (mut wo, mut wi) = (V8::default(), V8::default());
-            let (mut uc, mut u0, mut u1) = (F8::default(), F8::default(), F8::default());
-            let mut one = Vec::new();
-            for i in 0..8 {
+            let case = LaneInputs::draw(&mut rng, |rng, i| {
                 let black = [1.0, 1.0, 1.0, 0.0][(round + i) % 4];
                 let d = DiffuseTransmission {
                     reflectance: Vec3::new(rng.uniform_f32(), 0.4, 0.1) * black,
                     transmittance: Vec3::new(0.3, rng.uniform_f32(), 0.6) * [1.0, 0.0][i % 2],
                 };
-                lanes.set_lane(i, d);
-                let (mut o, mut w) = (direction(&mut rng), direction(&mut rng));
+                let (mut o, mut w) = (direction(rng), direction(rng));
                 match round % 7 {
                     2 => w.z = 0.0,
                     5 => o.z = 0.0,
                     _ => {}
                 }
-                wo.set(i, o);
-                wi.set(i, w);
-                (uc.0[i], u0.0[i], u1.0[i]) =
-                    (rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
-                one.push(d);
+                (d, o, w)
+            });
+            let mut lanes = DiffuseTransmission::<V8>::default();
+            for (i, d) in case.one.iter().enumerate() {
+                lanes.set_lane(i, *d);
             }
-            let (f, pdf) = lanes.f_and_pdf(wo, wi);
-            let s = lanes.sample_real(wo, uc, u0, u1);
-            for (i, d) in one.iter().enumerate() {
-                let (o, w) = (wo.get(i), wi.get(i));
+            let (f, pdf) = lanes.f_and_pdf(case.wo, case.wi);
+            let s = lanes.sample_real(case.wo, case.uc, case.u[0], case.u[1]);
+            for (i, d) in case.one.iter().enumerate() {
+                let (o, w, uc, u) = case.lane(i);
                 let what = format!("{o} {w}");
                 assert_lane_f_pdf(f, pdf, i, (d.f(o, w), d.pdf(o, w)), &what);
-                let scalar = d.sample(o, uc.0[i], Vec2::new(u0.0[i], u1.0[i]));
-                if let Some(scalar) = assert_lane_sample(&s, i, scalar, &what) {
+                if let Some(scalar) = assert_lane_sample(&s, i, d.sample(o, uc, u), &what) {
                     if scalar.wi.z * o.z > 0.0 {
                         reflected += 1;
                     } else {

@@ -200,6 +200,49 @@ pub(crate) mod tests {
         v.to_array().map(f32::to_bits)
     }
 
+    /// Eight lanes of inputs for a test of a model's lanes against one material: each
+    /// lane's material, the directions wo and wi, and a sample's numbers uc and u.
+    pub(crate) struct LaneInputs<T> {
+        pub(crate) one: Vec<T>,
+        pub(crate) wo: V8,
+        pub(crate) wi: V8,
+        pub(crate) uc: F8,
+        pub(crate) u: [F8; 2],
+    }
+
+    impl<T> LaneInputs<T> {
+        /// Each lane's material and directions (wo, wi) from `lane(rng, i)`, and then its
+        /// sample's numbers uc, u0 and u1, all drawn from `rng` lane after lane.
+        pub(crate) fn draw(
+            rng: &mut Pcg32,
+            mut lane: impl FnMut(&mut Pcg32, usize) -> (T, Vec3, Vec3),
+        ) -> Self {
+            let mut inputs = LaneInputs {
+                one: Vec::with_capacity(8),
+                wo: V8::default(),
+                wi: V8::default(),
+                uc: F8::default(),
+                u: [F8::default(); 2],
+            };
+            for i in 0..8 {
+                let (material, o, w) = lane(rng, i);
+                inputs.one.push(material);
+                inputs.wo.set(i, o);
+                inputs.wi.set(i, w);
+                let [u0, u1] = &mut inputs.u;
+                (inputs.uc.0[i], u0.0[i], u1.0[i]) =
+                    (rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
+            }
+            inputs
+        }
+
+        /// Lane `i`'s wo, wi, uc and u.
+        pub(crate) fn lane(&self, i: usize) -> (Vec3, Vec3, f32, Vec2) {
+            let u = Vec2::new(self.u[0].0[i], self.u[1].0[i]);
+            (self.wo.get(i), self.wi.get(i), self.uc.0[i], u)
+        }
+    }
+
     /// Asserts that lane `i` of `f` and `pdf` are `one`'s (f, pdf), to the bit.
     pub(crate) fn assert_lane_f_pdf(f: V8, pdf: F8, i: usize, one: (Vec3, f32), what: &str) {
         assert_eq!(bits(f.get(i)), bits(one.0), "f, lane {i}: {what}");
@@ -235,34 +278,28 @@ pub(crate) mod tests {
         let mut rng = Pcg32::new(3, 5);
         let (mut seen, mut specular, mut diffuse) = (0, 0, 0);
         for round in 0..400 {
-            let mut lanes = Plastic::<V8, F8, M8>::default();
-            let (mut wo, mut wi) = (V8::default(), V8::default());
-            let (mut uc, mut u0, mut u1) = (F8::default(), F8::default(), F8::default());
-            let mut one = Vec::new();
-            for i in 0..8 {
+            let case = LaneInputs::draw(&mut rng, |rng, i| {
                 let rho = Vec3::new(rng.uniform_f32(), 0.5, rng.uniform_f32());
                 let eta = [1.5, 1.33, 2.4, 1.05][(round + i) % 4];
                 let s = [1.0, 0.0, 0.4][(round + i) % 3];
                 let p = Plastic::new(rho, eta, i % 2 == 0).with_specular(Vec3::new(s, 1.0, s));
-                lanes.set_lane(i, p);
-                let (o, mut w) = (direction(&mut rng), direction(&mut rng));
+                let (o, mut w) = (direction(rng), direction(rng));
                 if round % 5 == 2 {
                     w.z = 0.0;
                 }
-                wo.set(i, o);
-                wi.set(i, w);
-                (uc.0[i], u0.0[i], u1.0[i]) =
-                    (rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
-                one.push(p);
+                (p, o, w)
+            });
+            let mut lanes = Plastic::<V8, F8, M8>::default();
+            for (i, p) in case.one.iter().enumerate() {
+                lanes.set_lane(i, *p);
             }
-            let (f, pdf) = lanes.f_and_pdf(wo, wi);
-            let (s, delta) = lanes.sample_real(wo, uc, u0, u1);
-            for (i, p) in one.iter().enumerate() {
-                let (o, w) = (wo.get(i), wi.get(i));
+            let (f, pdf) = lanes.f_and_pdf(case.wo, case.wi);
+            let (s, delta) = lanes.sample_real(case.wo, case.uc, case.u[0], case.u[1]);
+            for (i, p) in case.one.iter().enumerate() {
+                let (o, w, uc, u) = case.lane(i);
                 let what = format!("{o} {w}");
                 assert_lane_f_pdf(f, pdf, i, (p.f(o, w), p.pdf(o, w)), &what);
-                let u = Vec2::new(u0.0[i], u1.0[i]);
-                if let Some(scalar) = assert_lane_sample(&s, i, p.sample(o, uc.0[i], u), &what) {
+                if let Some(scalar) = assert_lane_sample(&s, i, p.sample(o, uc, u), &what) {
                     assert_eq!(delta.get(i), scalar.delta, "lane {i}");
                     if scalar.delta {
                         specular += 1;

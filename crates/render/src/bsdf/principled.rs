@@ -1008,7 +1008,9 @@ impl<V: Vector3> ThinHalf<V> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::plastic::tests::{assert_lane_f_pdf, assert_lane_sample, direction};
+    use crate::bsdf::plastic::tests::{
+        assert_lane_f_pdf, assert_lane_sample, direction, LaneInputs,
+    };
     use pathlab_mc::rng::Pcg32;
 
     /// A principled material of random parameters, each optional one given or not by `bits`,
@@ -1056,40 +1058,34 @@ mod tests {
         let mut rng = Pcg32::new(11, 13);
         let (mut seen, mut sampled, mut refracted) = (0, 0, 0);
         for round in 0..600 {
-            let mut lanes = PrincipledLobes::<V8, F8, M8, MicrofacetLanes>::default();
-            let (mut wo, mut wi) = (V8::default(), V8::default());
-            let (mut uc, mut u0, mut u1) = (F8::default(), F8::default(), F8::default());
-            let mut one = Vec::new();
-            for i in 0..8 {
+            let case = LaneInputs::draw(&mut rng, |rng, i| {
                 let bits = rng.next_u32() & 511;
                 let thin = match round % 3 {
                     0 => false,
                     1 => true,
                     _ => i % 2 == 0,
                 };
-                let p = random_material(&mut rng, bits, thin);
-                lanes.set_lane(i, p.lobes());
-                let o = direction(&mut rng);
+                let p = random_material(rng, bits, thin);
+                let o = direction(rng);
                 let w = match (round + i) % 5 {
                     0 => Vec3::new(o.x, o.y, 0.0),
                     1 => Vec3::new(-o.x, -o.y, o.z),
-                    _ => direction(&mut rng),
+                    _ => direction(rng),
                 };
-                wo.set(i, o);
-                wi.set(i, w);
-                (uc.0[i], u0.0[i], u1.0[i]) =
-                    (rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
-                one.push(p);
+                (p, o, w)
+            });
+            let mut lanes = PrincipledLobes::<V8, F8, M8, MicrofacetLanes>::default();
+            for (i, p) in case.one.iter().enumerate() {
+                lanes.set_lane(i, p.lobes());
             }
-            let (f, pdf) = lanes.f_and_pdf(wo, wi);
-            let s = lanes.sample_real(wo, uc, u0, u1);
-            let eta = lanes.relative_ior(wo, s.wi);
-            for (i, p) in one.iter().enumerate() {
-                let (o, w) = (wo.get(i), wi.get(i));
+            let (f, pdf) = lanes.f_and_pdf(case.wo, case.wi);
+            let s = lanes.sample_real(case.wo, case.uc, case.u[0], case.u[1]);
+            let eta = lanes.relative_ior(case.wo, s.wi);
+            for (i, p) in case.one.iter().enumerate() {
+                let (o, w, uc, u) = case.lane(i);
                 let what = format!("{p:?} {o} {w}");
                 assert_lane_f_pdf(f, pdf, i, (p.f(o, w), p.pdf(o, w)), &what);
-                let u = Vec2::new(u0.0[i], u1.0[i]);
-                if let Some(scalar) = assert_lane_sample(&s, i, p.sample(o, uc.0[i], u), &what) {
+                if let Some(scalar) = assert_lane_sample(&s, i, p.sample(o, uc, u), &what) {
                     let bxdf = super::super::Bxdf::Principled(*p);
                     let expected = bxdf.relative_ior(o, scalar.wi);
                     assert_eq!(eta.0[i].to_bits(), expected.to_bits(), "η', lane {i}");

@@ -439,7 +439,9 @@ mod tests {
 mod lane_tests {
     use super::*;
     use crate::bsdf::conductor::tests::lane_kind;
-    use crate::bsdf::plastic::tests::{assert_lane_f_pdf, assert_lane_sample, direction};
+    use crate::bsdf::plastic::tests::{
+        assert_lane_f_pdf, assert_lane_sample, direction, LaneInputs,
+    };
     use pathlab_mc::rng::Pcg32;
 
     /// Eight lanes of rough plastic compute, lane by lane, what one rough plastic computes,
@@ -451,39 +453,33 @@ mod lane_tests {
         let mut rng = Pcg32::new(13, 1);
         let (mut seen, mut valid) = (0, 0);
         for round in 0..300 {
-            let mut lanes = RoughPlastic::<V8, F8, MicrofacetLanes, M8, CoatLanes>::default();
-            let (mut wo, mut wi) = (V8::default(), V8::default());
-            let (mut uc, mut u0, mut u1) = (F8::default(), F8::default(), F8::default());
-            let mut one = Vec::new();
-            for i in 0..8 {
+            let case = LaneInputs::draw(&mut rng, |rng, i| {
                 let alpha = [0.01, 0.1, 0.3, 0.7][(round + i) % 4];
                 let eta = [1.5, 1.33, 1.9][(round + i) % 3];
                 let rho = Vec3::new(rng.uniform_f32(), 0.3, rng.uniform_f32());
                 let specular = Vec3::new(1.0, rng.uniform_f32(), 0.5);
                 let m = Microfacet::new(lane_kind(round, i), alpha);
                 let p = RoughPlastic::new(rho, specular, eta, m, i % 2 == 1);
-                lanes.set_lane(i, p);
-                let (o, mut w) = (direction(&mut rng), direction(&mut rng));
+                let (o, mut w) = (direction(rng), direction(rng));
                 match round % 6 {
                     0 => w = -o,
                     1 => w = o,
                     2 => w.z = 0.0,
                     _ => {}
                 }
-                wo.set(i, o);
-                wi.set(i, w);
-                (uc.0[i], u0.0[i], u1.0[i]) =
-                    (rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32());
-                one.push(p);
+                (p, o, w)
+            });
+            let mut lanes = RoughPlastic::<V8, F8, MicrofacetLanes, M8, CoatLanes>::default();
+            for (i, p) in case.one.iter().enumerate() {
+                lanes.set_lane(i, *p);
             }
-            let (f, pdf) = lanes.f_and_pdf(wo, wi);
-            let s = lanes.sample_real(wo, uc, u0, u1);
-            for (i, p) in one.iter().enumerate() {
-                let (o, w) = (wo.get(i), wi.get(i));
+            let (f, pdf) = lanes.f_and_pdf(case.wo, case.wi);
+            let s = lanes.sample_real(case.wo, case.uc, case.u[0], case.u[1]);
+            for (i, p) in case.one.iter().enumerate() {
+                let (o, w, uc, u) = case.lane(i);
                 let what = format!("{o} {w}");
                 assert_lane_f_pdf(f, pdf, i, (p.f(o, w), p.pdf(o, w)), &what);
-                let scalar = p.sample(o, uc.0[i], Vec2::new(u0.0[i], u1.0[i]));
-                if let Some(scalar) = assert_lane_sample(&s, i, scalar, &what) {
+                if let Some(scalar) = assert_lane_sample(&s, i, p.sample(o, uc, u), &what) {
                     assert!(!scalar.delta);
                     valid += 1;
                 }
