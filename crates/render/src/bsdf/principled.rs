@@ -187,22 +187,28 @@ fn smith_ggx1<V: Vector3>(v: V, wh: V) -> V::R {
     V::R::select((v.dot(wh) * v.z()).le(zero), zero, g)
 }
 
-/// The GTR1 distribution of the clear coat, of roughness `alpha`, at the normal `m` (`lanes`:
-/// where it is wanted; its logarithm is taken only there).
+/// ln α² of the clear coat's GTR1 distribution of roughness α, taken once per material
+/// ([`Principled::lobes`]) rather than in each evaluation.
 #[inline(always)]
-fn gtr1_eval<V: Vector3>(alpha: V::R, m: V, lanes: Mask<V>) -> V::R {
+fn gtr1_ln_a2(alpha: f32) -> f32 {
+    (alpha * alpha).ln()
+}
+
+/// The GTR1 distribution of the clear coat, of roughness `alpha` (and `ln_a2`, its
+/// [`gtr1_ln_a2`]), at the normal `m`.
+#[inline(always)]
+fn gtr1_eval<V: Vector3>(alpha: V::R, ln_a2: V::R, m: V) -> V::R {
     let one = V::R::splat(1.0);
     let a2 = alpha * alpha;
-    let ln_a2 = a2.map_where(lanes, f32::ln);
     let r = (a2 - one) / (V::R::splat(PI) * ln_a2 * (one + (a2 - one) * m.z() * m.z()));
     V::R::select((r * m.z()).gt(V::R::splat(1e-20)), r, V::R::splat(0.0))
 }
 
 /// The density of [`gtr1_sample`]'s normals.
 #[inline(always)]
-fn gtr1_pdf<V: Vector3>(alpha: V::R, m: V, lanes: Mask<V>) -> V::R {
+fn gtr1_pdf<V: Vector3>(alpha: V::R, ln_a2: V::R, m: V) -> V::R {
     let zero = V::R::splat(0.0);
-    V::R::select(m.z().lt(zero), zero, m.z() * gtr1_eval(alpha, m, lanes))
+    V::R::select(m.z().lt(zero), zero, m.z() * gtr1_eval(alpha, ln_a2, m))
 }
 
 /// A normal from GTR1 of roughness `alpha` (computed in the lanes `lanes`).
@@ -251,6 +257,8 @@ pub struct PrincipledLobes<V = Rgb, R = f32, M = bool, D = Microfacet> {
     clearcoat: R,
     /// The clear coat's GTR1 roughness (from its glossiness).
     clearcoat_alpha: R,
+    /// Its [`gtr1_ln_a2`], where the material has a clear coat (zero elsewhere).
+    clearcoat_ln_a2: R,
     sheen: R,
     sheen_tint: R,
     spec_tint: R,
@@ -306,13 +314,19 @@ impl Principled {
             flatness: has_flatness,
             diff_trans: has_diff_trans,
         } = flags;
+        let clearcoat_alpha = 0.1 + clearcoat_gloss * (0.001 - 0.1);
         PrincipledLobes {
             base_color,
             roughness,
             spec_trans,
             metallic,
             clearcoat,
-            clearcoat_alpha: 0.1 + clearcoat_gloss * (0.001 - 0.1),
+            clearcoat_alpha,
+            clearcoat_ln_a2: if has_clearcoat {
+                gtr1_ln_a2(clearcoat_alpha)
+            } else {
+                0.0
+            },
             sheen,
             sheen_tint,
             spec_tint,
@@ -365,6 +379,7 @@ impl PrincipledLobes<V8, F8, M8, MicrofacetLanes> {
             metallic,
             clearcoat,
             clearcoat_alpha,
+            clearcoat_ln_a2,
             sheen,
             sheen_tint,
             spec_tint,
@@ -390,6 +405,7 @@ impl PrincipledLobes<V8, F8, M8, MicrofacetLanes> {
             (&mut self.metallic, metallic),
             (&mut self.clearcoat, clearcoat),
             (&mut self.clearcoat_alpha, clearcoat_alpha),
+            (&mut self.clearcoat_ln_a2, clearcoat_ln_a2),
             (&mut self.sheen, sheen),
             (&mut self.sheen_tint, sheen_tint),
             (&mut self.spec_tint, spec_tint),
@@ -549,7 +565,7 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
         let coated = self.has_clearcoat & self.clearcoat.gt(zero) & reflect & refl_ok & front;
         value = add_where(value, coated, || {
             let fcc = calc_schlick(grey::<V>(V::R::splat(0.04)), v.dot(wh), self.eta).x();
-            let dcc = gtr1_eval(self.clearcoat_alpha, wh, coated);
+            let dcc = gtr1_eval(self.clearcoat_alpha, self.clearcoat_ln_a2, wh);
             let gcc = smith_ggx1(v, wh) * smith_ggx1(l, wh);
             grey(self.clearcoat * V::R::splat(0.25) * fcc * dcc * gcc * cos_o.abs())
         });
@@ -892,7 +908,7 @@ impl<V: Vector3, D: Distribution<V::R>> PrincipledLobes<V, V::R, Mask<V>, D> {
         let mut reflected = add_real_where(zero, refl_ok, || p_refl * visible * jacobian);
         let coated = refl_ok & self.has_clearcoat;
         reflected = add_real_where(reflected, coated, || {
-            p_coat * gtr1_pdf(self.clearcoat_alpha, wh, coated) * jacobian
+            p_coat * gtr1_pdf(self.clearcoat_alpha, self.clearcoat_ln_a2, wh) * jacobian
         });
         reflected = reflected + p_diff * cosine_hemisphere_pdf(l.z().abs());
         // Transmission.
