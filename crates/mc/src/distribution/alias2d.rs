@@ -171,6 +171,16 @@ impl PiecewiseConstantAlias2D {
         (point, pdf)
     }
 
+    /// Asks memory for the bins of the large table that [`PiecewiseConstantAlias2D::sample_lanes`]
+    /// will read for the lanes `active` of `u`, for a caller that knows the numbers some
+    /// time before it samples.
+    pub fn prefetch_lanes(&self, u: [F8; 2], active: u32) {
+        for i in (0..W).filter(|i| active & (1 << i) != 0) {
+            let at = self.locate(Vec2::new(u[0].0[i], u[1].0[i]));
+            crate::simd::prefetch(&self.cells[at.cell]);
+        }
+    }
+
     /// The first half of a sample from `u`: the row, from the rows' table, and the bin of the
     /// row's table that `u.x` falls in.
     #[inline(always)]
@@ -319,8 +329,16 @@ mod tests {
         let func: Vec<f32> = (0..40 * 20).map(|i| ((i * 37) % 11) as f32).collect();
         let d = PiecewiseConstantAlias2D::new(&func, 40, 20).unwrap();
         let mut rng = Pcg32::new(5, 1);
-        for active in [0xff, 0x5a, 0x01, 0] {
-            let u = [(); 2].map(|_| F8(std::array::from_fn(|_| rng.uniform_f32())));
+        let below_one = 1.0 - f32::EPSILON / 2.0;
+        let edges = F8([0.0, below_one, 0.5, below_one, 0.0, 0.25, 0.75, 1e-9]);
+        for (round, active) in [0xff, 0x5a, 0x01, 0, 0xff].into_iter().enumerate() {
+            let mut u = [(); 2].map(|_| F8(std::array::from_fn(|_| rng.uniform_f32())));
+            if round == 4 {
+                u = [edges, F8(std::array::from_fn(|i| edges.0[7 - i]))];
+            }
+            // Asking for the bins changes nothing the lanes then compute (and indexes the
+            // table as they do, edges included).
+            d.prefetch_lanes(u, active);
             let (p, pdf) = d.sample_lanes(u, active);
             for i in 0..W {
                 let (one, one_pdf) = if active & (1 << i) != 0 {

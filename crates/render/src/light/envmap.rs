@@ -320,6 +320,12 @@ impl EnvironmentMap {
         }
     }
 
+    /// Asks memory for what [`EnvironmentMap::sample_direction_lanes`] of the same numbers
+    /// will read first (the distribution's table, a cache miss more often than not).
+    pub fn prefetch_directions(&self, u: [F8; 2], active: u32) {
+        self.distribution.prefetch_lanes(u, active);
+    }
+
     /// Bilinear radiance at the map's (u, v), as [`EnvironmentMap::sample_direction`] gives
     /// them.
     #[inline]
