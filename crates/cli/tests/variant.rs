@@ -7,8 +7,18 @@ mod common;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::{Mutex, MutexGuard};
 
 use pathlab_mc::simd::{runs_x86_64_v3, runs_x86_64_v4};
+
+/// Held by each test for its whole run. The tests write scripts and run programs: one
+/// test's child, between its fork and its exec, holds open whatever file another test is
+/// writing, and a script held open for writing cannot be run ("text file busy"), so
+/// `pathlab` would fall back to the baseline build and a test fail at random.
+fn one_at_a_time() -> MutexGuard<'static, ()> {
+    static LOCK: Mutex<()> = Mutex::new(());
+    LOCK.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
 
 /// A folder holding `pathlab` (a link to the built binary) and nothing else.
 fn folder(name: &str) -> PathBuf {
@@ -44,12 +54,14 @@ fn version(dir: &Path, env: &[(&str, &str)]) -> String {
 
 #[test]
 fn the_baseline_build_says_so() {
+    let _one = one_at_a_time();
     let dir = folder("variant-none");
     assert!(version(&dir, &[]).ends_with("(baseline)"));
 }
 
 #[test]
 fn a_variant_beside_pathlab_runs_in_its_place_with_the_same_arguments() {
+    let _one = one_at_a_time();
     let dir = folder("variant-v3");
     fake_variant(&dir, "x86-64-v3");
     let v = version(&dir, &[]);
@@ -64,6 +76,7 @@ fn a_variant_beside_pathlab_runs_in_its_place_with_the_same_arguments() {
 
 #[test]
 fn a_variant_older_than_pathlab_is_taken_for_a_stale_build_and_not_run() {
+    let _one = one_at_a_time();
     let dir = folder("variant-stale");
     let fake = fake_variant(&dir, "x86-64-v3");
     let built = std::fs::metadata(dir.join("pathlab"))
@@ -80,6 +93,7 @@ fn a_variant_older_than_pathlab_is_taken_for_a_stale_build_and_not_run() {
 
 #[test]
 fn the_avx512_variant_stands_aside_when_avx512_is_turned_off() {
+    let _one = one_at_a_time();
     let dir = folder("variant-v4");
     fake_variant(&dir, "x86-64-v4");
     fake_variant(&dir, "x86-64-v3");
