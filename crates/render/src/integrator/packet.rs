@@ -837,10 +837,7 @@ fn look_up_escapes(
     lanes: &[Option<Lane>; W],
     hits: &[Option<SurfaceInteraction>; W],
 ) -> Option<Escapes> {
-    let index = scene.environment()?;
-    let Light::EnvironmentMap { map, .. } = &scene.lights()[index as usize] else {
-        return None;
-    };
+    let map = environment_map(scene)?;
     let mut w = V8::default();
     let mut active = 0u32;
     for (i, (lane, hit)) in lanes.iter().zip(hits).enumerate() {
