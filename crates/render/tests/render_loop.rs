@@ -263,9 +263,9 @@ fn with_textures(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
-/// `desc` with smooth lobes: a mirror, a smooth conductor, glass (exact Fresnel reflectance,
-/// shaded in the lanes; and Schlick's, left to the scalar code), a thin sheet of glass (in
-/// the lanes), each on a sphere, the glass ones large enough to be entered and left.
+/// `desc` with smooth lobes: a mirror, a smooth conductor, glass (of exact Fresnel
+/// reflectance and of Schlick's), a thin sheet of glass, each shaded in the lanes, each on a
+/// sphere, the glass ones large enough to be entered and left.
 fn with_smooth_lobes(mut desc: SceneDesc) -> SceneDesc {
     let glass = |fresnel| MaterialDesc::Glass {
         reflectance: Vec3::ONE,

@@ -1,13 +1,15 @@
 //! A smooth dielectric interface (glass).
 
 use super::bxdf::DirectionSample;
-use super::fresnel::{fresnel_dielectric, fresnel_dielectric_real, fresnel_schlick};
+use super::fresnel::{
+    fresnel_dielectric, fresnel_dielectric_real, fresnel_schlick, fresnel_schlick_real,
+};
 use super::mirror::specular_reflection_real;
 use super::scattering::{refract_real, relative_eta};
 use super::{Lobes, LocalSample};
 use crate::desc::Rgb;
 use glam::Vec3;
-use pathlab_mc::simd::lanes::{Real, Vector3, F8, V8};
+use pathlab_mc::simd::lanes::{Real, Vector3, F8, M8, V8};
 
 /// Which Fresnel reflectance a dielectric uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -93,7 +95,7 @@ fn sample_interface<V: Vector3>(
     }
 }
 
-/// Eight lanes' smooth dielectrics of exact Fresnel reflectance (the path tracer's lanes).
+/// Eight lanes' smooth dielectrics (the path tracer's lanes).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct DielectricLanes {
     /// Relative index η.
@@ -102,12 +104,13 @@ pub struct DielectricLanes {
     pub reflectance: V8,
     /// Scale of the transmitted part.
     pub transmittance: V8,
+    /// Lanes whose Fresnel reflectance is Schlick's approximation (the others': exact).
+    pub schlick: M8,
 }
 
 impl DielectricLanes {
-    /// Sets lane `i` to `d`, whose Fresnel reflectance must be exact. Every field is taken
-    /// apart here: a field added to [`SmoothDielectric`] fails to compile until its lanes are
-    /// set too.
+    /// Sets lane `i` to `d`. Every field is taken apart here: a field added to
+    /// [`SmoothDielectric`] fails to compile until its lanes are set too.
     #[inline(always)]
     pub fn set_lane(&mut self, i: usize, d: SmoothDielectric) {
         let SmoothDielectric {
@@ -116,17 +119,26 @@ impl DielectricLanes {
             transmittance,
             fresnel,
         } = d;
-        debug_assert_eq!(fresnel, FresnelModel::Exact);
         self.eta.0[i] = eta;
         self.reflectance.set(i, reflectance);
         self.transmittance.set(i, transmittance);
+        self.schlick.set(
+            i,
+            match fresnel {
+                FresnelModel::Exact => false,
+                FresnelModel::Schlick => true,
+            },
+        );
     }
 
-    /// [`SmoothDielectric::sample`] in every lane (both lobes, exact Fresnel reflectance),
-    /// and the relative index η' of each sample.
+    /// [`SmoothDielectric::sample`] in every lane (both lobes), and the relative index η' of
+    /// each sample. Schlick's reflectance is computed only where some lane takes it.
     #[inline(always)]
     pub fn sample(&self, wo: V8, uc: F8) -> (DirectionSample<V8>, F8) {
-        let f = fresnel_dielectric_real(wo.z, self.eta);
+        let mut f = fresnel_dielectric_real(wo.z, self.eta);
+        if self.schlick.any() {
+            f = self.schlick.select(fresnel_schlick_real(wo.z, self.eta), f);
+        }
         let lobe = (self.reflectance, self.transmittance, self.eta);
         // `Lobes::All`'s probabilities: (F, 1 - F).
         let s = sample_interface(lobe, wo, uc, f, (f, F8::splat(1.0) - f));
@@ -143,7 +155,8 @@ mod tests {
 
     /// Eight lanes of glass sample, lane by lane, what the one-direction [`SmoothDielectric`]
     /// samples, to the bit, with the relative index [`Bxdf::relative_ior`] gives: from both
-    /// sides, at grazing angles, beyond the critical angle and on the surface.
+    /// sides, at grazing angles, beyond the critical angle and on the surface; of exact
+    /// Fresnel reflectance and of Schlick's, in lanes of either alone and side by side.
     #[test]
     fn lanes_sample_what_one_direction_samples() {
         let mut rng = Pcg32::new(5, 3);
@@ -157,7 +170,11 @@ mod tests {
                     eta: [1.5, 1.0 / 1.33, 2.4, 1.0001][(round + i) % 4],
                     reflectance: Vec3::new(1.0, rng.uniform_f32(), 0.5),
                     transmittance: Vec3::new(rng.uniform_f32(), 1.0, 0.9),
-                    fresnel: FresnelModel::Exact,
+                    // Both models side by side, and lanes of one model alone.
+                    fresnel: match (round / 4 % 3, i % 2) {
+                        (0, 1) | (1, _) => FresnelModel::Schlick,
+                        _ => FresnelModel::Exact,
+                    },
                 };
                 lanes.set_lane(i, d);
                 let z = match round % 7 {

@@ -35,23 +35,31 @@ pub fn fresnel_dielectric_real<R: Real>(cos_theta_i: R, eta: R) -> R {
 /// R0 = ((η - 1)/(η + 1))², on the side with the smaller index (inside a denser medium it
 /// uses the transmitted angle and is 1 past the critical angle).
 pub fn fresnel_schlick(cos_theta_i: f32, eta: f32) -> f32 {
-    let r0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
-    // Schlick's formula holds for the angle in the less dense medium.
-    let (cos_i, eta_rel) = if cos_theta_i < 0.0 {
-        (-cos_theta_i, 1.0 / eta)
-    } else {
-        (cos_theta_i, eta)
-    };
-    let cos = if eta_rel < 1.0 {
-        let sin2_t = (1.0 - cos_i * cos_i) / (eta_rel * eta_rel);
-        if sin2_t >= 1.0 {
-            return 1.0;
-        }
-        (1.0 - sin2_t).sqrt()
-    } else {
-        cos_i.min(1.0)
-    };
-    r0 + (1.0 - r0) * (1.0 - cos).powi(5)
+    fresnel_schlick_real(cos_theta_i, eta)
+}
+
+/// [`fresnel_schlick`] written once for one value and for lanes. The fifth power is
+/// x · (x² · x²), the products `powi(5)` is expanded into.
+#[inline(always)]
+pub fn fresnel_schlick_real<R: Real>(cos_theta_i: R, eta: R) -> R {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let r = (eta - one) / (eta + one);
+    let r0 = r * r;
+    // From inside: the angle's cosine on the inside and the index seen from there.
+    let inside = cos_theta_i.lt(zero);
+    let cos_i = R::select(inside, -cos_theta_i, cos_theta_i);
+    let eta_rel = R::select(inside, one / eta, eta);
+    // Schlick's formula holds for the angle in the less dense medium: where light arrives
+    // from the denser side, the transmitted angle's cosine (its square root is not taken
+    // past the critical angle, where the reflectance is 1).
+    let denser = eta_rel.lt(one);
+    let sin2_t = (one - cos_i * cos_i) / (eta_rel * eta_rel);
+    let total = denser & one.le(sin2_t);
+    let cos = R::select(denser, (one - sin2_t).sqrt(), cos_i.min(one));
+    let m = one - cos;
+    let m2 = m * m;
+    let f = r0 + (one - r0) * ((m2 * m2) * m);
+    R::select(total, one, f)
 }
 
 /// A complex number over a [`Real`] (one value or lanes), only as much as the conductor

@@ -361,7 +361,7 @@ pub enum LaneBxdf {
     Mirror(Mirror),
     /// A smooth conductor.
     SmoothConductor(SmoothConductor<Rgb>),
-    /// Smooth glass of exact Fresnel reflectance.
+    /// Smooth glass (of exact Fresnel reflectance or Schlick's).
     Dielectric(SmoothDielectric),
     /// Diffuse under a smooth coat.
     Plastic(Plastic),
@@ -387,7 +387,7 @@ impl LaneBxdf {
             },
             Bxdf::RoughDielectric(d) => LaneBxdf::RoughDielectric(*d),
             Bxdf::Mirror(m) => LaneBxdf::Mirror(*m),
-            Bxdf::Dielectric(d) if d.fresnel == FresnelModel::Exact => LaneBxdf::Dielectric(*d),
+            Bxdf::Dielectric(d) => LaneBxdf::Dielectric(*d),
             Bxdf::Plastic(p) => LaneBxdf::Plastic(*p),
             Bxdf::RoughPlastic(p) => LaneBxdf::RoughPlastic(*p),
             Bxdf::ThinDielectric(d) => LaneBxdf::ThinDielectric(*d),
@@ -451,9 +451,9 @@ impl Material {
     /// The lobe of a material of one lobe that the path tracer's lanes shade together, its
     /// textures read at `tex`: Lambertian, a rough conductor or rough glass of GGX or Beckmann
     /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, smooth glass
-    /// of exact Fresnel reflectance, a thin sheet of glass, smooth or rough plastic, diffuse
-    /// reflection and transmission, the principled model; one of those under a normal or
-    /// bump map; or a blend of two Lambertian materials, which is one Lambertian lobe.
+    /// (of exact Fresnel reflectance or Schlick's), a thin sheet of glass, smooth or rough
+    /// plastic, diffuse reflection and transmission, the principled model; one of those under
+    /// a normal or bump map; or a blend of two Lambertian materials, which is one Lambertian lobe.
     /// Textured models are evaluated (as [`Material::bsdf`] evaluates them) only where they
     /// may give one of those: diffuse (and diffuse transmission), conductors, glass, rough
     /// plastic and the principled model.
