@@ -603,6 +603,75 @@ fn with_principled(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with two-sided pairs of different materials, each side shaded in the lanes: on the
+/// wall (Lambertian in front, an anisotropic rough conductor behind, its frame along the
+/// tangent around the reversed normal) and on spheres that let light in, whose insides are
+/// their back sides: diffuse transmission outside and a one-sided Lambertian material inside
+/// (whose normal `collect` reverses), rough glass outside and the anisotropic conductor
+/// inside, smooth glass outside and glass of Schlick's reflectance inside, a thin sheet outside
+/// and a two-sided Lambertian material inside.
+fn with_two_sided_pairs(mut desc: SceneDesc) -> SceneDesc {
+    let pair = |front, back| MaterialDesc::TwoSided {
+        front: Box::new(front),
+        back: Box::new(back),
+    };
+    let diffuse = |r: Vec3, two_sided| MaterialDesc::Diffuse {
+        reflectance: r,
+        two_sided,
+    };
+    let anisotropic = || MaterialDesc::RoughConductor {
+        alpha_u: TextureDesc::Constant(Vec3::splat(0.1)),
+        alpha_v: TextureDesc::Constant(Vec3::splat(0.4)),
+        eta: Vec3::new(0.2, 0.9, 1.1),
+        k: Vec3::new(3.9, 2.4, 2.2),
+        specular: TextureDesc::Constant(Vec3::ONE),
+        distribution: NormalDistribution::Ggx,
+    };
+    let glass = |roughness, fresnel| MaterialDesc::Glass {
+        reflectance: Vec3::ONE,
+        transmittance: Vec3::new(0.95, 1.0, 0.9),
+        roughness,
+        ior: 1.5,
+        distribution: NormalDistribution::Ggx,
+        fresnel,
+    };
+    desc.materials[1] = pair(diffuse(Vec3::new(0.6, 0.6, 0.3), false), anisotropic());
+    let first = desc.materials.len();
+    desc.materials.extend([
+        pair(
+            MaterialDesc::DiffuseTransmission {
+                reflectance: TextureDesc::Constant(Vec3::new(0.3, 0.5, 0.4)),
+                transmittance: TextureDesc::Constant(Vec3::new(0.5, 0.4, 0.3)),
+            },
+            diffuse(Vec3::new(0.9, 0.3, 0.2), false),
+        ),
+        pair(glass(0.2, FresnelModel::Exact), anisotropic()),
+        pair(
+            glass(0.0, FresnelModel::Exact),
+            glass(0.0, FresnelModel::Schlick),
+        ),
+        pair(
+            MaterialDesc::ThinGlass {
+                reflectance: Vec3::ONE,
+                transmittance: Vec3::new(0.8, 1.0, 0.9),
+                ior: 1.5,
+            },
+            diffuse(Vec3::new(0.2, 0.4, 0.9), true),
+        ),
+    ]);
+    push_spheres(
+        &mut desc,
+        first,
+        &[
+            (-0.5, 0.4, 0.2),
+            (0.45, -0.3, 0.2),
+            (0.1, 0.5, 0.22),
+            (-0.2, -0.3, 0.2),
+        ],
+    );
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -614,7 +683,7 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // textured or not, in the scenes `with_metals`, `with_smooth_lobes` and `with_textures`;
     // blends of two diffuse materials in `with_blends`; those lobes under normal and bump
     // maps in `with_maps`; smooth and rough plastics in `with_plastics`; the principled model
-    // in `with_principled`): every sample's radiance must be the scalar `li`'s to the bit, and
+    // in `with_principled`; two-sided pairs in `with_two_sided_pairs`): every sample's radiance must be the scalar `li`'s to the bit, and
     // the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these
@@ -651,6 +720,11 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         (crowded(under_a_sky(with_principled(mixed_scene()))), true),
         (with_more_lights(with_principled(mixed_scene())), false),
         (with_more_lights(with_maps(mixed_scene())), false),
+        (with_two_sided_pairs(mixed_scene()), false),
+        (
+            crowded(under_a_sky(with_two_sided_pairs(mixed_scene()))),
+            true,
+        ),
         (without_emitting_surfaces(mixed_scene(), false), false),
         (without_emitting_surfaces(mixed_scene(), true), false),
         (

@@ -427,6 +427,31 @@ impl Leaf {
     }
 }
 
+/// [`Material::lane_bxdf`] of a two-sided pair of materials (front, back), `cos_o` the cosine
+/// of wo to the shading normal: the front leaf's lobe where wo is on the front side, as
+/// [`Material::collect`] takes it; the back leaf's where wo is behind, given as two-sided so
+/// that its frame is the one around the reversed normal `collect` gives it (the lanes turn a
+/// two-sided lobe's normal towards wo); none where wo lies in the surface, or where the side
+/// is not a leaf the lanes shade.
+#[inline(always)]
+fn lane_side<'a>(
+    (front, back): &(Material, Material),
+    tex: impl FnOnce() -> TexPoint<'a>,
+    cos_o: f32,
+) -> Option<LaneLobe> {
+    match (front, back) {
+        (Material::Leaf(leaf), _) if cos_o > 0.0 => leaf.lane_lobe(tex, false),
+        (_, Material::Leaf(leaf)) if cos_o < 0.0 => {
+            let lobe = leaf.lane_lobe(tex, false)?;
+            Some(LaneLobe {
+                two_sided: true,
+                ..lobe
+            })
+        }
+        _ => None,
+    }
+}
+
 impl Material {
     /// A material of one model without textures.
     pub fn new(bxdf: Bxdf, two_sided: bool) -> Self {
@@ -456,11 +481,19 @@ impl Material {
     /// a normal or bump map; or a blend of two Lambertian materials, which is one Lambertian lobe.
     /// Textured models are evaluated (as [`Material::bsdf`] evaluates them) only where they
     /// may give one of those: diffuse (and diffuse transmission), conductors, glass, rough
-    /// plastic and the principled model.
+    /// plastic and the principled model. Of a two-sided pair of materials, the one on the
+    /// side of `wo` (against the shading normal `n`), where that is one of those models
+    /// (none where `wo` lies in the surface).
     #[inline]
-    pub fn lane_bxdf<'a>(&self, tex: impl FnOnce() -> TexPoint<'a>) -> Option<LaneLobe> {
+    pub fn lane_bxdf<'a>(
+        &self,
+        tex: impl FnOnce() -> TexPoint<'a>,
+        wo: Vec3,
+        n: Vec3,
+    ) -> Option<LaneLobe> {
         match self {
             Material::Leaf(leaf) => leaf.lane_lobe(tex, false),
+            Material::TwoSided(ab) => lane_side(ab, tex, wo.dot(n)),
             Material::Blend(..) => self.lane_blend(tex),
             Material::NormalMap(_, inner) | Material::BumpMap(_, _, inner) => match &**inner {
                 Material::Leaf(leaf) => leaf.lane_lobe(tex, true),
@@ -478,6 +511,11 @@ impl Material {
         let at = Local::at(p);
         let (at, two_sided) = match self {
             Material::Leaf(leaf) => (at, leaf.two_sided),
+            // The side `collect` takes: the back one's leaf around the reversed normal.
+            Material::TwoSided(ab) => match wo.dot(at.n) > 0.0 {
+                true => (at, ab.0.leaf_two_sided()),
+                false => (Local { n: -at.n, ..at }, ab.1.leaf_two_sided()),
+            },
             _ => match self.perturbation(p, &at, wo) {
                 Some((perturbed, Material::Leaf(leaf))) => (perturbed, leaf.two_sided),
                 // Not a lobe `lane_bxdf` gives as mapped.
@@ -485,6 +523,11 @@ impl Material {
             },
         };
         (leaf_frame(at.n, at.dpdu, two_sided, wo, true), at.guard)
+    }
+
+    /// A leaf's sidedness (false for any other material).
+    fn leaf_two_sided(&self) -> bool {
+        matches!(self, Material::Leaf(leaf) if leaf.two_sided)
     }
 
     /// [`Material::lane_bxdf`] of a blend of two Lambertian materials of one sidedness: the
@@ -915,5 +958,26 @@ mod tests {
         assert_eq!(lobes[0].weight, 0.0);
         assert!(matches!(lobes[0].bxdf, Bxdf::Diffuse(d) if d.reflectance == Rgb::ZERO));
         assert_eq!(bsdf.pass_through(), 1.0);
+    }
+
+    #[test]
+    fn a_two_sided_pairs_lane_lobe_is_the_side_of_wo() {
+        // In front, the front leaf as it is; behind, the back leaf, two-sided (its normal
+        // reversed, as `collect` reverses it); in the surface, none (left to `bsdf`).
+        let pair = Material::TwoSided(Box::new((diffuse(0.2), mirror(0.7))));
+        let tex = || TexPoint::uv(Vec2::ZERO);
+        let n = Vec3::Z;
+        let front = pair.lane_bxdf(tex, Vec3::new(0.3, 0.0, 0.9), n).unwrap();
+        assert!(matches!(front.bxdf, LaneBxdf::Diffuse(d) if d.reflectance == Rgb::splat(0.2)));
+        assert!(!front.two_sided && !front.mapped);
+        let back = pair.lane_bxdf(tex, Vec3::new(0.3, 0.0, -0.9), n).unwrap();
+        assert!(matches!(back.bxdf, LaneBxdf::Mirror(m) if m.reflectance == Rgb::splat(0.7)));
+        assert!(back.two_sided && !back.mapped);
+        assert!(pair.lane_bxdf(tex, Vec3::X, n).is_none());
+        // A side the lanes do not shade (a mask) leaves the pair to `bsdf` on that side.
+        let masked = Material::Mask(Tex::Constant(Rgb::splat(0.5)), Box::new(diffuse(0.5)));
+        let pair = Material::TwoSided(Box::new((diffuse(0.2), masked)));
+        assert!(pair.lane_bxdf(tex, Vec3::Z, n).is_some());
+        assert!(pair.lane_bxdf(tex, -Vec3::Z, n).is_none());
     }
 }

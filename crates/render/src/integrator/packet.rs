@@ -13,8 +13,8 @@
 //! is one Lambertian lobe; a mirror; smooth conductors and glass; rough GGX or Beckmann
 //! conductors and glass, of one roughness or anisotropic; thin sheets of glass; smooth and
 //! rough plastic; diffuse reflection and transmission; the principled model, solid or thin;
-//! any of those under a normal or bump
-//! map). There the lanes are shaded together in SIMD registers by the same functions the
+//! any of those under a normal or bump map; of a two-sided pair of those, the one on wo's
+//! side). There the lanes are shaded together in SIMD registers by the same functions the
 //! one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
 //! [`RoughConductor`], [`RoughDielectric`] (their distributions: [`MicrofacetLanes`], whose
 //! anisotropic Beckmann lanes go one lane at a time), [`Mirror`], [`SmoothConductor`],
@@ -925,7 +925,7 @@ fn gather_lobe(
     a: &mut ScatterIn,
     stats: &mut PathStats,
 ) -> Option<bool> {
-    let lane = material.lane_bxdf(|| scene.tex_point(si))?;
+    let lane = material.lane_bxdf(|| scene.tex_point(si), wo, si.ns)?;
     let (lobe, two_sided) = (lane.bxdf, lane.two_sided);
     if lane.mapped {
         gather_frame(scene, si, wo, material, i, a);
