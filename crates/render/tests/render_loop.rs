@@ -672,6 +672,83 @@ fn with_two_sided_pairs(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with masks whose opacity is a checkerboard of one and less: their opaque points
+/// shaded in the lanes, the others (passing light through) one lane at a time. On the floor
+/// over a Lambertian material (half see-through), and on spheres: over a two-sided pair,
+/// over an anisotropic conductor under a normal map (the frame the mask's inner material
+/// gives), over glass of Schlick's reflectance (opaque everywhere), and a mask over a mask.
+fn with_masks(mut desc: SceneDesc) -> SceneDesc {
+    let mask = |opaque_elsewhere: f32, inner| MaterialDesc::Mask {
+        opacity: TextureDesc::Checkerboard {
+            color0: Vec3::ONE,
+            color1: Vec3::splat(opaque_elsewhere),
+            to_uv: glam::Affine2::from_scale(glam::Vec2::splat(6.0)),
+        },
+        inner: Box::new(inner),
+    };
+    let diffuse = |r: Vec3, two_sided| MaterialDesc::Diffuse {
+        reflectance: r,
+        two_sided,
+    };
+    let anisotropic = MaterialDesc::RoughConductor {
+        alpha_u: TextureDesc::Constant(Vec3::splat(0.3)),
+        alpha_v: TextureDesc::Constant(Vec3::splat(0.05)),
+        eta: Vec3::new(0.2, 0.9, 1.1),
+        k: Vec3::new(3.9, 2.4, 2.2),
+        specular: TextureDesc::Constant(Vec3::ONE),
+        distribution: NormalDistribution::Ggx,
+    };
+    desc.materials[0] = mask(0.5, diffuse(Vec3::new(0.6, 0.5, 0.4), false));
+    let first = desc.materials.len();
+    desc.materials.extend([
+        mask(
+            0.0,
+            MaterialDesc::TwoSided {
+                front: Box::new(diffuse(Vec3::new(0.8, 0.3, 0.2), false)),
+                back: Box::new(diffuse(Vec3::new(0.2, 0.3, 0.8), false)),
+            },
+        ),
+        mask(
+            0.3,
+            MaterialDesc::NormalMap {
+                normals: TextureDesc::Bilerp {
+                    corners: [
+                        Vec3::new(0.7, 0.5, 0.9),
+                        Vec3::new(0.3, 0.6, 0.8),
+                        Vec3::new(0.5, 0.2, 0.7),
+                        Vec3::new(0.5, 0.5, 1.0),
+                    ],
+                    to_uv: glam::Affine2::from_scale(glam::Vec2::splat(3.0)),
+                },
+                inner: Box::new(anisotropic),
+            },
+        ),
+        mask(
+            1.0,
+            MaterialDesc::Glass {
+                reflectance: Vec3::ONE,
+                transmittance: Vec3::new(0.95, 1.0, 0.9),
+                roughness: 0.0,
+                ior: 1.5,
+                distribution: NormalDistribution::Ggx,
+                fresnel: FresnelModel::Schlick,
+            },
+        ),
+        mask(0.6, mask(1.0, diffuse(Vec3::new(0.3, 0.8, 0.3), true))),
+    ]);
+    push_spheres(
+        &mut desc,
+        first,
+        &[
+            (-0.5, 0.4, 0.2),
+            (0.45, -0.3, 0.2),
+            (0.1, 0.5, 0.22),
+            (-0.2, -0.3, 0.2),
+        ],
+    );
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -683,8 +760,9 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // textured or not, in the scenes `with_metals`, `with_smooth_lobes` and `with_textures`;
     // blends of two diffuse materials in `with_blends`; those lobes under normal and bump
     // maps in `with_maps`; smooth and rough plastics in `with_plastics`; the principled model
-    // in `with_principled`; two-sided pairs in `with_two_sided_pairs`): every sample's radiance must be the scalar `li`'s to the bit, and
-    // the rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
+    // in `with_principled`; two-sided pairs in `with_two_sided_pairs`; masks' opaque points
+    // in `with_masks`): every sample's radiance must be the scalar `li`'s to the bit, and the
+    // rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
     // rays are tested against every primitive at once instead of walking the BVH (the same
     // distances; of primitives at exactly the same distance, possibly another, which these
     // rays do not meet), and no nodes are counted; with a hundred triangles more, the lanes
@@ -724,6 +802,11 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         (
             crowded(under_a_sky(with_two_sided_pairs(mixed_scene()))),
             true,
+        ),
+        (with_masks(mixed_scene()), false),
+        (
+            with_more_lights(under_a_sky(with_masks(mixed_scene()))),
+            false,
         ),
         (without_emitting_surfaces(mixed_scene(), false), false),
         (without_emitting_surfaces(mixed_scene(), true), false),

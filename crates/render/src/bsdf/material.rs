@@ -452,6 +452,27 @@ fn lane_side<'a>(
     }
 }
 
+/// [`Material::lane_bxdf`] of a mask of `opacity` over `inner` at `tex`: the inner material's
+/// lobe where the mask is opaque (an opacity of one or more, where [`Material::collect`] gives
+/// the inner material's lobes their whole weight and nothing passes through, the BSDF
+/// [`Material::bsdf`] makes of the inner material alone); none where light may pass through.
+/// Out of line, and not generic: a mask holds a material, which may be a mask.
+#[inline(never)]
+fn lane_opaque(
+    opacity: &Tex,
+    inner: &Material,
+    tex: TexPoint,
+    wo: Vec3,
+    n: Vec3,
+) -> Option<LaneLobe> {
+    // A NaN opacity keeps no lobe and gives a NaN pass-through weight: not this case.
+    let a = opacity.eval_float(&tex).clamp(0.0, 1.0);
+    if a.is_nan() || a < 1.0 {
+        return None;
+    }
+    inner.lane_bxdf(|| tex, wo, n)
+}
+
 impl Material {
     /// A material of one model without textures.
     pub fn new(bxdf: Bxdf, two_sided: bool) -> Self {
@@ -483,7 +504,7 @@ impl Material {
     /// may give one of those: diffuse (and diffuse transmission), conductors, glass, rough
     /// plastic and the principled model. Of a two-sided pair of materials, the one on the
     /// side of `wo` (against the shading normal `n`), where that is one of those models
-    /// (none where `wo` lies in the surface).
+    /// (none where `wo` lies in the surface); of a mask, its material's where it is opaque.
     #[inline]
     pub fn lane_bxdf<'a>(
         &self,
@@ -494,12 +515,12 @@ impl Material {
         match self {
             Material::Leaf(leaf) => leaf.lane_lobe(tex, false),
             Material::TwoSided(ab) => lane_side(ab, tex, wo.dot(n)),
+            Material::Mask(opacity, inner) => lane_opaque(opacity, inner, tex(), wo, n),
             Material::Blend(..) => self.lane_blend(tex),
             Material::NormalMap(_, inner) | Material::BumpMap(_, _, inner) => match &**inner {
                 Material::Leaf(leaf) => leaf.lane_lobe(tex, true),
                 _ => None,
             },
-            _ => None,
         }
     }
 
@@ -511,6 +532,8 @@ impl Material {
         let at = Local::at(p);
         let (at, two_sided) = match self {
             Material::Leaf(leaf) => (at, leaf.two_sided),
+            // An opaque point of a mask: its material's frame.
+            Material::Mask(_, inner) => return inner.lane_frame(p, wo),
             // The side `collect` takes: the back one's leaf around the reversed normal.
             Material::TwoSided(ab) => match wo.dot(at.n) > 0.0 {
                 true => (at, ab.0.leaf_two_sided()),
@@ -979,5 +1002,20 @@ mod tests {
         let pair = Material::TwoSided(Box::new((diffuse(0.2), masked)));
         assert!(pair.lane_bxdf(tex, Vec3::Z, n).is_some());
         assert!(pair.lane_bxdf(tex, -Vec3::Z, n).is_none());
+    }
+
+    #[test]
+    fn a_masks_lane_lobe_is_its_materials_where_it_is_opaque_only() {
+        let tex = || TexPoint::uv(Vec2::ZERO);
+        let (wo, n) = (Vec3::Z, Vec3::Z);
+        let mask = |a: f32| Material::Mask(Tex::Constant(Rgb::splat(a)), Box::new(mirror(0.7)));
+        for a in [1.0, 2.0] {
+            let lobe = mask(a).lane_bxdf(tex, wo, n).unwrap();
+            assert!(matches!(lobe.bxdf, LaneBxdf::Mirror(m) if m.reflectance == Rgb::splat(0.7)));
+        }
+        // Passing some light through, or a NaN opacity: left to `bsdf`.
+        for a in [0.0, 0.5, 1.0 - f32::EPSILON, f32::NAN] {
+            assert!(mask(a).lane_bxdf(tex, wo, n).is_none(), "{a}");
+        }
     }
 }
