@@ -14,7 +14,7 @@ use pathlab_render::desc::{
 use pathlab_render::film::Film;
 use pathlab_render::integrator::{BdptIntegrator, IntegratorKind};
 use pathlab_render::render::{render, RenderSettings};
-use pathlab_render::scene::Scene;
+use pathlab_render::scene::{diffuse, Scene};
 
 #[test]
 fn same_seed_same_image_for_any_thread_count() {
@@ -175,6 +175,27 @@ fn push_spheres(desc: &mut SceneDesc, first: usize, spheres: &[(f32, f32, f32)])
     }
 }
 
+/// An anisotropic rough GGX conductor of roughness `alpha_u` along the tangent and `alpha_v`
+/// across it (its frame follows the tangent).
+fn anisotropic_conductor(alpha_u: f32, alpha_v: f32) -> MaterialDesc {
+    MaterialDesc::RoughConductor {
+        alpha_u: TextureDesc::Constant(Vec3::splat(alpha_u)),
+        alpha_v: TextureDesc::Constant(Vec3::splat(alpha_v)),
+        eta: Vec3::new(0.2, 0.9, 1.1),
+        k: Vec3::new(3.9, 2.4, 2.2),
+        specular: TextureDesc::Constant(Vec3::ONE),
+        distribution: NormalDistribution::Ggx,
+    }
+}
+
+/// Four spheres on the floor, (x, z, r) for [`push_spheres`], large enough to be entered.
+const FOUR_SPHERES: [(f32, f32, f32); 4] = [
+    (-0.5, 0.4, 0.2),
+    (0.45, -0.3, 0.2),
+    (0.1, 0.5, 0.22),
+    (-0.2, -0.3, 0.2),
+];
+
 /// `desc` with rough conductors: GGX of one roughness on the wall and the mirror sphere, a
 /// Beckmann sphere and an anisotropic GGX one (its frame along the sphere's tangent), all
 /// shaded in the lanes; and rough glass spheres, GGX and Beckmann.
@@ -188,14 +209,7 @@ fn with_metals(mut desc: SceneDesc) -> SceneDesc {
     desc.materials[1] = gold(0.08, NormalDistribution::Ggx);
     desc.materials[2] = gold(0.3, NormalDistribution::Ggx);
     desc.materials.push(gold(0.2, NormalDistribution::Beckmann));
-    desc.materials.push(MaterialDesc::RoughConductor {
-        alpha_u: TextureDesc::Constant(Vec3::splat(0.1)),
-        alpha_v: TextureDesc::Constant(Vec3::splat(0.4)),
-        eta: Vec3::new(0.2, 0.9, 1.1),
-        k: Vec3::new(3.9, 2.4, 2.2),
-        specular: TextureDesc::Constant(Vec3::ONE),
-        distribution: NormalDistribution::Ggx,
-    });
+    desc.materials.push(anisotropic_conductor(0.1, 0.4));
     let rough_glass = |distribution| MaterialDesc::Glass {
         reflectance: Vec3::ONE,
         transmittance: Vec3::new(0.95, 1.0, 0.9),
@@ -420,14 +434,7 @@ fn with_maps(mut desc: SceneDesc) -> SceneDesc {
         reflectance: r,
         two_sided,
     };
-    let metal = MaterialDesc::RoughConductor {
-        alpha_u: TextureDesc::Constant(Vec3::splat(0.25)),
-        alpha_v: TextureDesc::Constant(Vec3::splat(0.05)),
-        eta: Vec3::new(0.2, 0.9, 1.1),
-        k: Vec3::new(3.9, 2.4, 2.2),
-        specular: TextureDesc::Constant(Vec3::ONE),
-        distribution: NormalDistribution::Ggx,
-    };
+    let metal = anisotropic_conductor(0.25, 0.05);
     desc.materials[0] = normal_map(diffuse(Vec3::new(0.6, 0.5, 0.4), false), 1.0);
     let first = desc.materials.len();
     desc.materials.extend([
@@ -615,18 +622,7 @@ fn with_two_sided_pairs(mut desc: SceneDesc) -> SceneDesc {
         front: Box::new(front),
         back: Box::new(back),
     };
-    let diffuse = |r: Vec3, two_sided| MaterialDesc::Diffuse {
-        reflectance: r,
-        two_sided,
-    };
-    let anisotropic = || MaterialDesc::RoughConductor {
-        alpha_u: TextureDesc::Constant(Vec3::splat(0.1)),
-        alpha_v: TextureDesc::Constant(Vec3::splat(0.4)),
-        eta: Vec3::new(0.2, 0.9, 1.1),
-        k: Vec3::new(3.9, 2.4, 2.2),
-        specular: TextureDesc::Constant(Vec3::ONE),
-        distribution: NormalDistribution::Ggx,
-    };
+    let anisotropic = || anisotropic_conductor(0.1, 0.4);
     let glass = |roughness, fresnel| MaterialDesc::Glass {
         reflectance: Vec3::ONE,
         transmittance: Vec3::new(0.95, 1.0, 0.9),
@@ -659,16 +655,7 @@ fn with_two_sided_pairs(mut desc: SceneDesc) -> SceneDesc {
             diffuse(Vec3::new(0.2, 0.4, 0.9), true),
         ),
     ]);
-    push_spheres(
-        &mut desc,
-        first,
-        &[
-            (-0.5, 0.4, 0.2),
-            (0.45, -0.3, 0.2),
-            (0.1, 0.5, 0.22),
-            (-0.2, -0.3, 0.2),
-        ],
-    );
+    push_spheres(&mut desc, first, &FOUR_SPHERES);
     desc
 }
 
@@ -686,18 +673,7 @@ fn with_masks(mut desc: SceneDesc) -> SceneDesc {
         },
         inner: Box::new(inner),
     };
-    let diffuse = |r: Vec3, two_sided| MaterialDesc::Diffuse {
-        reflectance: r,
-        two_sided,
-    };
-    let anisotropic = MaterialDesc::RoughConductor {
-        alpha_u: TextureDesc::Constant(Vec3::splat(0.3)),
-        alpha_v: TextureDesc::Constant(Vec3::splat(0.05)),
-        eta: Vec3::new(0.2, 0.9, 1.1),
-        k: Vec3::new(3.9, 2.4, 2.2),
-        specular: TextureDesc::Constant(Vec3::ONE),
-        distribution: NormalDistribution::Ggx,
-    };
+    let anisotropic = anisotropic_conductor(0.3, 0.05);
     desc.materials[0] = mask(0.5, diffuse(Vec3::new(0.6, 0.5, 0.4), false));
     let first = desc.materials.len();
     desc.materials.extend([
@@ -736,16 +712,7 @@ fn with_masks(mut desc: SceneDesc) -> SceneDesc {
         ),
         mask(0.6, mask(1.0, diffuse(Vec3::new(0.3, 0.8, 0.3), true))),
     ]);
-    push_spheres(
-        &mut desc,
-        first,
-        &[
-            (-0.5, 0.4, 0.2),
-            (0.45, -0.3, 0.2),
-            (0.1, 0.5, 0.22),
-            (-0.2, -0.3, 0.2),
-        ],
-    );
+    push_spheres(&mut desc, first, &FOUR_SPHERES);
     desc
 }
 
