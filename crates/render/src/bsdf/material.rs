@@ -499,8 +499,8 @@ impl Material {
     /// normals (of one roughness or anisotropic), a mirror, a smooth conductor, smooth glass
     /// (of exact Fresnel reflectance or Schlick's), a thin sheet of glass, smooth or rough
     /// plastic, diffuse reflection and transmission, the principled model; one of those under
-    /// a normal or bump map; or a blend of two Lambertian materials, which is one Lambertian lobe.
-    /// Textured models are evaluated (as [`Material::bsdf`] evaluates them) only where they
+    /// a normal or bump map; or a blend of two Lambertian materials, which is one Lambertian
+    /// lobe. Textured models are evaluated (as [`Material::bsdf`] evaluates them) only where they
     /// may give one of those: diffuse (and diffuse transmission), conductors, glass, rough
     /// plastic and the principled model. Of a two-sided pair of materials, the one on the
     /// side of `wo` (against the shading normal `n`), where that is one of those models

@@ -14,8 +14,9 @@
 //! conductors and glass, of one roughness or anisotropic; thin sheets of glass; smooth and
 //! rough plastic; diffuse reflection and transmission; the principled model, solid or thin;
 //! any of those under a normal or bump map; of a two-sided pair of those, the one on wo's
-//! side; a mask over one of those, where it is opaque). There the lanes are shaded together in SIMD registers by the same functions the
-//! one-path code calls, instantiated on eight lanes (the BSDFs: [`Diffuse`],
+//! side; a mask over one of those, where it is opaque). There the lanes are shaded together
+//! in SIMD registers by the same functions the one-path code calls, instantiated on eight
+//! lanes (the BSDFs: [`Diffuse`],
 //! [`RoughConductor`], [`RoughDielectric`] (their distributions: [`MicrofacetLanes`], whose
 //! anisotropic Beckmann lanes go one lane at a time), [`Mirror`], [`SmoothConductor`],
 //! [`DielectricLanes`], [`ThinDielectric`], [`Plastic`], [`RoughPlastic`] (its coat's table
