@@ -259,6 +259,39 @@ impl Local {
     }
 }
 
+/// The side of a two-sided pair of materials that `wo` is on, `cos_o` its cosine to the
+/// normal of the pair's frame: the front material where it is positive; the back one otherwise (`wo` in
+/// the surface or the cosine NaN included), seen around the reversed normal.
+struct Side<'m> {
+    material: &'m Material,
+    back: bool,
+}
+
+impl<'m> Side<'m> {
+    #[inline(always)]
+    fn of((front, back): &'m (Material, Material), cos_o: f32) -> Side<'m> {
+        match cos_o > 0.0 {
+            true => Side {
+                material: front,
+                back: false,
+            },
+            false => Side {
+                material: back,
+                back: true,
+            },
+        }
+    }
+
+    /// The frame `at` as this side sees it: its normal reversed on the back.
+    #[inline(always)]
+    fn frame(&self, at: &Local) -> Local {
+        match self.back {
+            true => Local { n: -at.n, ..*at },
+            false => *at,
+        }
+    }
+}
+
 /// The frame with normal `n` and first axis `dpdu` made orthogonal to it (Mitsuba's shading
 /// frame); an arbitrary tangent where `dpdu` is zero or along `n`.
 fn tangent_frame(n: Vec3, dpdu: Vec3) -> Frame {
@@ -435,21 +468,24 @@ impl Leaf {
 /// is not a leaf the lanes shade.
 #[inline(always)]
 fn lane_side<'a>(
-    (front, back): &(Material, Material),
+    pair: &(Material, Material),
     tex: impl FnOnce() -> TexPoint<'a>,
     cos_o: f32,
 ) -> Option<LaneLobe> {
-    match (front, back) {
-        (Material::Leaf(leaf), _) if cos_o > 0.0 => leaf.lane_lobe(tex, false),
-        (_, Material::Leaf(leaf)) if cos_o < 0.0 => {
-            let lobe = leaf.lane_lobe(tex, false)?;
-            Some(LaneLobe {
-                two_sided: true,
-                ..lobe
-            })
-        }
-        _ => None,
+    // In the surface (or NaN) `collect` takes the back, around the reversed normal; the lanes,
+    // which turn a two-sided lobe's normal towards `wo`, would not reverse it there.
+    if cos_o == 0.0 || cos_o.is_nan() {
+        return None;
     }
+    let side = Side::of(pair, cos_o);
+    let Material::Leaf(leaf) = side.material else {
+        return None;
+    };
+    let lobe = leaf.lane_lobe(tex, false)?;
+    Some(LaneLobe {
+        two_sided: lobe.two_sided || side.back,
+        ..lobe
+    })
 }
 
 /// [`Material::lane_bxdf`] of a mask of `opacity` over `inner` at `tex`: the inner material's
@@ -534,11 +570,11 @@ impl Material {
             Material::Leaf(leaf) => (at, leaf.two_sided),
             // An opaque point of a mask: its material's frame.
             Material::Mask(_, inner) => return inner.lane_frame(p, wo),
-            // The side `collect` takes: the back one's leaf around the reversed normal.
-            Material::TwoSided(ab) => match wo.dot(at.n) > 0.0 {
-                true => (at, ab.0.leaf_two_sided()),
-                false => (Local { n: -at.n, ..at }, ab.1.leaf_two_sided()),
-            },
+            // The side `collect` takes.
+            Material::TwoSided(ab) => {
+                let side = Side::of(ab, wo.dot(at.n));
+                (side.frame(&at), side.material.leaf_two_sided())
+            }
             _ => match self.perturbation(p, &at, wo) {
                 Some((perturbed, Material::Leaf(leaf))) => (perturbed, leaf.two_sided),
                 // Not a lobe `lane_bxdf` gives as mapped.
@@ -714,12 +750,9 @@ impl Material {
                 ab.1.collect(p, at, wo, weight * w, lobes, null);
             }
             Material::TwoSided(ab) => {
-                if wo.dot(at.n) > 0.0 {
-                    ab.0.collect(p, at, wo, weight, lobes, null);
-                } else {
-                    let flipped = Local { n: -at.n, ..*at };
-                    ab.1.collect(p, &flipped, wo, weight, lobes, null);
-                }
+                let side = Side::of(ab, wo.dot(at.n));
+                side.material
+                    .collect(p, &side.frame(at), wo, weight, lobes, null);
             }
             Material::NormalMap(..) | Material::BumpMap(..) => {
                 if let Some((perturbed, inner)) = self.perturbation(p, at, wo) {
@@ -981,6 +1014,24 @@ mod tests {
         assert_eq!(lobes[0].weight, 0.0);
         assert!(matches!(lobes[0].bxdf, Bxdf::Diffuse(d) if d.reflectance == Rgb::ZERO));
         assert_eq!(bsdf.pass_through(), 1.0);
+    }
+
+    #[test]
+    fn a_two_sided_pair_is_its_front_in_front_and_its_back_around_the_reversed_normal() {
+        // One-sided Lambertian sides of two reflectances: each reflects on its own side only.
+        let pair = Material::TwoSided(Box::new((diffuse(0.2), diffuse(0.6))));
+        let p = ShadingPoint::at(Vec3::Z);
+        let (above, below) = (Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.6, 0.0, -0.8));
+        let f = |wo: Vec3, wi: Vec3| pair.bsdf(&p, wo).f(wo, wi);
+        let lambert = |r: f32| Rgb::splat(r / std::f32::consts::PI);
+        assert!((f(above, above) - lambert(0.2)).abs().max_element() < 1e-6);
+        assert!((f(below, below) - lambert(0.6)).abs().max_element() < 1e-6);
+        assert_eq!(f(above, below), Rgb::ZERO);
+        assert_eq!(f(below, above), Rgb::ZERO);
+        // In the surface: the back, around the reversed normal.
+        let in_plane = pair.bsdf(&p, Vec3::X);
+        assert_eq!(in_plane.frame().n, -Vec3::Z);
+        assert!(matches!(in_plane.bxdf(), Bxdf::Diffuse(d) if d.reflectance == Rgb::splat(0.6)));
     }
 
     #[test]
