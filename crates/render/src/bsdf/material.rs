@@ -260,8 +260,9 @@ impl Local {
 }
 
 /// The side of a two-sided pair of materials that `wo` is on, `cos_o` its cosine to the
-/// normal of the pair's frame: the front material where it is positive; the back one otherwise (`wo` in
-/// the surface or the cosine NaN included), seen around the reversed normal.
+/// normal of the pair's frame: the front material where it is positive; the back one
+/// otherwise (`wo` in the surface or the cosine NaN included), seen around the reversed
+/// normal.
 struct Side<'m> {
     material: &'m Material,
     back: bool,
