@@ -716,6 +716,78 @@ fn with_masks(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `desc` with masks that let some light through, shaded in the lanes as their lobe and
+/// passing through (`LaneLobe::weight`): checkerboards of two opacities below one, or of
+/// none, over smooth plastic on the floor (a delta lobe and a diffuse one), a rough conductor
+/// on the wall, and spheres of smooth glass, rough glass, a two-sided pair (rough plastic in
+/// front, a mirror behind) and diffuse transmission.
+fn with_see_through_masks(mut desc: SceneDesc) -> SceneDesc {
+    let mask = |opacities: [f32; 2], inner| MaterialDesc::Mask {
+        opacity: TextureDesc::Checkerboard {
+            color0: Vec3::splat(opacities[0]),
+            color1: Vec3::splat(opacities[1]),
+            to_uv: glam::Affine2::from_scale(glam::Vec2::splat(5.0)),
+        },
+        inner: Box::new(inner),
+    };
+    let glass = |roughness| MaterialDesc::Glass {
+        reflectance: Vec3::ONE,
+        transmittance: Vec3::new(0.9, 1.0, 0.95),
+        roughness,
+        ior: 1.5,
+        distribution: NormalDistribution::Ggx,
+        fresnel: FresnelModel::Exact,
+    };
+    desc.materials[0] = mask(
+        [0.75, 0.25],
+        MaterialDesc::Plastic {
+            diffuse: Vec3::new(0.6, 0.5, 0.4),
+            specular: Vec3::ONE,
+            ior: 1.5,
+            nonlinear: false,
+        },
+    );
+    desc.materials[1] = mask(
+        [0.5, 0.0],
+        MaterialDesc::Conductor {
+            alpha: 0.2,
+            eta: Vec3::new(0.143, 0.374, 1.442),
+            k: Vec3::new(3.983, 2.385, 1.603),
+            distribution: NormalDistribution::Ggx,
+        },
+    );
+    let first = desc.materials.len();
+    desc.materials.extend([
+        mask([0.4, 0.8], glass(0.0)),
+        mask([0.6, 0.0], glass(0.3)),
+        mask(
+            [0.5, 0.25],
+            MaterialDesc::TwoSided {
+                front: Box::new(MaterialDesc::RoughPlastic {
+                    diffuse: TextureDesc::Constant(Vec3::new(0.7, 0.2, 0.2)),
+                    specular: Vec3::ONE,
+                    alpha: 0.2,
+                    ior: 1.5,
+                    nonlinear: false,
+                    distribution: NormalDistribution::Ggx,
+                }),
+                back: Box::new(MaterialDesc::Mirror {
+                    reflectance: Vec3::new(0.9, 0.8, 0.7),
+                }),
+            },
+        ),
+        mask(
+            [0.7, 0.3],
+            MaterialDesc::DiffuseTransmission {
+                reflectance: TextureDesc::Constant(Vec3::new(0.3, 0.5, 0.4)),
+                transmittance: TextureDesc::Constant(Vec3::new(0.4, 0.3, 0.5)),
+            },
+        ),
+    ]);
+    push_spheres(&mut desc, first, &FOUR_SPHERES);
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -727,13 +799,13 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // textured or not, in the scenes `with_metals`, `with_smooth_lobes` and `with_textures`;
     // blends of two diffuse materials in `with_blends`; those lobes under normal and bump
     // maps in `with_maps`; smooth and rough plastics in `with_plastics`; the principled model
-    // in `with_principled`; two-sided pairs in `with_two_sided_pairs`; masks' opaque points
-    // in `with_masks`): every sample's radiance must be the scalar `li`'s to the bit, and the
-    // rays and nodes counted the same. In a scene of a few triangles and spheres the lanes'
-    // rays are tested against every primitive at once instead of walking the BVH (the same
-    // distances; of primitives at exactly the same distance, possibly another, which these
-    // rays do not meet), and no nodes are counted; with a hundred triangles more, the lanes
-    // walk the BVH.
+    // in `with_principled`; two-sided pairs in `with_two_sided_pairs`; masks in `with_masks`
+    // and `with_see_through_masks`): every sample's radiance must be the scalar `li`'s to the
+    // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres
+    // the lanes' rays are tested against every primitive at once instead of walking the BVH
+    // (the same distances; of primitives at exactly the same distance, possibly another,
+    // which these rays do not meet), and no nodes are counted; with a hundred triangles more,
+    // the lanes walk the BVH.
     for (desc, bvh) in [
         (mixed_scene(), false),
         (crowded(mixed_scene()), true),
@@ -771,6 +843,13 @@ fn packets_compute_what_one_path_at_a_time_computes() {
             true,
         ),
         (with_masks(mixed_scene()), false),
+        (with_see_through_masks(mixed_scene()), false),
+        (
+            crowded(with_more_lights(under_a_sky(with_see_through_masks(
+                mixed_scene(),
+            )))),
+            true,
+        ),
         (
             with_more_lights(under_a_sky(with_masks(mixed_scene()))),
             false,

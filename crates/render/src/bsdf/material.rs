@@ -380,6 +380,11 @@ pub struct LaneLobe {
     /// is the one around the shading normal, turned towards wo on a two-sided material's back
     /// side.
     pub mapped: bool,
+    /// The lobe's weight, in (0, 1]: the rest of the light passes straight through (a mask
+    /// where it lets some through; [`crate::bsdf::Bsdf::sample_f`] chooses between the lobe
+    /// and passing through). Zero where all of it passes through (a black Lambertian lobe
+    /// of weight zero, around the shading normal, holds the frame).
+    pub weight: f32,
 }
 
 /// A lobe's model in the path tracer's lanes ([`LaneLobe`]).
@@ -457,6 +462,7 @@ impl Leaf {
             bxdf: LaneBxdf::of(bxdf)?,
             two_sided: self.two_sided,
             mapped: mapped || anisotropic,
+            weight: 1.0,
         })
     }
 }
@@ -489,25 +495,46 @@ fn lane_side<'a>(
     })
 }
 
-/// [`Material::lane_bxdf`] of a mask of `opacity` over `inner` at `tex`: the inner material's
-/// lobe where the mask is opaque (an opacity of one or more, where [`Material::collect`] gives
-/// the inner material's lobes their whole weight and nothing passes through, the BSDF
-/// [`Material::bsdf`] makes of the inner material alone); none where light may pass through.
-/// Out of line, and not generic: a mask holds a material, which may be a mask.
+/// [`Material::lane_bxdf`] of a mask of `opacity` over `inner` at `tex`, the BSDF
+/// [`Material::collect`] makes of it: where the mask is opaque (an opacity of one or more),
+/// the inner material's lobe alone; where it lets some light through, that lobe (one around
+/// the shading normal or turned towards wo, of weight one) weighted by the opacity, the rest
+/// passing through; where it lets all through, passing through alone. None where the opacity
+/// is NaN, or where the inner lobe is none the lanes shade, or has a frame of its own or a
+/// weight below one. Out of line, and not generic: a mask holds a material, which may be a
+/// mask.
 #[inline(never)]
-fn lane_opaque(
+fn lane_mask(
     opacity: &Tex,
     inner: &Material,
     tex: TexPoint,
     wo: Vec3,
     n: Vec3,
 ) -> Option<LaneLobe> {
-    // A NaN opacity keeps no lobe and gives a NaN pass-through weight: not this case.
+    // `collect`'s weights at the top of the tree: the lobe's one times the opacity.
     let a = opacity.eval_float(&tex).clamp(0.0, 1.0);
-    if a.is_nan() || a < 1.0 {
+    if a.is_nan() {
         return None;
     }
-    inner.lane_bxdf(|| tex, wo, n)
+    if a >= 1.0 {
+        return inner.lane_bxdf(|| tex, wo, n);
+    }
+    if a <= 0.0 {
+        // No lobe: `bsdf`'s black one, of weight zero, holds the frame.
+        return Some(LaneLobe {
+            bxdf: LaneBxdf::Diffuse(Diffuse {
+                reflectance: Rgb::ZERO,
+            }),
+            two_sided: false,
+            mapped: false,
+            weight: 0.0,
+        });
+    }
+    let lobe = inner.lane_bxdf(|| tex, wo, n)?;
+    if lobe.mapped || lobe.weight < 1.0 {
+        return None;
+    }
+    Some(LaneLobe { weight: a, ..lobe })
 }
 
 impl Material {
@@ -541,7 +568,8 @@ impl Material {
     /// may give one of those: diffuse (and diffuse transmission), conductors, glass, rough
     /// plastic and the principled model. Of a two-sided pair of materials, the one on the
     /// side of `wo` (against the shading normal `n`), where that is one of those models
-    /// (none where `wo` lies in the surface); of a mask, its material's where it is opaque.
+    /// (none where `wo` lies in the surface); of a mask, its material's lobe weighted by its
+    /// opacity, the rest of the light passing through ([`LaneLobe::weight`]).
     #[inline]
     pub fn lane_bxdf<'a>(
         &self,
@@ -552,7 +580,7 @@ impl Material {
         match self {
             Material::Leaf(leaf) => leaf.lane_lobe(tex, false),
             Material::TwoSided(ab) => lane_side(ab, tex, wo.dot(n)),
-            Material::Mask(opacity, inner) => lane_opaque(opacity, inner, tex(), wo, n),
+            Material::Mask(opacity, inner) => lane_mask(opacity, inner, tex(), wo, n),
             Material::Blend(..) => self.lane_blend(tex),
             Material::NormalMap(_, inner) | Material::BumpMap(_, _, inner) => match &**inner {
                 Material::Leaf(leaf) => leaf.lane_lobe(tex, true),
@@ -569,7 +597,7 @@ impl Material {
         let at = Local::at(p);
         let (at, two_sided) = match self {
             Material::Leaf(leaf) => (at, leaf.two_sided),
-            // An opaque point of a mask: its material's frame.
+            // A mask: its material's frame.
             Material::Mask(_, inner) => return inner.lane_frame(p, wo),
             // The side `collect` takes.
             Material::TwoSided(ab) => {
@@ -621,6 +649,7 @@ impl Material {
             bxdf: LaneBxdf::Diffuse(d),
             two_sided: a.two_sided,
             mapped: false,
+            weight: 1.0,
         })
     }
 
@@ -1057,17 +1086,44 @@ mod tests {
     }
 
     #[test]
-    fn a_masks_lane_lobe_is_its_materials_where_it_is_opaque_only() {
+    fn a_masks_lane_lobe_is_its_materials_weighted_by_its_opacity() {
         let tex = || TexPoint::uv(Vec2::ZERO);
         let (wo, n) = (Vec3::Z, Vec3::Z);
-        let mask = |a: f32| Material::Mask(Tex::Constant(Rgb::splat(a)), Box::new(mirror(0.7)));
+        let mask =
+            |a: f32, inner: Material| Material::Mask(Tex::Constant(Rgb::splat(a)), Box::new(inner));
+        // Opaque: the material's lobe alone.
         for a in [1.0, 2.0] {
-            let lobe = mask(a).lane_bxdf(tex, wo, n).unwrap();
+            let lobe = mask(a, mirror(0.7)).lane_bxdf(tex, wo, n).unwrap();
             assert!(matches!(lobe.bxdf, LaneBxdf::Mirror(m) if m.reflectance == Rgb::splat(0.7)));
+            assert_eq!(lobe.weight, 1.0);
         }
-        // Passing some light through, or a NaN opacity: left to `bsdf`.
-        for a in [0.0, 0.5, 1.0 - f32::EPSILON, f32::NAN] {
-            assert!(mask(a).lane_bxdf(tex, wo, n).is_none(), "{a}");
+        // Letting some light through: the lobe, weighted as `collect` weighs it.
+        for a in [0.5, 1.0 - f32::EPSILON, f32::MIN_POSITIVE] {
+            let lobe = mask(a, mirror(0.7)).lane_bxdf(tex, wo, n).unwrap();
+            assert!(matches!(lobe.bxdf, LaneBxdf::Mirror(_)));
+            assert!(lobe.weight > 0.0 && lobe.weight < 1.0 && (lobe.weight - a).abs() < 1e-6);
+            let bsdf = mask(a, mirror(0.7)).bsdf(&ShadingPoint::at(n), wo);
+            assert_eq!(
+                bsdf.lobes().map(|l| l.weight).collect::<Vec<_>>(),
+                [lobe.weight]
+            );
+            assert_eq!(bsdf.pass_through(), 1.0 - lobe.weight);
         }
+        // Letting all through: a black lobe of weight zero.
+        for a in [0.0, -1.0] {
+            let lobe = mask(a, mirror(0.7)).lane_bxdf(tex, wo, n).unwrap();
+            assert!(matches!(lobe.bxdf, LaneBxdf::Diffuse(d) if d.reflectance == Rgb::ZERO));
+            assert_eq!(
+                (lobe.weight, lobe.two_sided, lobe.mapped),
+                (0.0, false, false)
+            );
+        }
+        // A NaN opacity, or a see-through mask over a weighted lobe: left to `bsdf`.
+        assert!(mask(f32::NAN, mirror(0.7)).lane_bxdf(tex, wo, n).is_none());
+        let nested = mask(0.5, mask(0.5, diffuse(0.5)));
+        assert!(nested.lane_bxdf(tex, wo, n).is_none());
+        assert!(mask(1.0, mask(0.5, diffuse(0.5)))
+            .lane_bxdf(tex, wo, n)
+            .is_some());
     }
 }

@@ -14,7 +14,8 @@
 //! conductors and glass, of one roughness or anisotropic; thin sheets of glass; smooth and
 //! rough plastic; diffuse reflection and transmission; the principled model, solid or thin;
 //! any of those under a normal or bump map; of a two-sided pair of those, the one on wo's
-//! side; a mask over one of those, where it is opaque). There the lanes are shaded together
+//! side; a mask over one of those, its lobe weighted by the opacity, the rest passing
+//! straight through). There the lanes are shaded together
 //! in SIMD registers by the same functions the one-path code calls, instantiated on eight
 //! lanes (the BSDFs: [`Diffuse`],
 //! [`RoughConductor`], [`RoughDielectric`] (their distributions: [`MicrofacetLanes`], whose
@@ -83,6 +84,11 @@ struct ScatterIn {
     translucent: DiffuseTransmission<V8>,
     principled: PrincipledLobes<V8, F8, M8, MicrofacetLanes>,
     two_sided: M8,
+    /// Lanes whose lobe has a weight below one, the rest of the light passing straight
+    /// through ([`crate::bsdf::LaneLobe::weight`]: a mask that lets some through), and that
+    /// weight (cleared, and looked at, only where `mixed` has the lane).
+    mixed: M8,
+    lobe_weight: F8,
     /// Whether some lane has one of the lobes of `coated` (cleared, and looked at, only
     /// where one had).
     coated: bool,
@@ -206,30 +212,36 @@ struct ScatterOut {
     weight: V8,
 }
 
-/// The lanes' scattering at the lobes [`Material::lane_bxdf`] gives, composed of the functions
-/// the one-path code calls, on lanes: the shading frame ([`Frame::from_normal`], turned towards
-/// wo for a two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does),
-/// [`super::sample_light`] for a point on an emitting triangle, an environment map's
-/// direction (drawn before, by [`EnvironmentMap::sample_direction_lanes`]) or a sample of
-/// another light (drawn before, one lane at a time, into [`ScatterIn::drawn`]) up to the
-/// shadow ray ([`TriangleEmitter::sample_li`], [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`],
-/// [`RoughDielectric::f_and_pdf`], [`Plastic::f_and_pdf`], [`RoughPlastic::f_and_pdf`] or
-/// [`DiffuseTransmission::f_and_pdf`] or [`PrincipledLobes::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`]
-/// against the lobe's density, weight one for a delta light; the map's radiance is read after
-/// the shadow ray, as there), and [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe
+/// The lanes' scattering at the lobes [`Material::lane_bxdf`] gives, composed of the functions the
+/// one-path code calls, on lanes: the shading frame ([`Frame::from_normal`], turned towards wo for
+/// a two-sided material as [`crate::bsdf::Bsdf::from_bxdf`] does), [`super::sample_light`] for a
+/// point on an emitting triangle, an environment map's direction (drawn before, by
+/// [`EnvironmentMap::sample_direction_lanes`]) or a sample of another light (drawn before, one lane
+/// at a time, into [`ScatterIn::drawn`]) up to the shadow ray ([`TriangleEmitter::sample_li`],
+/// [`Diffuse::f_z`], [`RoughConductor::f_and_pdf`], [`RoughDielectric::f_and_pdf`],
+/// [`Plastic::f_and_pdf`], [`RoughPlastic::f_and_pdf`] or [`DiffuseTransmission::f_and_pdf`] or
+/// [`PrincipledLobes::f_and_pdf`], [`offset_ray_origin`], [`power_heuristic_weight`] against the
+/// lobe's density, weight one for a delta light; the map's radiance is read after the shadow ray,
+/// as there), and [`crate::bsdf::Bsdf::sample_f`] for a BSDF of that one lobe
 /// ([`Diffuse::sample_z`], [`RoughConductor::sample`], [`RoughDielectric::sample_real`],
 /// [`Mirror::sample_real`], [`SmoothConductor::sample`], [`DielectricLanes::sample`],
-/// [`ThinDielectric::sample_real`], [`Plastic::sample_real`] (whose coat's reflection is a
-/// delta sample), [`RoughPlastic::sample_real`], [`DiffuseTransmission::sample_real`],
-/// [`PrincipledLobes::sample_real`]; smooth
-/// lobes have no light sample). Only the control flow is the lanes' own: masks where the
-/// one-path code returns early, and each lobe's functions skipped where no lane has it (all
-/// but the Lambertian ones and the triangles' and maps' light samples without
-/// `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes alone; the
-/// plastics, thin glass, diffuse transmission and the principled model only with `COATED`: the instance for the
-/// other lobes stays as small as it was without them).
+/// [`ThinDielectric::sample_real`], [`Plastic::sample_real`] (whose coat's reflection is a delta
+/// sample), [`RoughPlastic::sample_real`], [`DiffuseTransmission::sample_real`],
+/// [`PrincipledLobes::sample_real`]; smooth lobes have no light sample); where some light passes
+/// straight through (a mask), the choice [`crate::bsdf::Bsdf::sample_f`] makes between the lobe and
+/// passing through, the lobe's value and density weighted, and, for a sample that is not a delta
+/// one, both evaluated again towards the direction taken (the lobes' functions above). Only the
+/// control flow is the lanes' own: masks where the one-path code returns early, and each lobe's
+/// functions skipped where no lane has it (all but the Lambertian ones and the triangles' and maps'
+/// light samples without `OTHER_LOBES`: a separate, smaller instance for passes of Lambertian lanes
+/// alone; the plastics, thin glass, diffuse transmission and the principled model only with
+/// `COATED`: the instance for the other lobes stays as small as it was without them; passing
+/// through only with `MIXED`).
 #[inline(always)]
-fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool>(a: &ScatterIn, out: &mut ScatterOut) {
+fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>(
+    a: &ScatterIn,
+    out: &mut ScatterOut,
+) {
     let zero = F8::splat(0.0);
     let flip = a.two_sided & a.wo.dot(a.ns).lt(zero);
     let mut frame = Frame::from_normal(flip.select3(-a.ns, a.ns));
@@ -268,6 +280,198 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool>(a: &ScatterIn, out
     if any_drawn {
         wi = drawn.lanes.select3(drawn.wi, wi);
     }
+    let (f, mut bsdf_pdf) = lobes_f_and_pdf::<OTHER_LOBES, COATED>(a, &frame, wo_z, wo_local, wi);
+    let cos_i = wi.dot(frame.n).abs();
+    // `Bsdf::f_cos` and `Bsdf::pdf` of a lobe with passing through: f (weight · cos), and
+    // the weight times the lobe's density.
+    let mixed = a.mixed;
+    let any_mixed = OTHER_LOBES && MIXED && mixed.any();
+    let w = a.lobe_weight;
+    let mut f_scale = cos_i;
+    if any_mixed {
+        f_scale = mixed.select(w * cos_i, f_scale);
+        bsdf_pdf = mixed.select(w * bsdf_pdf, bsdf_pdf);
+    }
+    let guard = a.guard;
+    let guarded = OTHER_LOBES && a.mapped && guard.any();
+    let f = if guarded {
+        // `Bsdf::f_cos` of a guarded lobe: f (weight · attenuation · cos), its weight one.
+        // Where the guard does not admit wi this is zero, and the sample ends here (its
+        // density, which `Bsdf::pdf` would make zero too, is not asked for).
+        let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
+        let guarded = F8::splat(1.0) * attenuation * cos_i;
+        guard.select3(f.scale(guarded), f.scale(f_scale))
+    } else {
+        f.scale(f_scale)
+    };
+    // `visible_light_sample`'s early returns (`!(x <= 0)` lets NaN through, as there).
+    let triangle = a.light
+        & ls.dist2.not_equal(zero)
+        & ls.abs_cos_light.not_equal(zero)
+        & !ls.pdf.le(zero)
+        & !ls.li.max_element().le(zero);
+    let environment = env & !a.environment_pdf.le(zero);
+    // (A drawn sample's checks of its density and radiance were made where it was drawn.)
+    out.shadow = (triangle | environment | drawn.lanes) & !f.max_element().le(zero);
+    // Towards the triangle's point (`spawn_ray_to`), or along the direction (`spawn_ray`).
+    let o = offset_ray_origin(a.p, a.ng, env.select3(wi, ls.p_light - a.p));
+    let end = offset_ray_origin(ls.p_light, a.emitter.normal, o - ls.p_light);
+    out.shadow_o = o;
+    out.shadow_d = env.select3(wi, end - o);
+    out.shadow_t_max = env.select(F8::splat(f32::INFINITY), F8::splat(SHADOW_RAY_END));
+    let mut light_pdf = env.select(a.environment_pdf, ls.pdf);
+    let mut li = ls.li;
+    if any_drawn {
+        let on = drawn.lanes;
+        out.shadow_o = on.select3(drawn.shadow_o, out.shadow_o);
+        out.shadow_d = on.select3(drawn.shadow_d, out.shadow_d);
+        out.shadow_t_max = on.select(drawn.shadow_t_max, out.shadow_t_max);
+        light_pdf = on.select(drawn.pdf, light_pdf);
+        li = on.select3(drawn.li, li);
+    }
+    let pdf = a.light_pmf * light_pdf;
+    let mut mis = power_heuristic_weight(pdf, bsdf_pdf);
+    if any_drawn {
+        // A delta light's sample has weight one (no BSDF sample finds it).
+        mis = (drawn.lanes & drawn.delta).select(F8::splat(1.0), mis);
+    }
+    out.ld = f.mul_axes(li).scale(mis / pdf);
+    out.f = f;
+    out.weight_over_pdf = mis / pdf;
+
+    // BSDF sampling (and `Bsdf::sample_f`'s checks of a positive density and a finite value).
+    let [u0, u1] = a.u_bsdf;
+    // Where light may pass through, `Bsdf::sample_f` chooses the lobe with probability its
+    // weight, and reuses the rest of the number within it.
+    let mut u_lobe = a.u_lobe;
+    let mut passing = M8::default();
+    if any_mixed {
+        passing = mixed & !(w.gt(zero) & u_lobe.lt(w));
+        let within = (u_lobe / w).max(zero).min(F8::splat(1.0 - f32::EPSILON));
+        u_lobe = mixed.select(within, u_lobe);
+    }
+    let mut bs = a.diffuse.sample_z(wo_z, u0, u1);
+    if any_metal {
+        bs = DirectionSample::select(metal, a.metal.sample(wo_local, u0, u1), bs);
+    }
+    let mut eta = F8::splat(1.0);
+    if any_rough_glass {
+        let g = a
+            .rough_glass
+            .sample_real(wo_local, u_lobe, u0, u1, Lobes::All);
+        eta = rough_glass.select(a.rough_glass.relative_ior(wo_local, g.wi), eta);
+        bs = DirectionSample::select(rough_glass, g, bs);
+    }
+    let lobes = &a.lobes;
+    let mut delta = lobes.delta;
+    if any_plastic {
+        let (p, specular) = a.plastic.sample_real(wo_local, u_lobe, u0, u1);
+        bs = DirectionSample::select(plastic, p, bs);
+        delta = delta | (plastic & specular);
+    }
+    if any_rough_plastic {
+        let p = a.rough_plastic.sample_real(wo_local, u_lobe, u0, u1);
+        bs = DirectionSample::select(rough_plastic, p, bs);
+    }
+    if any_translucent {
+        let t = a.translucent.sample_real(wo_local, u_lobe, u0, u1);
+        bs = DirectionSample::select(translucent, t, bs);
+    }
+    if any_principled {
+        let p = a.principled.sample_real(wo_local, u_lobe, u0, u1);
+        eta = principled.select(a.principled.relative_ior(wo_local, p.wi), eta);
+        bs = DirectionSample::select(principled, p, bs);
+    }
+    if OTHER_LOBES && lobes.delta.any() {
+        let wo = wo_local;
+        let mut d = a.mirror.sample_real(wo);
+        if lobes.smooth_metal.any() {
+            d = DirectionSample::select(lobes.smooth_metal, a.smooth_metal.sample(wo), d);
+        }
+        if lobes.glass.any() {
+            let (g, g_eta) = a.glass.sample(wo, u_lobe);
+            d = DirectionSample::select(lobes.glass, g, d);
+            eta = lobes.glass.select(g_eta, eta);
+        }
+        let thin_glass = a.coated_lobes.thin_glass;
+        if COATED && thin_glass.any() {
+            let g = a.thin_glass.sample_real(wo, u_lobe);
+            d = DirectionSample::select(thin_glass, g, d);
+        }
+        bs = DirectionSample::select(lobes.delta, d, bs);
+    }
+    out.delta = delta;
+    out.eta = eta;
+    let wi = frame.to_world(bs.wi);
+    let (mut f, mut valid) = (bs.f, bs.valid);
+    if guarded {
+        // `Bsdf::sample_f` of a guarded lobe: none where the guard does not admit wi, the
+        // value attenuated where it does.
+        let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
+        f = guard.select3(f.scale(attenuation), f);
+        valid = valid & (guard_admits(a.guard_n, frame.n, wi) | !guard);
+    }
+    let finite = |f: V8| f.x.is_finite() & f.y.is_finite() & f.z.is_finite();
+    let mut sampled = valid & bs.pdf.gt(zero) & finite(f);
+    let (mut wi, mut pdf, mut cos) = (wi, bs.pdf, wi.dot(frame.n).abs());
+    if any_mixed {
+        // The lobe's delta sample: f and the density times its weight.
+        let chosen = mixed & !passing;
+        let scaled = chosen & delta;
+        f = scaled.select3(f.scale(w), f);
+        pdf = scaled.select(pdf * w, pdf);
+        // Its other samples: the mixture's value and density towards the direction taken
+        // (`Bsdf::f_cos` / cos and `Bsdf::pdf`), where the density is positive.
+        let smooth = chosen & !delta & sampled;
+        if smooth.any() {
+            let (f_mixed, pdf_mixed) =
+                lobes_f_and_pdf::<OTHER_LOBES, COATED>(a, &frame, wo_z, wo_local, wi);
+            let pdf_mixed = w * pdf_mixed;
+            let f_mixed = f_mixed.scale(w * cos).div_by(cos);
+            let ok = pdf_mixed.gt(zero) & cos.gt(zero) & finite(f_mixed);
+            sampled = sampled & (ok | !smooth);
+            f = smooth.select3(f_mixed, f);
+            pdf = smooth.select(pdf_mixed, pdf);
+        }
+        // Straight through: f cos / pdf = null / null (one), a delta sample of no refraction.
+        let null = F8::splat(1.0) - w;
+        let c = a.wo.dot(frame.n).abs().max(F8::splat(1e-6));
+        f = passing.select3(V8::splat(glam::Vec3::ONE).scale(null / c), f);
+        wi = passing.select3(-a.wo, wi);
+        pdf = passing.select(null, pdf);
+        cos = passing.select(c, cos);
+        sampled = (passing & null.gt(zero)) | (sampled & !passing);
+        out.delta = out.delta | passing;
+        out.eta = passing.select(F8::splat(1.0), out.eta);
+    }
+    out.sampled = sampled;
+    out.wi = wi;
+    out.pdf = pdf;
+    out.weight = f.scale(cos / pdf);
+}
+
+/// The value and density of each lane's lobe ([`scatter_lanes`]' lobes, `Bxdf::f` and
+/// `Bxdf::pdf`) towards `wi`, from wo (`wo_z` its cosine and `wo_local` it in `frame`).
+#[inline(always)]
+fn lobes_f_and_pdf<const OTHER_LOBES: bool, const COATED: bool>(
+    a: &ScatterIn,
+    frame: &Frame<V8>,
+    wo_z: F8,
+    wo_local: V8,
+    wi: V8,
+) -> (V8, F8) {
+    let metal = a.lobes.conductor;
+    let rough_glass = a.lobes.rough_glass;
+    let plastic = a.coated_lobes.plastic;
+    let rough_plastic = a.coated_lobes.rough_plastic;
+    let translucent = a.coated_lobes.translucent;
+    let principled = a.coated_lobes.principled;
+    let any_metal = OTHER_LOBES && metal.any();
+    let any_rough_glass = OTHER_LOBES && rough_glass.any();
+    let any_plastic = COATED && plastic.any();
+    let any_rough_plastic = COATED && rough_plastic.any();
+    let any_translucent = COATED && translucent.any();
+    let any_principled = COATED && principled.any();
     let wi_z = wi.dot(frame.n);
     let wi_local = frame.to_local(wi);
     let (mut f, mut bsdf_pdf) = (a.diffuse.f_z(wo_z, wi_z), a.diffuse.pdf_z(wo_z, wi_z));
@@ -310,133 +514,18 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool>(a: &ScatterIn, out
             principled.select(pdf_p, bsdf_pdf),
         );
     }
-    let cos_i = wi.dot(frame.n).abs();
-    let guard = a.guard;
-    let guarded = OTHER_LOBES && a.mapped && guard.any();
-    let f = if guarded {
-        // `Bsdf::f_cos` of a guarded lobe: f (weight · attenuation · cos), its weight one.
-        // Where the guard does not admit wi this is zero, and the sample ends here (its
-        // density, which `Bsdf::pdf` would make zero too, is not asked for).
-        let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
-        let guarded = F8::splat(1.0) * attenuation * cos_i;
-        guard.select3(f.scale(guarded), f.scale(cos_i))
-    } else {
-        f.scale(cos_i)
-    };
-    // `visible_light_sample`'s early returns (`!(x <= 0)` lets NaN through, as there).
-    let triangle = a.light
-        & ls.dist2.not_equal(zero)
-        & ls.abs_cos_light.not_equal(zero)
-        & !ls.pdf.le(zero)
-        & !ls.li.max_element().le(zero);
-    let environment = env & !a.environment_pdf.le(zero);
-    // (A drawn sample's checks of its density and radiance were made where it was drawn.)
-    out.shadow = (triangle | environment | drawn.lanes) & !f.max_element().le(zero);
-    // Towards the triangle's point (`spawn_ray_to`), or along the direction (`spawn_ray`).
-    let o = offset_ray_origin(a.p, a.ng, env.select3(wi, ls.p_light - a.p));
-    let end = offset_ray_origin(ls.p_light, a.emitter.normal, o - ls.p_light);
-    out.shadow_o = o;
-    out.shadow_d = env.select3(wi, end - o);
-    out.shadow_t_max = env.select(F8::splat(f32::INFINITY), F8::splat(SHADOW_RAY_END));
-    let mut light_pdf = env.select(a.environment_pdf, ls.pdf);
-    let mut li = ls.li;
-    if any_drawn {
-        let on = drawn.lanes;
-        out.shadow_o = on.select3(drawn.shadow_o, out.shadow_o);
-        out.shadow_d = on.select3(drawn.shadow_d, out.shadow_d);
-        out.shadow_t_max = on.select(drawn.shadow_t_max, out.shadow_t_max);
-        light_pdf = on.select(drawn.pdf, light_pdf);
-        li = on.select3(drawn.li, li);
-    }
-    let pdf = a.light_pmf * light_pdf;
-    let mut mis = power_heuristic_weight(pdf, bsdf_pdf);
-    if any_drawn {
-        // A delta light's sample has weight one (no BSDF sample finds it).
-        mis = (drawn.lanes & drawn.delta).select(F8::splat(1.0), mis);
-    }
-    out.ld = f.mul_axes(li).scale(mis / pdf);
-    out.f = f;
-    out.weight_over_pdf = mis / pdf;
-
-    // BSDF sampling (and `Bsdf::sample_f`'s checks of a positive density and a finite value).
-    let [u0, u1] = a.u_bsdf;
-    let mut bs = a.diffuse.sample_z(wo_z, u0, u1);
-    if any_metal {
-        bs = DirectionSample::select(metal, a.metal.sample(wo_local, u0, u1), bs);
-    }
-    let mut eta = F8::splat(1.0);
-    if any_rough_glass {
-        let g = a
-            .rough_glass
-            .sample_real(wo_local, a.u_lobe, u0, u1, Lobes::All);
-        eta = rough_glass.select(a.rough_glass.relative_ior(wo_local, g.wi), eta);
-        bs = DirectionSample::select(rough_glass, g, bs);
-    }
-    let lobes = &a.lobes;
-    let mut delta = lobes.delta;
-    if any_plastic {
-        let (p, specular) = a.plastic.sample_real(wo_local, a.u_lobe, u0, u1);
-        bs = DirectionSample::select(plastic, p, bs);
-        delta = delta | (plastic & specular);
-    }
-    if any_rough_plastic {
-        let p = a.rough_plastic.sample_real(wo_local, a.u_lobe, u0, u1);
-        bs = DirectionSample::select(rough_plastic, p, bs);
-    }
-    if any_translucent {
-        let t = a.translucent.sample_real(wo_local, a.u_lobe, u0, u1);
-        bs = DirectionSample::select(translucent, t, bs);
-    }
-    if any_principled {
-        let p = a.principled.sample_real(wo_local, a.u_lobe, u0, u1);
-        eta = principled.select(a.principled.relative_ior(wo_local, p.wi), eta);
-        bs = DirectionSample::select(principled, p, bs);
-    }
-    if OTHER_LOBES && lobes.delta.any() {
-        let wo = wo_local;
-        let mut d = a.mirror.sample_real(wo);
-        if lobes.smooth_metal.any() {
-            d = DirectionSample::select(lobes.smooth_metal, a.smooth_metal.sample(wo), d);
-        }
-        if lobes.glass.any() {
-            let (g, g_eta) = a.glass.sample(wo, a.u_lobe);
-            d = DirectionSample::select(lobes.glass, g, d);
-            eta = lobes.glass.select(g_eta, eta);
-        }
-        let thin_glass = a.coated_lobes.thin_glass;
-        if COATED && thin_glass.any() {
-            let g = a.thin_glass.sample_real(wo, a.u_lobe);
-            d = DirectionSample::select(thin_glass, g, d);
-        }
-        bs = DirectionSample::select(lobes.delta, d, bs);
-    }
-    out.delta = delta;
-    out.eta = eta;
-    let wi = frame.to_world(bs.wi);
-    let (mut f, mut valid) = (bs.f, bs.valid);
-    if guarded {
-        // `Bsdf::sample_f` of a guarded lobe: none where the guard does not admit wi, the
-        // value attenuated where it does.
-        let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
-        f = guard.select3(f.scale(attenuation), f);
-        valid = valid & (guard_admits(a.guard_n, frame.n, wi) | !guard);
-    }
-    let finite = f.x.is_finite() & f.y.is_finite() & f.z.is_finite();
-    out.sampled = valid & bs.pdf.gt(zero) & finite;
-    out.wi = wi;
-    out.pdf = bs.pdf;
-    out.weight = f.scale(wi.dot(frame.n).abs() / bs.pdf);
+    (f, bsdf_pdf)
 }
 
 /// [`scatter_lanes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn scatter_avx2<const OTHER_LOBES: bool, const COATED: bool>(
+fn scatter_avx2<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>(
     _: crate::simd::Avx2,
     a: &ScatterIn,
     out: &mut ScatterOut,
 ) {
-    scatter_lanes::<OTHER_LOBES, COATED>(a, out)
+    scatter_lanes::<OTHER_LOBES, COATED, MIXED>(a, out)
 }
 
 /// [`scatter_lanes`] on the best vector unit this CPU has, its Lambertian instance where no
@@ -444,7 +533,7 @@ fn scatter_avx2<const OTHER_LOBES: bool, const COATED: bool>(
 #[inline]
 fn scatter(a: &mut ScatterIn, out: &mut ScatterOut) {
     let lobes = &a.lobes;
-    let other = (lobes.conductor | lobes.rough_glass | lobes.delta | a.drawn.lanes).any()
+    let other = (lobes.conductor | lobes.rough_glass | lobes.delta | a.drawn.lanes | a.mixed).any()
         || a.mapped
         || a.coated;
     if other {
@@ -454,9 +543,9 @@ fn scatter(a: &mut ScatterIn, out: &mut ScatterOut) {
     if let Some(avx2) = crate::simd::Avx2::detect() {
         // SAFETY: `scatter_avx2` requires AVX2 and FMA, which `avx2` proves this CPU has. Its
         // body is safe code.
-        return unsafe { scatter_avx2::<false, false>(avx2, a, out) };
+        return unsafe { scatter_avx2::<false, false, false>(avx2, a, out) };
     }
-    scatter_lanes::<false, false>(a, out)
+    scatter_lanes::<false, false, false>(a, out)
 }
 
 /// [`scatter`]'s instance for every lobe and light, out of line so that the Lambertian one
@@ -481,15 +570,18 @@ fn scatter_other_lobes(a: &mut ScatterIn, out: &mut ScatterOut) {
         a.principled.only_in(principled);
     }
     let a = &*a;
+    if a.mixed.any() {
+        return scatter_mixed(a, out);
+    }
     if a.coated {
         return scatter_coated(a, out);
     }
     #[cfg(target_arch = "x86_64")]
     if let Some(avx2) = crate::simd::Avx2::detect() {
         // SAFETY: as in `scatter`.
-        return unsafe { scatter_avx2::<true, false>(avx2, a, out) };
+        return unsafe { scatter_avx2::<true, false, false>(avx2, a, out) };
     }
-    scatter_lanes::<true, false>(a, out)
+    scatter_lanes::<true, false, false>(a, out)
 }
 
 /// [`scatter_other_lobes`]' instance where some lane has a plastic, a thin sheet of glass or
@@ -499,9 +591,30 @@ fn scatter_coated(a: &ScatterIn, out: &mut ScatterOut) {
     #[cfg(target_arch = "x86_64")]
     if let Some(avx2) = crate::simd::Avx2::detect() {
         // SAFETY: as in `scatter`.
-        return unsafe { scatter_avx2::<true, true>(avx2, a, out) };
+        return unsafe { scatter_avx2::<true, true, false>(avx2, a, out) };
     }
-    scatter_lanes::<true, true>(a, out)
+    scatter_lanes::<true, true, false>(a, out)
+}
+
+/// [`scatter_other_lobes`]' instances where some lane's lobe lets light pass through (a
+/// mask's): the choice between them and the lobe evaluated again take code (and time) the
+/// other instances are without.
+#[inline(never)]
+fn scatter_mixed(a: &ScatterIn, out: &mut ScatterOut) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx2) = crate::simd::Avx2::detect() {
+        // SAFETY: as in `scatter`.
+        return unsafe {
+            match a.coated {
+                true => scatter_avx2::<true, true, true>(avx2, a, out),
+                false => scatter_avx2::<true, false, true>(avx2, a, out),
+            }
+        };
+    }
+    match a.coated {
+        true => scatter_lanes::<true, true, true>(a, out),
+        false => scatter_lanes::<true, false, true>(a, out),
+    }
 }
 
 /// One lane's path: its sample's tag and where the path stands.
@@ -578,6 +691,7 @@ impl PathIntegrator {
             // gather the others' inputs.
             let mut shaded = 0u32;
             a.lobes = LobeLanes::default();
+            a.mixed = M8::default();
             if a.coated {
                 (a.coated, a.coated_lobes) = (false, CoatedLanes::default());
             }
@@ -931,10 +1045,20 @@ fn gather_lobe(
     if lane.mapped {
         gather_frame(scene, si, wo, material, i, a);
     }
-    // As `scatter` counts a vertex whose BSDF is not black: every lobe but a black diffuse one.
-    let black = matches!(lobe, LaneBxdf::Diffuse(d) if d.reflectance.max_element() <= 0.0);
-    stats.random_vertices += u64::from(!black);
     let lobes = &mut a.lobes;
+    let mixed = lane.weight < 1.0;
+    if mixed {
+        a.mixed.set(i, true);
+        a.lobe_weight.0[i] = lane.weight;
+        // All passing through: a delta BSDF (`Bsdf::is_delta`), without a light sample.
+        if lane.weight <= 0.0 {
+            lobes.delta.set(i, true);
+        }
+    }
+    // As `scatter` counts a vertex whose BSDF is not black: every lobe but a black diffuse
+    // one, and any through which light passes.
+    let black = matches!(lobe, LaneBxdf::Diffuse(d) if d.reflectance.max_element() <= 0.0);
+    stats.random_vertices += u64::from(!black || mixed);
     let coated = &mut a.coated_lobes;
     match lobe {
         LaneBxdf::Diffuse(diffuse) => a.diffuse.set_lane(i, diffuse),
