@@ -489,3 +489,39 @@ fn samplers_pathlab_lacks_are_rendered_by_its_nearest_with_a_note() {
         }
     }
 }
+
+#[test]
+fn unknown_and_unused_bsdfs_are_reported_with_their_line() {
+    let text = r#"<scene version="3.0.0">
+    <bsdf type="nosuch" id="used"/>
+    <bsdf type="alsonosuch" id="spare"/>
+    <bsdf type="diffuse" id="idle"><texture type="checkerboard" name="reflectance"/></bsdf>
+    <texture type="bitmap" id="unreferenced"/>
+    <shape type="sphere"><ref id="used"/></shape>
+</scene>"#;
+    let file = write("unknown-and-unused.xml", text);
+    let desc = mitsuba::load(&file).unwrap();
+    let line = |n: usize| format!("unknown-and-unused.xml:{n}:");
+    let unused = "is not used by anything in the scene; not loaded";
+    let expected = [
+        (
+            2,
+            r#"<bsdf type="nosuch"> is not supported by pathlab yet; drawn as grey"#,
+        ),
+        (
+            3,
+            &format!(r#"<bsdf type="alsonosuch" id="spare"> {unused}"#),
+        ),
+        (4, &format!(r#"<bsdf type="diffuse" id="idle"> {unused}"#)),
+        (
+            5,
+            &format!(r#"<texture type="bitmap" id="unreferenced"> {unused}"#),
+        ),
+    ];
+    assert_eq!(desc.warnings.len(), expected.len(), "{:?}", desc.warnings);
+    for ((n, text), w) in expected.iter().zip(&desc.warnings) {
+        assert!(w.contains(&line(*n)) && w.contains(text), "{w}");
+    }
+    // The scene itself is what it was: one sphere, of the grey stand-in.
+    assert_eq!(desc.materials.len(), 1);
+}

@@ -509,6 +509,7 @@ impl<'t> Ctx<'t> {
     fn scene(&mut self, root: usize) -> Result<(), Error> {
         let scene = self.obj(root);
         let props: Vec<usize> = (0..self.tree.nodes[root].props.len()).collect();
+        let mut defined = Vec::new();
         for k in props {
             let p = &self.tree.nodes[root].props[k];
             let Some(i) = self.object_value(p)? else {
@@ -532,6 +533,7 @@ impl<'t> Ctx<'t> {
                 // Defined here, used where referenced.
                 "bsdf" | "texture" | "spectrum" => {
                     self.visited[i].set(false);
+                    defined.push(i);
                 }
                 _ => {
                     let what = self.what(o);
@@ -541,6 +543,20 @@ impl<'t> Ctx<'t> {
                     );
                     self.accept_all(o);
                 }
+            }
+        }
+        // Definitions nothing referenced are not converted (an unknown plugin among them would
+        // otherwise pass unseen): said, not dropped silently.
+        for i in defined {
+            if !self.visited[i].get() {
+                let n = &self.tree.nodes[i];
+                let id = n.id.as_ref().map(|id| format!(" id=\"{id}\""));
+                let id = id.unwrap_or_default();
+                let message = format!(
+                    "<{} type=\"{}\"{id}> is not used by anything in the scene; not loaded",
+                    n.class, n.plugin
+                );
+                self.warn(n.loc, message);
             }
         }
         let _ = scene;
