@@ -722,14 +722,7 @@ fn with_masks(mut desc: SceneDesc) -> SceneDesc {
 /// on the wall, and spheres of smooth glass, rough glass, a two-sided pair (rough plastic in
 /// front, a mirror behind) and diffuse transmission.
 fn with_see_through_masks(mut desc: SceneDesc) -> SceneDesc {
-    let mask = |opacities: [f32; 2], inner| MaterialDesc::Mask {
-        opacity: TextureDesc::Checkerboard {
-            color0: Vec3::splat(opacities[0]),
-            color1: Vec3::splat(opacities[1]),
-            to_uv: glam::Affine2::from_scale(glam::Vec2::splat(5.0)),
-        },
-        inner: Box::new(inner),
-    };
+    let mask = see_through_mask;
     let glass = |roughness| MaterialDesc::Glass {
         reflectance: Vec3::ONE,
         transmittance: Vec3::new(0.9, 1.0, 0.95),
@@ -788,6 +781,28 @@ fn with_see_through_masks(mut desc: SceneDesc) -> SceneDesc {
     desc
 }
 
+/// `inner` under a mask of a checkerboard of `opacities`.
+fn see_through_mask(opacities: [f32; 2], inner: MaterialDesc) -> MaterialDesc {
+    MaterialDesc::Mask {
+        opacity: TextureDesc::Checkerboard {
+            color0: Vec3::splat(opacities[0]),
+            color1: Vec3::splat(opacities[1]),
+            to_uv: glam::Affine2::from_scale(glam::Vec2::splat(5.0)),
+        },
+        inner: Box::new(inner),
+    }
+}
+
+/// `desc` with every material under a mask that lets some light through everywhere: over
+/// `with_maps`' materials, lobes in frames of their own (normal and bump maps, anisotropic
+/// roughness) under their maps' guards.
+fn under_see_through_masks(mut desc: SceneDesc) -> SceneDesc {
+    for m in &mut desc.materials {
+        *m = see_through_mask([0.7, 0.35], m.clone());
+    }
+    desc
+}
+
 #[test]
 fn packets_compute_what_one_path_at_a_time_computes() {
     // The path integrator follows eight paths at once, computing the scattering at
@@ -799,8 +814,8 @@ fn packets_compute_what_one_path_at_a_time_computes() {
     // textured or not, in the scenes `with_metals`, `with_smooth_lobes` and `with_textures`;
     // blends of two diffuse materials in `with_blends`; those lobes under normal and bump
     // maps in `with_maps`; smooth and rough plastics in `with_plastics`; the principled model
-    // in `with_principled`; two-sided pairs in `with_two_sided_pairs`; masks in `with_masks`
-    // and `with_see_through_masks`): every sample's radiance must be the scalar `li`'s to the
+    // in `with_principled`; two-sided pairs in `with_two_sided_pairs`; masks in `with_masks`,
+    // `with_see_through_masks` and, over maps, `under_see_through_masks`): every sample's radiance must be the scalar `li`'s to the
     // bit, and the rays and nodes counted the same. In a scene of a few triangles and spheres
     // the lanes' rays are tested against every primitive at once instead of walking the BVH
     // (the same distances; of primitives at exactly the same distance, possibly another,
@@ -852,6 +867,13 @@ fn packets_compute_what_one_path_at_a_time_computes() {
         ),
         (
             with_more_lights(under_a_sky(with_masks(mixed_scene()))),
+            false,
+        ),
+        (under_see_through_masks(with_maps(mixed_scene())), false),
+        (
+            with_more_lights(under_a_sky(under_see_through_masks(with_maps(
+                mixed_scene(),
+            )))),
             false,
         ),
         (without_emitting_surfaces(mixed_scene(), false), false),

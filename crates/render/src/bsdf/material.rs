@@ -497,12 +497,11 @@ fn lane_side<'a>(
 
 /// [`Material::lane_bxdf`] of a mask of `opacity` over `inner` at `tex`, the BSDF
 /// [`Material::collect`] makes of it: where the mask is opaque (an opacity of one or more),
-/// the inner material's lobe alone; where it lets some light through, that lobe (one around
-/// the shading normal or turned towards wo, of weight one) weighted by the opacity, the rest
-/// passing through; where it lets all through, passing through alone. None where the opacity
-/// is NaN, or where the inner lobe is none the lanes shade, or has a frame of its own or a
-/// weight below one. Out of line, and not generic: a mask holds a material, which may be a
-/// mask.
+/// the inner material's lobe alone; where it lets some light through, that lobe (of weight
+/// one, in its own frame and under its map's guard if it has them) weighted by the opacity,
+/// the rest passing through; where it lets all through, passing through alone. None where the
+/// opacity is NaN, or where the inner lobe is none the lanes shade, or has a weight below one.
+/// Out of line, and not generic: a mask holds a material, which may be a mask.
 #[inline(never)]
 fn lane_mask(
     opacity: &Tex,
@@ -531,7 +530,7 @@ fn lane_mask(
         });
     }
     let lobe = inner.lane_bxdf(|| tex, wo, n)?;
-    if lobe.mapped || lobe.weight < 1.0 {
+    if lobe.weight < 1.0 {
         return None;
     }
     Some(LaneLobe { weight: a, ..lobe })
@@ -1118,6 +1117,12 @@ mod tests {
                 (0.0, false, false)
             );
         }
+        // Over a lobe with a frame of its own (a normal map's): that lobe, weighted.
+        let normals = Tex::Constant(Rgb::new(0.6, 0.5, 0.9));
+        let mapped = Material::NormalMap(normals, Box::new(mirror(0.7)));
+        let lobe = mask(0.25, mapped).lane_bxdf(tex, wo, n).unwrap();
+        assert!(matches!(lobe.bxdf, LaneBxdf::Mirror(_)));
+        assert_eq!((lobe.weight, lobe.mapped), (0.25, true));
         // A NaN opacity, or a see-through mask over a weighted lobe: left to `bsdf`.
         assert!(mask(f32::NAN, mirror(0.7)).lane_bxdf(tex, wo, n).is_none());
         let nested = mask(0.5, mask(0.5, diffuse(0.5)));

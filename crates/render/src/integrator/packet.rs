@@ -298,8 +298,13 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>
         // `Bsdf::f_cos` of a guarded lobe: f (weight · attenuation · cos), its weight one.
         // Where the guard does not admit wi this is zero, and the sample ends here (its
         // density, which `Bsdf::pdf` would make zero too, is not asked for).
+        // A guarded lobe's weight is one, or the mask's opacity where light passes through.
         let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
-        let guarded = F8::splat(1.0) * attenuation * cos_i;
+        let mut weight = F8::splat(1.0);
+        if any_mixed {
+            weight = mixed.select(w, weight);
+        }
+        let guarded = weight * attenuation * cos_i;
         guard.select3(f.scale(guarded), f.scale(f_scale))
     } else {
         f.scale(f_scale)
@@ -404,10 +409,13 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>
     out.eta = eta;
     let wi = frame.to_world(bs.wi);
     let (mut f, mut valid) = (bs.f, bs.valid);
+    // The guard's attenuation towards wi (one where there is no guard).
+    let mut attenuation = F8::splat(1.0);
     if guarded {
         // `Bsdf::sample_f` of a guarded lobe: none where the guard does not admit wi, the
         // value attenuated where it does.
-        let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
+        let towards_wi = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
+        attenuation = guard.select(towards_wi, attenuation);
         f = guard.select3(f.scale(attenuation), f);
         valid = valid & (guard_admits(a.guard_n, frame.n, wi) | !guard);
     }
@@ -415,10 +423,11 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>
     let mut sampled = valid & bs.pdf.gt(zero) & finite(f);
     let (mut wi, mut pdf, mut cos) = (wi, bs.pdf, wi.dot(frame.n).abs());
     if any_mixed {
-        // The lobe's delta sample: f and the density times its weight.
+        // The lobe's delta sample: f times its weight and attenuation, the density times its
+        // weight.
         let chosen = mixed & !passing;
         let scaled = chosen & delta;
-        f = scaled.select3(f.scale(w), f);
+        f = scaled.select3(bs.f.scale(w * attenuation), f);
         pdf = scaled.select(pdf * w, pdf);
         // Its other samples: the mixture's value and density towards the direction taken
         // (`Bsdf::f_cos` / cos and `Bsdf::pdf`), where the density is positive.
@@ -427,7 +436,7 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>
             let (f_mixed, pdf_mixed) =
                 lobes_f_and_pdf::<OTHER_LOBES, COATED>(a, &frame, wo_z, wo_local, wi);
             let pdf_mixed = w * pdf_mixed;
-            let f_mixed = f_mixed.scale(w * cos).div_by(cos);
+            let f_mixed = f_mixed.scale(w * attenuation * cos).div_by(cos);
             let ok = pdf_mixed.gt(zero) & cos.gt(zero) & finite(f_mixed);
             sampled = sampled & (ok | !smooth);
             f = smooth.select3(f_mixed, f);
