@@ -295,10 +295,10 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>
     let guard = a.guard;
     let guarded = OTHER_LOBES && a.mapped && guard.any();
     let f = if guarded {
-        // `Bsdf::f_cos` of a guarded lobe: f (weight · attenuation · cos), its weight one.
-        // Where the guard does not admit wi this is zero, and the sample ends here (its
-        // density, which `Bsdf::pdf` would make zero too, is not asked for).
-        // A guarded lobe's weight is one, or the mask's opacity where light passes through.
+        // `Bsdf::f_cos` of a guarded lobe: f (weight · attenuation · cos), its weight one,
+        // or the mask's opacity where light passes through. Where the guard does not admit
+        // wi this is zero, and the sample ends here (its density, which `Bsdf::pdf` would
+        // make zero too, is not asked for).
         let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
         let mut weight = F8::splat(1.0);
         if any_mixed {
