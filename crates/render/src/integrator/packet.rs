@@ -286,11 +286,15 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>
     // the weight times the lobe's density.
     let mixed = a.mixed;
     let any_mixed = OTHER_LOBES && MIXED && mixed.any();
+    // The lobe's weight: the mask's opacity where light passes through, one elsewhere (one
+    // times a value is that value, to the bit).
     let w = a.lobe_weight;
+    let mut lobe_w = F8::splat(1.0);
     let mut f_scale = cos_i;
     if any_mixed {
-        f_scale = mixed.select(w * cos_i, f_scale);
-        bsdf_pdf = mixed.select(w * bsdf_pdf, bsdf_pdf);
+        lobe_w = mixed.select(w, lobe_w);
+        f_scale = lobe_w * cos_i;
+        bsdf_pdf = lobe_w * bsdf_pdf;
     }
     let guard = a.guard;
     let guarded = OTHER_LOBES && a.mapped && guard.any();
@@ -300,11 +304,7 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>
         // wi this is zero, and the sample ends here (its density, which `Bsdf::pdf` would
         // make zero too, is not asked for).
         let attenuation = guard_attenuation(a.guard_n, a.guard_alpha2, frame.n, wi);
-        let mut weight = F8::splat(1.0);
-        if any_mixed {
-            weight = mixed.select(w, weight);
-        }
-        let guarded = weight * attenuation * cos_i;
+        let guarded = lobe_w * attenuation * cos_i;
         guard.select3(f.scale(guarded), f.scale(f_scale))
     } else {
         f.scale(f_scale)
@@ -483,47 +483,37 @@ fn lobes_f_and_pdf<const OTHER_LOBES: bool, const COATED: bool>(
     let any_principled = COATED && principled.any();
     let wi_z = wi.dot(frame.n);
     let wi_local = frame.to_local(wi);
-    let (mut f, mut bsdf_pdf) = (a.diffuse.f_z(wo_z, wi_z), a.diffuse.pdf_z(wo_z, wi_z));
+    let mut f_pdf = (a.diffuse.f_z(wo_z, wi_z), a.diffuse.pdf_z(wo_z, wi_z));
     if any_metal {
-        let (f_metal, pdf_metal) = a.metal.f_and_pdf(wo_local, wi_local);
-        (f, bsdf_pdf) = (metal.select3(f_metal, f), metal.select(pdf_metal, bsdf_pdf));
+        f_pdf = where_lobe(metal, a.metal.f_and_pdf(wo_local, wi_local), f_pdf);
     }
     if any_rough_glass {
-        let (f_glass, pdf_glass) = a.rough_glass.f_and_pdf(wo_local, wi_local, Lobes::All);
-        (f, bsdf_pdf) = (
-            rough_glass.select3(f_glass, f),
-            rough_glass.select(pdf_glass, bsdf_pdf),
-        );
+        let glass = a.rough_glass.f_and_pdf(wo_local, wi_local, Lobes::All);
+        f_pdf = where_lobe(rough_glass, glass, f_pdf);
     }
     if any_plastic {
-        let (f_plastic, pdf_plastic) = a.plastic.f_and_pdf(wo_local, wi_local);
-        (f, bsdf_pdf) = (
-            plastic.select3(f_plastic, f),
-            plastic.select(pdf_plastic, bsdf_pdf),
-        );
+        f_pdf = where_lobe(plastic, a.plastic.f_and_pdf(wo_local, wi_local), f_pdf);
     }
     if any_rough_plastic {
-        let (f_plastic, pdf_plastic) = a.rough_plastic.f_and_pdf(wo_local, wi_local);
-        (f, bsdf_pdf) = (
-            rough_plastic.select3(f_plastic, f),
-            rough_plastic.select(pdf_plastic, bsdf_pdf),
-        );
+        let rough = a.rough_plastic.f_and_pdf(wo_local, wi_local);
+        f_pdf = where_lobe(rough_plastic, rough, f_pdf);
     }
     if any_translucent {
-        let (f_t, pdf_t) = a.translucent.f_and_pdf(wo_local, wi_local);
-        (f, bsdf_pdf) = (
-            translucent.select3(f_t, f),
-            translucent.select(pdf_t, bsdf_pdf),
-        );
+        let t = a.translucent.f_and_pdf(wo_local, wi_local);
+        f_pdf = where_lobe(translucent, t, f_pdf);
     }
     if any_principled {
-        let (f_p, pdf_p) = a.principled.f_and_pdf(wo_local, wi_local);
-        (f, bsdf_pdf) = (
-            principled.select3(f_p, f),
-            principled.select(pdf_p, bsdf_pdf),
-        );
+        let p = a.principled.f_and_pdf(wo_local, wi_local);
+        f_pdf = where_lobe(principled, p, f_pdf);
     }
-    (f, bsdf_pdf)
+    f_pdf
+}
+
+/// A lobe's value and density where `lanes` have it, `others` elsewhere (a function, not a
+/// closure: `#[inline(always)]` keeps it in the vector-unit instances that call it).
+#[inline(always)]
+fn where_lobe(lanes: M8, (f, pdf): (V8, F8), others: (V8, F8)) -> (V8, F8) {
+    (lanes.select3(f, others.0), lanes.select(pdf, others.1))
 }
 
 /// [`scatter_lanes`] compiled for AVX2.
