@@ -439,8 +439,7 @@ fn scatter_lanes<const OTHER_LOBES: bool, const COATED: bool, const MIXED: bool>
             let f_mixed = f_mixed.scale(w * attenuation * cos).div_by(cos);
             let ok = pdf_mixed.gt(zero) & cos.gt(zero) & finite(f_mixed);
             sampled = sampled & (ok | !smooth);
-            f = smooth.select3(f_mixed, f);
-            pdf = smooth.select(pdf_mixed, pdf);
+            (f, pdf) = where_lobe(smooth, (f_mixed, pdf_mixed), (f, pdf));
         }
         // Straight through: f cos / pdf = null / null (one), a delta sample of no refraction.
         let null = F8::splat(1.0) - w;
