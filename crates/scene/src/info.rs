@@ -1,7 +1,7 @@
 //! What a scene contains, for `pathlab info`.
 
 use glam::Vec3;
-use pathlab_render::desc::{SceneDesc, Visibility};
+use pathlab_render::desc::{ProjectorKind, SceneDesc, Visibility};
 use std::collections::BTreeMap;
 
 /// A summary of a scene description.
@@ -17,7 +17,8 @@ pub struct SceneInfo {
     pub sdf_grids: usize,
     /// Materials by kind (diffuse, mirror, ...).
     pub materials: BTreeMap<String, usize>,
-    /// Lights by kind (area meshes, area spheres, point, spot, directional, environment).
+    /// Lights by kind (area meshes, area spheres, point, spot, projector, directional,
+    /// environment).
     pub lights: BTreeMap<String, usize>,
     /// Camera position, target, vertical field of view (degrees) and image size.
     pub camera: (Vec3, Vec3, f32, [u32; 2]),
@@ -68,6 +69,14 @@ pub fn summarize(desc: &SceneDesc) -> SceneInfo {
     );
     add("point", desc.point_lights.len());
     add("spot", desc.spot_lights.len());
+    // Mitsuba's spots (an image over the cone, if only a constant one) are projectors inside.
+    for p in &desc.projectors {
+        let kind = match p.kind {
+            ProjectorKind::Spot { .. } => "spot",
+            ProjectorKind::Projector { .. } => "projector",
+        };
+        add(kind, 1);
+    }
     add("directional", desc.directional_lights.len());
     match &desc.environment_map {
         Some(m) => add(&format!("environment map ({} x {})", m.width, m.height), 1),

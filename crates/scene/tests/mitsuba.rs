@@ -525,3 +525,25 @@ fn unknown_and_unused_bsdfs_are_reported_with_their_line() {
     // The scene itself is what it was: one sphere, of the grey stand-in.
     assert_eq!(desc.materials.len(), 1);
 }
+
+#[test]
+fn info_counts_spots_and_projectors() {
+    let suite = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/mitsuba-suite/tests/scenes");
+    let lights = |file: &str| {
+        let desc = mitsuba::load(&suite.join(file)).unwrap();
+        info::summarize(&desc)
+            .lights
+            .into_iter()
+            .collect::<Vec<_>>()
+    };
+    let one = |kind: &str| (kind.to_string(), 1);
+    assert_eq!(
+        lights("spot_light/test_spot_direct.xml"),
+        [one("environment"), one("spot")]
+    );
+    assert_eq!(
+        lights("projector/test_projector_textured_direct.xml"),
+        [one("projector")]
+    );
+}
