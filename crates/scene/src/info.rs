@@ -69,7 +69,8 @@ pub fn summarize(desc: &SceneDesc) -> SceneInfo {
     );
     add("point", desc.point_lights.len());
     add("spot", desc.spot_lights.len());
-    // Mitsuba's spots (an image over the cone, if only a constant one) are projectors inside.
+    // Mitsuba's spot lights load as projectors: an image over the cone (a constant one where
+    // the file gives none).
     for p in &desc.projectors {
         let kind = match p.kind {
             ProjectorKind::Spot { .. } => "spot",
