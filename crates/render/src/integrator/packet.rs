@@ -788,6 +788,8 @@ impl PathIntegrator {
                 (a.environment, a.environment_wi, a.environment_pdf) = (d.found, d.wi, d.pdf);
             }
             scatter(&mut a, &mut b);
+            // Small scenes: every lane's shadow ray against every primitive at once.
+            let blocked = every_primitive.then(|| blocked_lanes(scene, &b, &mut rays));
             for i in 0..W {
                 let (Some(lane), Some(si)) = (&mut lanes[i], &hits[i]) else {
                     continue;
@@ -798,6 +800,7 @@ impl PathIntegrator {
                     &mut lane.st,
                     si,
                     &b,
+                    blocked.map(|m| m & (1 << i) != 0),
                     directions.as_ref(),
                     u[6][i],
                     stats,
@@ -810,9 +813,10 @@ impl PathIntegrator {
         }
     }
 
-    /// The end of lane `i`'s bounce after the SIMD scattering: the shadow ray (adding the light
-    /// sample's contribution where it is unblocked; an environment map's radiance, from
-    /// `directions`, is read then), the throughput times the BSDF sample's weight (and the
+    /// The end of lane `i`'s bounce after the SIMD scattering: the shadow ray (traced here
+    /// unless `blocked` says whether it is; adding the light sample's contribution where it is
+    /// unblocked; an environment map's radiance, from `directions`, is read then), the
+    /// throughput times the BSDF sample's weight (and the
     /// radiance scale by the relative index it crossed), Russian roulette with `u_rr`. Returns
     /// whether the path goes on.
     #[allow(clippy::too_many_arguments)]
@@ -824,6 +828,7 @@ impl PathIntegrator {
         st: &mut PathState,
         si: &SurfaceInteraction,
         b: &ScatterOut,
+        blocked: Option<bool>,
         directions: Option<&(&EnvironmentMap, DirectionLanes)>,
         u_rr: f32,
         stats: &mut PathStats,
@@ -831,13 +836,15 @@ impl PathIntegrator {
         if b.shadow.get(i) {
             stats.rays += 1;
             let environment = directions.filter(|(_, d)| d.found.get(i));
-            let shadow = Ray {
-                o: b.shadow_o.get(i),
-                d: b.shadow_d.get(i),
-                t_min: 0.0,
-                t_max: b.shadow_t_max.0[i],
-            };
-            if !scene.occluded(&shadow) {
+            let occluded = blocked.unwrap_or_else(|| {
+                scene.occluded(&Ray {
+                    o: b.shadow_o.get(i),
+                    d: b.shadow_d.get(i),
+                    t_min: 0.0,
+                    t_max: b.shadow_t_max.0[i],
+                })
+            });
+            if !occluded {
                 match environment {
                     Some((map, d)) => {
                         // As `visible_light_sample` and `sample_light` finish.
@@ -930,6 +937,25 @@ fn nearest_of_lanes(
         }
     }
     scene.nearest_of_rays(rays, t_max, coherent)
+}
+
+/// The lanes whose shadow ray ([`ScatterOut::shadow`]) something blocks, as bits, found by
+/// testing every primitive against all eight at once ([`Scene::nearest_of_rays`]; only where
+/// [`Scene::tests_every_primitive`]): a ray is blocked where it has a nearest hit within its
+/// extent, which is where [`Scene::occluded`] finds one (the same triangle and sphere tests).
+/// Lanes without a shadow ray get an empty extent.
+fn blocked_lanes(scene: &Scene, b: &ScatterOut, rays: &mut RayLanes) -> u32 {
+    if !b.shadow.any() {
+        return 0;
+    }
+    (rays.o, rays.d, rays.t_min) = (b.shadow_o, b.shadow_d, F8::splat(0.0));
+    let t_max = b
+        .shadow
+        .select(b.shadow_t_max, F8::splat(f32::NEG_INFINITY));
+    let nearest = scene.nearest_of_rays(rays, t_max, true);
+    (0..W)
+        .filter(|&i| nearest.lane(i).is_some())
+        .fold(0, |m, i| m | 1 << i)
 }
 
 /// An environment map's radiance and density towards the rays of the lanes `active`, which
