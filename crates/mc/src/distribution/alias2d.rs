@@ -326,30 +326,43 @@ mod tests {
 
     #[test]
     fn the_lanes_sample_what_one_sample_at_a_time_gives() {
-        let func: Vec<f32> = (0..40 * 20).map(|i| ((i * 37) % 11) as f32).collect();
-        let d = PiecewiseConstantAlias2D::new(&func, 40, 20).unwrap();
-        let mut rng = Pcg32::new(5, 1);
+        // Sizes that divide by a product (powers of two) and by a division, a single cell, and
+        // zero cells; numbers at and beyond the edges, NaN included, in some lanes.
         let below_one = 1.0 - f32::EPSILON / 2.0;
-        let edges = F8([0.0, below_one, 0.5, below_one, 0.0, 0.25, 0.75, 1e-9]);
-        for (round, active) in [0xff, 0x5a, 0x01, 0, 0xff].into_iter().enumerate() {
-            let mut u = [(); 2].map(|_| F8(std::array::from_fn(|_| rng.uniform_f32())));
-            if round == 4 {
-                u = [edges, F8(std::array::from_fn(|i| edges.0[7 - i]))];
-            }
-            // Asking for the bins changes nothing the lanes then compute (and indexes the
-            // table as they do, edges included).
-            d.prefetch_lanes(u, active);
-            let (p, pdf) = d.sample_lanes(u, active);
-            for i in 0..W {
-                let (one, one_pdf) = if active & (1 << i) != 0 {
-                    d.sample(Vec2::new(u[0].0[i], u[1].0[i]))
-                } else {
-                    (Vec2::ZERO, 0.0)
+        let edges = F8([0.0, below_one, 0.5, 1.0, -0.0, f32::NAN, -0.5, 1e-9]);
+        for (nu, nv) in [(40, 20), (64, 32), (1, 1), (7, 3)] {
+            let func: Vec<f32> = (0..nu * nv).map(|i| ((i * 37) % 11) as f32).collect();
+            let d = PiecewiseConstantAlias2D::new(&func, nu, nv).unwrap();
+            let mut rng = Pcg32::new(5, nu as u64);
+            for round in 0..400 {
+                let active = match round % 5 {
+                    0 => 0xff,
+                    1 => 0,
+                    2 => 0x01,
+                    _ => rng.next_u32() & 0xff,
                 };
-                assert_eq!(
-                    [p[0].0[i], p[1].0[i], pdf.0[i]].map(f32::to_bits),
-                    [one.x, one.y, one_pdf].map(f32::to_bits)
-                );
+                let mut u = [(); 2].map(|_| F8(std::array::from_fn(|_| rng.uniform_f32())));
+                match round % 4 {
+                    0 => u = [edges, F8(std::array::from_fn(|i| edges.0[7 - i]))],
+                    1 => u[1] = edges,
+                    _ => {}
+                }
+                // Asking for the bins changes nothing the lanes then compute (and indexes the
+                // table as they do, edges included).
+                d.prefetch_lanes(u, active);
+                let (p, pdf) = d.sample_lanes(u, active);
+                for i in 0..W {
+                    let (one, one_pdf) = if active & (1 << i) != 0 {
+                        d.sample(Vec2::new(u[0].0[i], u[1].0[i]))
+                    } else {
+                        (Vec2::ZERO, 0.0)
+                    };
+                    assert_eq!(
+                        [p[0].0[i], p[1].0[i], pdf.0[i]].map(f32::to_bits),
+                        [one.x, one.y, one_pdf].map(f32::to_bits),
+                        "{nu} x {nv}, lane {i} of {u:?}"
+                    );
+                }
             }
         }
     }
