@@ -3,7 +3,9 @@
 //! after another through the BVH (its own SIMD traversal), or, in scenes of a few dozen
 //! triangles and a few spheres, all eight against every primitive at once (skipping the
 //! blocks of triangles none of them meets where the rays go one way: camera rays and first
-//! bounces, since the lanes take consecutive samples of a pixel). The lanes that start
+//! bounces, since the lanes take consecutive samples of a pixel); their shadow rays too, the
+//! same way (one lane after another through the BVH, or all eight against every primitive,
+//! skipping the blocks none meets: rays towards one light converge). The lanes that start
 //! together make their camera rays together, and the sampler draws each bounce's random
 //! numbers for all lanes at once.
 //!
@@ -943,7 +945,10 @@ fn nearest_of_lanes(
 /// testing every primitive against all eight at once ([`Scene::nearest_of_rays`]; only where
 /// [`Scene::tests_every_primitive`]): a ray is blocked where it has a nearest hit within its
 /// extent, which is where [`Scene::occluded`] finds one (the same triangle and sphere tests).
-/// Lanes without a shadow ray get an empty extent.
+/// Lanes without a shadow ray get an empty extent. The blocks of triangles that no shadow ray
+/// meets the box of are skipped: shadow rays towards a small light converge on it, and in the
+/// Cornell box this is what makes the lanes' test faster than the BVH's early exit (without
+/// it, 7% slower; with it, 1% faster).
 fn blocked_lanes(scene: &Scene, b: &ScatterOut, rays: &mut RayLanes) -> u32 {
     if !b.shadow.any() {
         return 0;
