@@ -1248,6 +1248,11 @@ mod tests {
 
     /// A floor and a back wall lit by an emitting quad above, seen from the front.
     fn room() -> Scene {
+        Scene::build(&room_desc()).unwrap()
+    }
+
+    /// [`room`]'s description.
+    fn room_desc() -> SceneDesc {
         let quad = |c: [Vec3; 4], material, emission| MeshDesc {
             name: "quad".into(),
             positions: c.to_vec(),
@@ -1256,7 +1261,7 @@ mod tests {
             emission,
             ..Default::default()
         };
-        let desc = SceneDesc {
+        SceneDesc {
             meshes: vec![
                 quad(
                     [
@@ -1302,8 +1307,7 @@ mod tests {
             },
             resolution: [8, 8],
             ..Default::default()
-        };
-        Scene::build(&desc).unwrap()
+        }
     }
 
     /// The default path tracer's estimates of every pixel's samples, on this thread.
@@ -1332,6 +1336,73 @@ mod tests {
             &mut PathStats::default(),
         );
         out
+    }
+
+    #[test]
+    fn the_lanes_shadow_rays_are_blocked_where_the_bvh_finds_a_blocker() {
+        // The room with two spheres: small enough for the lanes' shadow rays to be tested
+        // against every primitive at once. Each lane's answer must be `Scene::occluded`'s, for
+        // rays of every length (to infinity, as towards an environment map, and short), in
+        // rounds where some lanes have no shadow ray.
+        let mut desc = room_desc();
+        desc.spheres = [
+            (Vec3::new(0.3, 0.4, 0.0), 0.3),
+            (Vec3::new(-0.5, 1.0, -0.5), 0.2),
+        ]
+        .map(|(center, radius)| crate::desc::SphereDesc {
+            center,
+            radius,
+            ..Default::default()
+        })
+        .to_vec();
+        let scene = Scene::build(&desc).unwrap();
+        assert!(scene.tests_every_primitive());
+        let mut rng = pathlab_mc::rng::Pcg32::new(3, 7);
+        let mut rays = RayLanes::default();
+        let (mut blocked, mut clear) = (0, 0);
+        for _ in 0..2000 {
+            let mut b = ScatterOut::default();
+            let mut shadows = [None; W];
+            for (i, shadow) in shadows.iter_mut().enumerate() {
+                if rng.uniform_f32() < 0.2 {
+                    continue;
+                }
+                let mut u = || rng.uniform_f32();
+                let mut point = || Vec3::new(2.0 * u() - 1.0, 1.8 * u() + 0.05, 2.0 * u() - 1.0);
+                let (o, target) = (point(), point());
+                let unit = pathlab_mc::warp::sample_uniform_sphere(glam::Vec2::new(u(), u()));
+                // Towards infinity, a short way, and to a point (as to a point light).
+                let (d, t_max) = match i % 3 {
+                    0 => (unit, f32::INFINITY),
+                    1 => (unit, 2.0 * u()),
+                    _ => (target - o, SHADOW_RAY_END),
+                };
+                b.shadow.set(i, true);
+                b.shadow_o.set(i, o);
+                b.shadow_d.set(i, d);
+                b.shadow_t_max.0[i] = t_max;
+                *shadow = Some(Ray {
+                    o,
+                    d,
+                    t_min: 0.0,
+                    t_max,
+                });
+            }
+            let lanes = blocked_lanes(&scene, &b, &mut rays);
+            for (i, shadow) in shadows.iter().enumerate() {
+                let want = shadow.is_some_and(|ray| scene.occluded(&ray));
+                assert_eq!(lanes & (1 << i) != 0, want, "lane {i}: {shadow:?}");
+                match (shadow, want) {
+                    (Some(_), true) => blocked += 1,
+                    (Some(_), false) => clear += 1,
+                    _ => {}
+                }
+            }
+        }
+        assert!(
+            blocked > 1000 && clear > 1000,
+            "{blocked} blocked, {clear} clear"
+        );
     }
 
     #[test]
