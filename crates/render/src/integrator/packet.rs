@@ -818,9 +818,8 @@ impl PathIntegrator {
     /// The end of lane `i`'s bounce after the SIMD scattering: the shadow ray (traced here
     /// unless `blocked` says whether it is; adding the light sample's contribution where it is
     /// unblocked; an environment map's radiance, from `directions`, is read then), the
-    /// throughput times the BSDF sample's weight (and the
-    /// radiance scale by the relative index it crossed), Russian roulette with `u_rr`. Returns
-    /// whether the path goes on.
+    /// throughput times the BSDF sample's weight (and the radiance scale by the relative index
+    /// it crossed), Russian roulette with `u_rr`. Returns whether the path goes on.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn finish_bounce(
